@@ -1,0 +1,101 @@
+"""PD joint-position controller with frozen joints and coupled (mimic) joints, batched over envs.
+
+One controller drives *every* joint of the robot so that frozen joints keep a drive target: the action only writes
+the free joints; frozen joints hold the target they had (the measured pose at reset); follower joints copy their
+leader's target (the ShadowHand's distal joints J0 follow the middle joints J1, as MuJoCo's tendons couple them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+from gymnasium import spaces
+from mani_skill.agents.controllers.pd_joint_pos import PDJointPosController, PDJointPosControllerConfig
+from mani_skill.utils.structs.types import Array
+
+from gendex_envs.errors import ControlModeError
+
+
+class FreezingJointPosController(PDJointPosController):
+    """Absolute or delta joint-position targets for the free joints; frozen joints hold, followers mimic."""
+
+    config: FreezingJointPosControllerConfig
+
+    def _initialize_joints(self):
+        super()._initialize_joints()
+        names = list(self.config.joint_names)
+        unknown = [n for n in (*self.config.free_joint_names, *self.config.mimic, *self.config.mimic.values())
+                   if n not in names]
+        if unknown:
+            raise ControlModeError(f"joints {unknown} are not driven by this controller; known joints: {names}")
+        followers = set(self.config.mimic)
+        free = [n for n in self.config.free_joint_names if n not in followers]
+        if not free:
+            raise ControlModeError("a controller needs at least one free joint")
+        device = self.device
+        self.free_idx = torch.tensor([names.index(n) for n in free], dtype=torch.long, device=device)
+        """[F] positions (in ``joint_names``) of the joints the action drives."""
+        self.follower_idx = torch.tensor([names.index(n) for n in self.config.mimic], dtype=torch.long, device=device)
+        self.leader_idx = torch.tensor([names.index(n) for n in self.config.mimic.values()], dtype=torch.long,
+                                       device=device)
+        self.free_joint_names = tuple(free)
+
+    def _get_joint_limits(self) -> np.ndarray:
+        free = self.free_idx.cpu().numpy()
+        if self.config.use_delta:
+            lo = np.broadcast_to(np.asarray(self.config.lower, dtype=np.float32), (len(free),))
+            hi = np.broadcast_to(np.asarray(self.config.upper, dtype=np.float32), (len(free),))
+            return np.stack([lo, hi], axis=1)
+        qlimits = self.articulation.get_qlimits()[0, self.active_joint_indices].cpu().numpy()
+        return qlimits[free]
+
+    def _initialize_action_space(self):
+        limits = self._get_joint_limits()
+        self.single_action_space = spaces.Box(limits[:, 0], limits[:, 1], dtype=np.float32)
+
+    def set_action(self, action: Array):
+        action = self._preprocess_action(action)  # [N, F]
+        self._step = 0
+        self._start_qpos = self.qpos
+        target = self._target_qpos.clone()  # [N, J]
+        if self.config.use_delta:
+            base = target if self.config.use_target else self._start_qpos
+            target[:, self.free_idx] = base[:, self.free_idx] + action
+        else:
+            target[:, self.free_idx] = action
+        if len(self.follower_idx):
+            target[:, self.follower_idx] = target[:, self.leader_idx]
+        self._target_qpos = target
+        if self.config.interpolate:
+            self._step_size = (self._target_qpos - self._start_qpos) / self._sim_steps
+        else:
+            self.set_drive_targets(self._target_qpos)
+
+    def reset(self):
+        super().reset()
+        # followers start on their leader's target so the first action does not jerk them
+        if len(self.follower_idx) and self._target_qpos is not None:
+            self._target_qpos[:, self.follower_idx] = self._target_qpos[:, self.leader_idx]
+            self.set_drive_targets(self._target_qpos)
+
+    def get_state(self) -> dict:
+        # always save the targets: frozen joints' targets are part of the state
+        return {"target_qpos": self._target_qpos}
+
+    def set_state(self, state: dict):
+        self._target_qpos = state["target_qpos"]
+        self.set_drive_targets(self._target_qpos)
+
+
+@dataclass
+class FreezingJointPosControllerConfig(PDJointPosControllerConfig):
+    """Config of :class:`FreezingJointPosController`. ``joint_names`` lists every driven joint."""
+
+    free_joint_names: Sequence[str] = ()
+    """Joints the action drives (a subset of ``joint_names``); the rest are frozen at their current target."""
+    mimic: dict[str, str] = field(default_factory=dict)
+    """follower joint -> leader joint; the follower's target is the leader's target."""
+    controller_cls = FreezingJointPosController

@@ -1,0 +1,241 @@
+"""``UR10eShadowHand``: a ShadowHand (24 DoF) on a UR10e arm (6 DoF), as a ManiSkill agent.
+
+Degrees of freedom (30 joints, 26 actuated):
+
+=========  ============================================================================================
+group      joints (articulation order may differ; use the names)
+=========  ============================================================================================
+arm (6)    shoulder_pan, shoulder_lift, elbow, wrist_1, wrist_2, wrist_3 (``*_joint``)
+wrist (2)  WRJ1 (radial/ulnar), WRJ0 (flexion)
+ff (4)     FFJ3 (abduction), FFJ2, FFJ1, FFJ0 (flexion; FFJ0 follows FFJ1)
+mf (4)     MFJ3, MFJ2, MFJ1, MFJ0 (MFJ0 follows MFJ1)
+rf (4)     RFJ3, RFJ2, RFJ1, RFJ0 (RFJ0 follows RFJ1)
+lf (5)     LFJ4 (metacarpal cup), LFJ3, LFJ2, LFJ1, LFJ0 (LFJ0 follows LFJ1)
+th (5)     THJ4 (rotation), THJ3, THJ2, THJ1, THJ0
+=========  ============================================================================================
+
+The distal joints J0 of the four fingers are coupled to J1 by tendons in the real hand (and in MuJoCo); PhysX
+does not import that coupling, so the controller does it: an action never addresses a J0 joint, whose target is
+always its J1's. The robot's links ignore gravity (a gravity-compensated controller) and do not collide with each
+other; they collide with everything else.
+
+``control_joint`` picks which joints an action drives; every other joint is frozen at its current target.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import sapien
+import torch
+from mani_skill.agents.base_agent import BaseAgent, Keyframe
+from mani_skill.agents.registration import register_agent
+from mani_skill.utils.structs import Actor, Link
+
+from gendex_envs.agents.controller import FreezingJointPosControllerConfig
+from gendex_envs.agents.robot_model import robot_urdf_path
+from gendex_envs.errors import ControlModeError
+from gendex_envs.geometry import quat_rotate
+
+log = logging.getLogger(__name__)
+
+ARM_JOINTS = ("shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",
+              "wrist_3_joint")
+WRIST_JOINTS = ("WRJ1", "WRJ0")
+FINGER_JOINTS = {
+    "th": ("THJ4", "THJ3", "THJ2", "THJ1", "THJ0"),
+    "ff": ("FFJ3", "FFJ2", "FFJ1", "FFJ0"),
+    "mf": ("MFJ3", "MFJ2", "MFJ1", "MFJ0"),
+    "rf": ("RFJ3", "RFJ2", "RFJ1", "RFJ0"),
+    "lf": ("LFJ4", "LFJ3", "LFJ2", "LFJ1", "LFJ0"),
+}
+HAND_JOINTS = WRIST_JOINTS + tuple(j for f in FINGER_JOINTS.values() for j in f)
+ALL_JOINTS = ARM_JOINTS + HAND_JOINTS
+COUPLED_DISTAL = {"FFJ0": "FFJ1", "MFJ0": "MFJ1", "RFJ0": "RFJ1", "LFJ0": "LFJ1"}
+"""Follower distal joint -> leader middle joint."""
+
+_fingers = lambda *names: tuple(j for n in names for j in FINGER_JOINTS[n])  # noqa: E731
+CONTROL_JOINT_GROUPS: dict[str, tuple[str, ...]] = {
+    "arm": ARM_JOINTS,
+    "hand": HAND_JOINTS,
+    "both": ALL_JOINTS,
+    "three_finger": _fingers("th", "ff", "mf"),
+    "arm_two_finger": ARM_JOINTS + _fingers("th", "mf"),
+    "lift_inspire": ("wrist_1_joint",) + _fingers("th", "ff", "mf", "rf", "lf"),
+}
+"""``control_joint`` mode -> joints the action drives (coupled distal joints are never in the action)."""
+
+TIP_LINKS = ("thdistal", "ffdistal", "mfdistal", "rfdistal", "lfdistal")
+"""Fingertip links, in the order of every ``[N, 5, ...]`` fingertip tensor: thumb, index, middle, ring, little."""
+TIP_OFFSETS_M = (0.0275, 0.026, 0.026, 0.026, 0.026)
+"""Distance of each fingertip point along its distal link's z axis (the MJCF's ``S_*tip`` sites)."""
+PALM_LINK = "palm"
+HAND_GROUP_LINKS: dict[str, tuple[str, ...]] = {
+    "th": ("thbase", "thproximal", "thhub", "thmiddle", "thdistal"),
+    "ff": ("ffknuckle", "ffproximal", "ffmiddle", "ffdistal"),
+    "mf": ("mfknuckle", "mfproximal", "mfmiddle", "mfdistal"),
+    "rf": ("rfknuckle", "rfproximal", "rfmiddle", "rfdistal"),
+    "lf": ("lfmetacarpal", "lfknuckle", "lfproximal", "lfmiddle", "lfdistal"),
+    "palm": ("palm",),
+}
+"""Link groups of :meth:`UR10eShadowHand.get_hand_group_obj_mean_force`, in its output order."""
+
+ROBOT_COLLISION_GROUP_ID = 1 << 20
+"""collision_groups[3] value shared by all robot shapes; with a common bit in groups[2] they ignore each other."""
+SELF_COLLISION_BIT = 1 << 29
+
+
+@dataclass(frozen=True)
+class DriveGains:
+    stiffness: float
+    damping: float
+    force_limit: float
+
+
+ARM_GAINS = DriveGains(stiffness=4000.0, damping=400.0, force_limit=330.0)
+WRIST_GAINS = DriveGains(stiffness=60.0, damping=3.0, force_limit=20.0)
+FINGER_GAINS = DriveGains(stiffness=15.0, damping=0.5, force_limit=2.0)
+"""Finger PD gains that grasp reliably in PhysX at 120 Hz (stiffness 10-20, damping ~0.5, force 1-5 N·m)."""
+
+DELTA_LIMIT_RAD = {"arm": 0.05, "hand": 0.1}
+"""Per-control-step bound of ``pd_joint_delta_pos`` actions, for arm and hand joints."""
+
+# Keyframes, by joint name (coupled distal joints equal their leader).
+_REST_ARM = (2.022, -0.994, 3.017, 1.118, -0.451, -3.142)
+"""Elbow up, palm facing the table 0.30 m above it at x = 0.10 m, fingers pointing +x (found by IK)."""
+_OPEN_HAND = {j: 0.0 for j in HAND_JOINTS}
+_RELAXED_HAND = _OPEN_HAND | {"FFJ2": 0.3, "FFJ1": 0.3, "FFJ0": 0.3, "MFJ2": 0.3, "MFJ1": 0.3, "MFJ0": 0.3,
+                              "RFJ2": 0.3, "RFJ1": 0.3, "RFJ0": 0.3, "LFJ2": 0.3, "LFJ1": 0.3, "LFJ0": 0.3,
+                              "THJ4": 0.6, "THJ3": 0.3}
+KEYFRAME_QPOS_BY_NAME: dict[str, dict[str, float]] = {
+    "rest": dict(zip(ARM_JOINTS, _REST_ARM)) | _RELAXED_HAND,
+    "pregrasp_open": dict(zip(ARM_JOINTS, _REST_ARM)) | _OPEN_HAND | {"THJ4": 1.0, "THJ3": 0.2},
+}
+
+
+@register_agent()
+class UR10eShadowHand(BaseAgent):
+    """ShadowHand on a UR10e; see the module docstring for the DoF table and control modes."""
+
+    uid = "ur10e_shadow"
+    fix_root_link = True
+    disable_self_collisions = True
+
+    def __init__(self, *args, control_joint: str = "both", **kwargs):
+        if control_joint not in CONTROL_JOINT_GROUPS:
+            raise ControlModeError(
+                f"control_joint={control_joint!r} is not a mode; allowed: {sorted(CONTROL_JOINT_GROUPS)}"
+            )
+        self.control_joint = control_joint
+        """Which joints actions drive: one of :data:`CONTROL_JOINT_GROUPS`."""
+        super().__init__(*args, **kwargs)
+
+    @property
+    def urdf_path(self) -> str:  # built (once, cached) from in-repo UR10e data + the gymnasium-robotics ShadowHand
+        return str(robot_urdf_path())
+
+    @property
+    def keyframes(self) -> dict[str, Keyframe]:
+        return {
+            name: Keyframe(pose=sapien.Pose(), qpos=self.qpos_from_names(q))
+            for name, q in KEYFRAME_QPOS_BY_NAME.items()
+        }
+
+    def qpos_from_names(self, by_name: dict[str, float]) -> np.ndarray:
+        """Joint positions by name -> (30,) array in the articulation's active-joint order."""
+        order = [j.name for j in self.robot.get_active_joints()]
+        return np.array([by_name[n] for n in order], dtype=np.float32)
+
+    # ------------------------------------------------------------------ loading
+    def _after_loading_articulation(self):
+        for link in self.robot.get_links():
+            for obj in link._objs:
+                obj.disable_gravity = True
+                for shape in obj.collision_shapes:
+                    groups = shape.get_collision_groups()
+                    groups[2] |= SELF_COLLISION_BIT
+                    groups[3] = ROBOT_COLLISION_GROUP_ID
+                    shape.set_collision_groups(groups)
+        self.tip_links: list[Link] = [self.robot.links_map[n] for n in TIP_LINKS]
+        """The five distal links (th, ff, mf, rf, lf)."""
+        self.palm_link: Link = self.robot.links_map[PALM_LINK]
+        self.group_links: dict[str, list[Link]] = {
+            g: [self.robot.links_map[n] for n in names] for g, names in HAND_GROUP_LINKS.items()
+        }
+        self._tip_offsets = torch.tensor(TIP_OFFSETS_M, dtype=torch.float32, device=self.device)
+
+    @property
+    def _controller_configs(self):
+        order = [j.name for j in self.robot.get_active_joints()]
+        free = [j for j in CONTROL_JOINT_GROUPS[self.control_joint] if j not in COUPLED_DISTAL]
+
+        def gains(attr: str) -> list[float]:
+            return [getattr(ARM_GAINS if j in ARM_JOINTS else WRIST_GAINS if j in WRIST_JOINTS else FINGER_GAINS,
+                            attr) for j in order]
+
+        delta = [DELTA_LIMIT_RAD["arm" if j in ARM_JOINTS else "hand"] for j in order]
+        common = dict(joint_names=order, stiffness=gains("stiffness"), damping=gains("damping"),
+                      force_limit=gains("force_limit"), free_joint_names=free, mimic=dict(COUPLED_DISTAL))
+        free_delta = [delta[order.index(j)] for j in free]
+        return dict(
+            pd_joint_pos=FreezingJointPosControllerConfig(lower=None, upper=None, normalize_action=False, **common),
+            pd_joint_delta_pos=FreezingJointPosControllerConfig(
+                lower=[-d for d in free_delta], upper=free_delta, use_delta=True, use_target=True,
+                normalize_action=True, **common),
+        )
+
+    # ------------------------------------------------------------------ reward-code API (batched)
+    @property
+    def tip_poses(self) -> torch.Tensor:
+        """[N, 5*7] fingertip poses (x, y, z, qw, qx, qy, qz) of th, ff, mf, rf, lf, concatenated."""
+        poses = []
+        for i, link in enumerate(self.tip_links):
+            pose = link.pose  # Pose, p [N, 3], q [N, 4]
+            offset = torch.zeros_like(pose.p)
+            offset[:, 2] = self._tip_offsets[i]
+            p = pose.p + quat_rotate(pose.q, offset)
+            poses.append(torch.cat([p, pose.q], dim=-1))
+        return torch.cat(poses, dim=-1)
+
+    @property
+    def tip_positions(self) -> torch.Tensor:
+        """[N, 5, 3] fingertip positions (th, ff, mf, rf, lf), metres."""
+        return self.tip_poses.view(-1, 5, 7)[..., :3]
+
+    def _contact_forces(self, links: list[Link], obj: Actor | Link | None) -> torch.Tensor:
+        """[N, len(links), 3] net (obj None) or pairwise contact forces on each link, newtons."""
+        if obj is None:
+            forces = [link.get_net_contact_forces() for link in links]
+        else:
+            forces = [self.scene.get_pairwise_contact_forces(link, obj) for link in links]
+        return torch.stack(forces, dim=1)
+
+    def get_fsr_force(self) -> torch.Tensor:
+        """[N, 5, 3] net contact force on each fingertip link (th, ff, mf, rf, lf), N."""
+        return self._contact_forces(self.tip_links, None)
+
+    def get_fsr_obj_force(self, obj: Actor | Link) -> torch.Tensor:
+        """[N, 5, 3] contact force between each fingertip link and ``obj``, N."""
+        return self._contact_forces(self.tip_links, obj)
+
+    def get_fsr_impulse(self) -> torch.Tensor:
+        """[N, 5, 3] net contact impulse on each fingertip over the last physics step, N·s."""
+        return self.get_fsr_force() * self.scene.timestep
+
+    def get_fsr_obj_impulse(self, obj: Actor | Link) -> torch.Tensor:
+        """[N, 5, 3] contact impulse between each fingertip and ``obj`` over the last physics step, N·s."""
+        return self.get_fsr_obj_force(obj) * self.scene.timestep
+
+    def get_hand_group_obj_mean_force(self, obj: Actor | Link) -> torch.Tensor:
+        """[N, 6, 1] mean contact-force magnitude between ``obj`` and each link group (th, ff, mf, rf, lf, palm), N."""
+        means = [torch.linalg.norm(self._contact_forces(links, obj), dim=-1).mean(dim=1)
+                 for links in self.group_links.values()]
+        return torch.stack(means, dim=1).unsqueeze(-1)
+
+    def is_grasping(self, obj: Actor | Link, min_force: float = 0.5) -> torch.Tensor:
+        """[N] bool: the thumb and at least one other finger press on ``obj`` with more than ``min_force`` N."""
+        f = torch.linalg.norm(self.get_fsr_obj_force(obj), dim=-1)  # [N, 5]
+        return (f[:, 0] > min_force) & (f[:, 1:] > min_force).any(dim=1)
+

@@ -1,0 +1,44 @@
+"""Pure, batched geometry on torch tensors. Quaternions are (w, x, y, z); every function keeps the batch dim."""
+
+from __future__ import annotations
+
+import torch
+
+
+def quat_rotate(q_wxyz: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
+    """Rotate vectors ``v`` [N, 3] by unit quaternions ``q_wxyz`` [N, 4] -> [N, 3]."""
+    w, xyz = q_wxyz[..., :1], q_wxyz[..., 1:]
+    t = 2.0 * torch.linalg.cross(xyz, v, dim=-1)
+    return v + w * t + torch.linalg.cross(xyz, t, dim=-1)
+
+
+def quat_mul(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Hamilton product a * b of quaternions [N, 4] -> [N, 4] (apply b, then a)."""
+    aw, ax, ay, az = a.unbind(-1)
+    bw, bx, by, bz = b.unbind(-1)
+    return torch.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        dim=-1,
+    )
+
+
+def yaw_quat(yaw_rad: torch.Tensor) -> torch.Tensor:
+    """Rotation about world z by ``yaw_rad`` [N] -> quaternions [N, 4]."""
+    half = 0.5 * yaw_rad
+    zeros = torch.zeros_like(half)
+    return torch.stack([torch.cos(half), zeros, zeros, torch.sin(half)], dim=-1)
+
+
+def transform_points(p: torch.Tensor, q_wxyz: torch.Tensor, local: torch.Tensor) -> torch.Tensor:
+    """World position [N, 3] of a point ``local`` ([3] or [N, 3]) given frame position p [N, 3] and rotation [N, 4]."""
+    return p + quat_rotate(q_wxyz, local.expand_as(p))
+
+
+def xy_distance(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """Horizontal distance between positions a, b [N, 3] -> [N], metres."""
+    return torch.linalg.norm(a[..., :2] - b[..., :2], dim=-1)
