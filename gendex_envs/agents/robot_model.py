@@ -27,7 +27,7 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
-BUILDER_VERSION = "3"
+BUILDER_VERSION = "4"
 """Bump when the generated URDF changes, so stale caches are rebuilt."""
 
 HAND_PREFIX = "robot0:"
@@ -63,7 +63,7 @@ D1, A2, A3, D4, D5, D6 = 0.1807, -0.6127, -0.57155, 0.17415, 0.11985, 0.11655
 HALF_PI = np.pi / 2
 UR10E_LINKS: tuple[URLink, ...] = (
     URLink("shoulder_link", "shoulder_pan_joint", (0, 0, 0), (0, 0, 0), 7.369,
-           (((0, 0, 0.02), (0, 0, D1 - 0.04), 0.078), ((0, -0.09, D1), (0, 0.09, D1), 0.078))),
+           (((0, 0, 0.115), (0, 0, D1 - 0.04), 0.075), ((0, -0.09, D1), (0, 0.09, D1), 0.078))),
     URLink("upper_arm_link", "shoulder_lift_joint", (0, 0, D1), (HALF_PI, 0, 0), 13.051,
            (((0, 0, 0.0), (A2, 0, 0), 0.062), ((A2, 0, -0.07), (A2, 0, 0.07), 0.07))),
     URLink("forearm_link", "elbow_joint", (A2, 0, 0), (0, 0, 0), 3.989,
@@ -308,9 +308,8 @@ def robot_urdf_path() -> Path:
     tmp = Path(tempfile.mkdtemp(prefix=".building-", dir=target.parent))
     try:
         (tmp / "ur10e_shadow.urdf").write_text(build_urdf_text(tmp))
-        licence = shadow_hand_mjcf_path().parent / "LICENSE.md"
-        if licence.is_file():
-            shutil.copy(licence, tmp / "SHADOW_HAND_LICENSE.md")
+        # the MJCF's header: "LICENSE.md must be kept together with this file"
+        shutil.copy(shadow_hand_mjcf_path().parent.parent / "LICENSE.md", tmp / "SHADOW_HAND_LICENSE.md")
         try:
             tmp.rename(target)
             log.info("built robot model %s", target)

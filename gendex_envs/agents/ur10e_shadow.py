@@ -82,9 +82,9 @@ HAND_GROUP_LINKS: dict[str, tuple[str, ...]] = {
 }
 """Link groups of :meth:`UR10eShadowHand.get_hand_group_obj_mean_force`, in its output order."""
 
-ROBOT_COLLISION_GROUP_ID = 1 << 20
-"""collision_groups[3] value shared by all robot shapes; with a common bit in groups[2] they ignore each other."""
 SELF_COLLISION_BIT = 1 << 29
+"""Bit set in collision_groups[2] of every robot shape. PhysX (SAPIEN's filter) ignores a pair whose groups[3] are
+equal and whose groups[2] share a bit; ManiSkill uses groups[3] for the sub-scene index, so it is left alone."""
 
 
 @dataclass(frozen=True)
@@ -156,7 +156,6 @@ class UR10eShadowHand(BaseAgent):
                 for shape in obj.collision_shapes:
                     groups = shape.get_collision_groups()
                     groups[2] |= SELF_COLLISION_BIT
-                    groups[3] = ROBOT_COLLISION_GROUP_ID
                     shape.set_collision_groups(groups)
         self.tip_links: list[Link] = [self.robot.links_map[n] for n in TIP_LINKS]
         """The five distal links (th, ff, mf, rf, lf)."""

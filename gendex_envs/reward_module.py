@@ -1,0 +1,73 @@
+"""Load a task's reward module (``reward.py`` beside its ``task.yaml``).
+
+A reward module is a small file of pure functions of the env state, all batched over ``[num_envs]``:
+
+``evaluate(env) -> dict[str, Tensor]``
+    must contain ``success`` ([N] bool); may contain ``fail`` ([N] bool) and any [N] diagnostics.
+``compute_dense_reward(env, obs, action, info) -> Tensor``
+    [N] float reward; ``info`` is what ``evaluate`` returned.
+``_get_obs_extra(env, info) -> dict[str, Tensor]``  (optional)
+    task observations, each [N, ...].
+``REWARD_MAX: float``  (optional, default 1.0)
+    upper bound of the dense reward, used by ``compute_normalized_dense_reward``.
+
+Modules written by a language model are validated by the generator before they are committed; this loader only
+checks that the interface is present.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import logging
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+from gendex_envs.errors import RewardModuleError
+
+log = logging.getLogger(__name__)
+
+REQUIRED_FUNCTIONS = ("evaluate", "compute_dense_reward")
+OPTIONAL_FUNCTIONS = ("_get_obs_extra",)
+
+
+@dataclass(frozen=True)
+class RewardModule:
+    """The functions of one task's reward module."""
+
+    path: Path
+    evaluate: Callable
+    compute_dense_reward: Callable
+    get_obs_extra: Callable | None
+    reward_max: float
+
+
+def load_reward_module(path: str | Path) -> RewardModule:
+    """Import ``path`` as a private module and check its interface; raises :class:`RewardModuleError`."""
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise RewardModuleError(f"reward module {path} does not exist; every task folder needs a reward.py")
+    digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
+    name = f"gendex_reward_{path.parent.parent.name}_{path.parent.name}_{digest}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module: ModuleType = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:
+        raise RewardModuleError(f"reward module {path} failed to import: {type(exc).__name__}: {exc}") from exc
+    sys.modules.setdefault(name, module)
+    missing = [f for f in REQUIRED_FUNCTIONS if not callable(getattr(module, f, None))]
+    if missing:
+        raise RewardModuleError(
+            f"reward module {path} lacks {missing}; required: {list(REQUIRED_FUNCTIONS)}, optional: "
+            f"{list(OPTIONAL_FUNCTIONS)}"
+        )
+    reward_max = float(getattr(module, "REWARD_MAX", 1.0))
+    if not reward_max > 0:
+        raise RewardModuleError(f"reward module {path}: REWARD_MAX={reward_max} must be > 0")
+    extra = getattr(module, "_get_obs_extra", None)
+    return RewardModule(path=path, evaluate=module.evaluate, compute_dense_reward=module.compute_dense_reward,
+                        get_obs_extra=extra if callable(extra) else None, reward_max=reward_max)

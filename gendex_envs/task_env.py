@@ -1,0 +1,379 @@
+"""``TaskEnv``: the one ManiSkill environment class that builds any GenDex task from its folder.
+
+A task is data (``task.yaml``, see :mod:`gendex_envs.spec`) plus a small reward module (``reward.py``, see
+:mod:`gendex_envs.reward_module`). There are no per-task env classes.
+
+Members that reward code may use (all batched over ``num_envs``, tensors on ``env.device``):
+
+* ``env.agent`` — :class:`~gendex_envs.agents.ur10e_shadow.UR10eShadowHand` (``tip_poses``, ``palm_link``,
+  ``get_fsr_*``, ``get_hand_group_obj_mean_force``, ...).
+* ``env.obj(name)`` / ``env.objects`` — ManiSkill ``Actor`` or ``Articulation`` per spec object;
+  ``env.articulations`` — the articulated ones.
+* ``env.handle_link(name)``, ``env.handle_pos(name)`` [N, 3] — the link and world grip point of an articulated
+  object's handle; ``env.joint_qpos(name)`` [N], ``env.open_qpos(name)``, ``env.closed_qpos(name)`` (floats),
+  ``env.joint_open_fraction(name)`` [N].
+* ``env.goal_pos`` [N, 3] (when the task has a goal), ``env.init_obj_pos(name)`` [N, 3] (pose at reset).
+* ``env.task_spec`` — the loaded :class:`~gendex_envs.spec.TaskSpec` (``env.spec`` is Gymnasium's EnvSpec).
+* ``env.spec_success()`` [N] bool — the spec's ``success.conditions`` evaluated generically.
+* ``env.table_height`` (0.0: the table top is the plane z = 0).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import sapien
+import torch
+from mani_skill.envs.sapien_env import BaseEnv
+from mani_skill.sensors.camera import CameraConfig
+from mani_skill.utils import sapien_utils
+from mani_skill.utils.structs import Actor, Articulation, Link, Pose
+from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
+
+from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
+from gendex_envs.assets.catalog import AssetRecord, JointRecord, asset_ids, get_asset, lowest_point_z
+from gendex_envs.errors import RewardModuleError, TaskSpecError, suggest
+from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
+from gendex_envs.reward_module import RewardModule, load_reward_module
+from gendex_envs.spec import ConditionSpec, TaskSpec, load_task_spec
+
+log = logging.getLogger(__name__)
+
+SIM_FREQ = 120
+CONTROL_FREQ = 20
+VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
+"""The three scene views used by rendering, refinement and the docs."""
+HAND_CAMERA = "hand_camera"
+
+
+def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
+    return sapien_utils.look_at(eye=list(eye), target=list(target), up=list(up))
+
+
+class TaskEnv(BaseEnv):
+    """Generic GenDex task: ShadowHand on UR10e at a table, objects and reward from a task folder."""
+
+    SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
+    agent: UR10eShadowHand
+
+    def __init__(self, *args, task_dir: str, control_joint: str | None = None, view_resolution: int = 512,
+                 sensor_resolution: int = 128, **kwargs):
+        self.task_dir = Path(task_dir)
+        """The task's version folder (holds task.yaml and reward.py)."""
+        self.task_spec: TaskSpec = load_task_spec(self.task_dir / "task.yaml", known_assets=asset_ids())
+        self.reward: RewardModule = load_reward_module(self.task_dir / "reward.py")
+        if control_joint is None:
+            rl = [s for s in self.task_spec.stages if s.method == "RL"]
+            control_joint = rl[0].control_joint if rl else "both"
+        if control_joint not in CONTROL_JOINT_GROUPS:
+            raise TaskSpecError(f"control_joint={control_joint!r} is not a mode; allowed: "
+                                f"{sorted(CONTROL_JOINT_GROUPS)}.{suggest(control_joint, CONTROL_JOINT_GROUPS)}")
+        self.control_joint = control_joint
+        """Joint group actions drive (default: the first RL stage's ``control_joint``, else ``both``)."""
+        self.view_resolution = view_resolution
+        self.sensor_resolution = sensor_resolution
+        self.table_height = 0.0
+        self.objects: dict[str, Actor | Articulation] = {}
+        self.articulations: dict[str, Articulation] = {}
+        self._records: dict[str, AssetRecord] = {o.name: get_asset(o.asset) for o in self.task_spec.objects}
+        kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
+        super().__init__(*args, **kwargs)
+
+    # ------------------------------------------------------------------ configuration
+    @property
+    def _default_sim_config(self) -> SimConfig:
+        return SimConfig(
+            sim_freq=SIM_FREQ,
+            control_freq=CONTROL_FREQ,
+            scene_config=SceneConfig(solver_position_iterations=15, solver_velocity_iterations=1,
+                                     contact_offset=0.01, enable_tgs=True),
+            default_materials_config=DefaultMaterialsConfig(static_friction=1.0, dynamic_friction=0.8),
+        )
+
+    def _view_poses(self) -> dict[str, Pose]:
+        target = [0.1, 0.0, 0.08]  # middle of the workspace in front of the robot
+        return {
+            "left_overhead": _look_at([0.0, 1.0, 0.9], target),
+            "right_overhead": _look_at([0.0, -1.0, 0.9], target),
+            "top_down": _look_at([0.05, 0.0, 1.6], [0.05, 0.0, 0.0], up=[1.0, 0.0, 0.0]),
+        }
+
+    @property
+    def _default_sensor_configs(self) -> list[CameraConfig]:
+        res = self.sensor_resolution
+        views = [CameraConfig(n, p, res, res, 1.0, 0.01, 10.0) for n, p in self._view_poses().items()]
+        # hand camera: on the palm, looking out of the palm (-y of the palm frame) towards the grasp
+        hand = CameraConfig(HAND_CAMERA, sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068]),
+                            res, res, 1.4, 0.01, 5.0, mount=self.agent.palm_link)
+        return [*views, hand]
+
+    @property
+    def _default_human_render_camera_configs(self) -> list[CameraConfig]:
+        res = self.view_resolution
+        return [CameraConfig(n, p, res, res, 1.0, 0.01, 10.0) for n, p in self._view_poses().items()]
+
+    # ------------------------------------------------------------------ loading
+    def _load_agent(self, options: dict, initial_agent_poses=None, build_separate: bool = False):
+        robot = self.task_spec.robot
+        yaw = math.radians(robot.base_yaw_deg)
+        pose = sapien.Pose(p=list(robot.base_pos_m), q=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+        self.agent = UR10eShadowHand(self.scene, self._control_freq, self._control_mode, initial_pose=pose,
+                                     build_separate=build_separate, control_joint=self.control_joint)
+
+    def _load_scene(self, options: dict):
+        table = self.task_spec.table
+        sx, sy = table.size_m
+        b = self.scene.create_actor_builder()
+        top = sapien.Pose(p=[0.0, 0.0, -0.025])
+        mat = sapien.physx.PhysxMaterial(table.friction, 0.8 * table.friction, 0.0)
+        b.add_box_collision(top, [sx / 2, sy / 2, 0.025], material=mat)
+        b.add_box_visual(top, [sx / 2, sy / 2, 0.025],
+                         material=sapien.render.RenderMaterial(base_color=[0.72, 0.62, 0.5, 1.0], roughness=0.8))
+        for lx in (-1, 1):  # legs: visual only, they never touch anything
+            for ly in (-1, 1):
+                leg = sapien.Pose(p=[lx * (sx / 2 - 0.05), ly * (sy / 2 - 0.05), -table.height_m / 2])
+                b.add_box_visual(leg, [0.03, 0.03, table.height_m / 2],
+                                 material=sapien.render.RenderMaterial(base_color=[0.35, 0.3, 0.25, 1.0]))
+        b.initial_pose = sapien.Pose()
+        self.table = b.build_static("table")
+        self.ground = self._build_ground(-table.height_m)
+
+        self.objects.clear()
+        self.articulations.clear()
+        self._init_pose: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
+        for obj in self.task_spec.objects:
+            rec = self._records[obj.name]
+            p, q = self._spec_pose(obj)
+            entity = rec.build(self.scene, obj.name, obj.scale, obj.color_rgba, obj.fixed,
+                               sapien.Pose(p=p.tolist(), q=q.tolist()), rec)
+            self.objects[obj.name] = entity
+            if rec.articulated:
+                self.articulations[obj.name] = entity
+                self._check_joint_state(obj.name, rec)
+            self._init_pose[obj.name] = (torch.tensor(p, dtype=torch.float32, device=self.device),
+                                         torch.tensor(q, dtype=torch.float32, device=self.device))
+        with torch.device(self.device):
+            self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
+            self._success_streak = torch.zeros(self.num_envs, dtype=torch.long)
+            self._streak_counted_at = torch.full((self.num_envs,), -1, dtype=torch.long)
+        self.goal_site = None
+        if self.task_spec.goal is not None:
+            gb = self.scene.create_actor_builder()
+            gb.add_sphere_visual(radius=self.task_spec.goal.radius_m,
+                                 material=sapien.render.RenderMaterial(base_color=[0.1, 0.9, 0.2, 0.5]))
+            gb.initial_pose = sapien.Pose(p=list(self.task_spec.goal.pos_m))
+            self.goal_site = gb.build_kinematic("goal_site")
+            self._hidden_objects.append(self.goal_site)
+
+    def _build_ground(self, z: float) -> Actor:
+        b = self.scene.create_actor_builder()
+        b.add_plane_collision(sapien.Pose(p=[0, 0, z], q=[0.7071068, 0, -0.7071068, 0]))
+        b.add_box_visual(sapien.Pose(p=[0, 0, z - 0.005]), [4.0, 4.0, 0.005],
+                         material=sapien.render.RenderMaterial(base_color=[0.55, 0.57, 0.6, 1.0]))
+        b.initial_pose = sapien.Pose()
+        return b.build_static("ground")
+
+    def _spec_pose(self, obj) -> tuple[np.ndarray, np.ndarray]:
+        """World position (origin z lifted so the lowest point sits ``pos_m[2]`` above the table) and quaternion."""
+        rec = self._records[obj.name]
+        q = np.asarray(obj.quat_wxyz, dtype=np.float64)
+        x, y, clearance = obj.pos_m
+        z = self.table_height + clearance - lowest_point_z(rec, obj.scale, q)
+        return np.array([x, y, z]), q
+
+    def _check_joint_state(self, name: str, rec: AssetRecord) -> None:
+        known = [j.name for j in rec.joints]
+        for joint, value in self.task_spec.object(name).joint_state.items():
+            if joint not in known:
+                raise TaskSpecError(f"{self.task_dir / 'task.yaml'}: objects[{name}].joint_state has joint {joint!r}, "
+                                    f"which asset {rec.id!r} lacks; joints: {known}.{suggest(joint, known)}")
+            lo, hi = rec.joint(joint).limits
+            if not lo <= value <= hi:
+                raise TaskSpecError(f"{self.task_dir / 'task.yaml'}: objects[{name}].joint_state.{joint}={value} "
+                                    f"is outside the joint limits [{lo}, {hi}]")
+
+    # ------------------------------------------------------------------ episodes
+    def reset(self, seed: int | list[int] | None = None, options: dict | None = None):
+        # Gymnasium's RNG (env.np_random) follows the reset seed. ManiSkill draws an unseeded episode from torch's
+        # global RNG; GenDex derives it from env.np_random instead, so that reset(seed=s) followed by reset() is
+        # reproducible, as the Gymnasium API promises.
+        if seed is None or isinstance(seed, int):
+            gym.Env.reset(self, seed=seed)
+        if seed is None:
+            seeds = self.np_random.integers(2**31, size=self.num_envs).tolist()
+            seed = seeds[0] if self.num_envs == 1 else seeds
+        return super().reset(seed=seed, options=options)
+
+    def _initialize_episode(self, env_idx: torch.Tensor, options: dict):
+        with torch.device(self.device):
+            b = len(env_idx)
+            qpos = torch.as_tensor(self.agent.qpos_from_names(KEYFRAME_QPOS_BY_NAME[self.task_spec.robot.init_keyframe]))
+            self.agent.robot.set_qpos(qpos.expand(b, -1).clone())
+            self.agent.robot.set_qvel(torch.zeros(b, qpos.shape[0]))
+            for obj in self.task_spec.objects:
+                p0, q0 = self._init_pose[obj.name]
+                p = p0.expand(b, 3).clone()
+                q = q0.expand(b, 4).clone()
+                rx, ry = obj.randomize.xy_m
+                if rx > 0 or ry > 0:
+                    p[:, :2] += (torch.rand(b, 2) * 2 - 1) * torch.tensor([rx, ry])
+                if obj.randomize.yaw_deg > 0:
+                    yaw = (torch.rand(b) * 2 - 1) * math.radians(obj.randomize.yaw_deg)
+                    q = quat_mul(yaw_quat(yaw), q)
+                entity = self.objects[obj.name]
+                entity.set_pose(Pose.create_from_pq(p, q))
+                if obj.name in self.articulations:
+                    art = self.articulations[obj.name]
+                    names = [j.name for j in art.get_active_joints()]
+                    state = torch.tensor([obj.joint_state.get(n, self._joint_record(obj.name, n).closed_qpos)
+                                          for n in names])
+                    art.set_qpos(state.expand(b, -1).clone())
+                    art.set_qvel(torch.zeros(b, len(names)))
+                elif not obj.fixed:
+                    entity.set_linear_velocity(torch.zeros(b, 3))
+                    entity.set_angular_velocity(torch.zeros(b, 3))
+            for name, entity in self.objects.items():
+                self._obj_reset_pos[name][env_idx] = entity.pose.p[env_idx]
+            self._success_streak[env_idx] = 0
+            self._streak_counted_at[env_idx] = -1
+
+    # ------------------------------------------------------------------ API for reward code
+    def obj(self, name: str) -> Actor | Articulation:
+        """The scene entity of spec object ``name``."""
+        try:
+            return self.objects[name]
+        except KeyError:
+            raise TaskSpecError(f"task {self.task_spec.name!r} has no object {name!r}; objects: {sorted(self.objects)}."
+                                f"{suggest(name, self.objects)}") from None
+
+    def _joint_record(self, name: str, joint: str | None = None) -> JointRecord:
+        rec = self._records[name]
+        if not rec.articulated:
+            raise TaskSpecError(f"object {name!r} (asset {rec.id!r}) is not articulated")
+        return rec.joints[0] if joint is None else rec.joint(joint)
+
+    def _joint_index(self, name: str, joint: str | None) -> int:
+        jr = self._joint_record(name, joint)
+        names = [j.name for j in self.articulations[name].get_active_joints()]
+        return names.index(jr.name)
+
+    def handle_link(self, name: str, joint: str | None = None) -> Link:
+        """The link carrying the handle of ``name``'s joint (default: its main joint)."""
+        return self.articulations[name].links_map[self._joint_record(name, joint).handle_link]
+
+    def handle_pos(self, name: str, joint: str | None = None) -> torch.Tensor:
+        """[N, 3] world position of the handle's grip point."""
+        jr = self._joint_record(name, joint)
+        link = self.handle_link(name, joint)
+        scale = self.task_spec.object(name).scale
+        local = torch.tensor(jr.handle_point_m, dtype=torch.float32, device=self.device) * scale
+        return transform_points(link.pose.p, link.pose.q, local)
+
+    def joint_qpos(self, name: str, joint: str | None = None) -> torch.Tensor:
+        """[N] current position of ``name``'s joint (default: its main joint)."""
+        return self.articulations[name].get_qpos()[:, self._joint_index(name, joint)]
+
+    def open_qpos(self, name: str, joint: str | None = None) -> float:
+        return self._joint_record(name, joint).open_qpos
+
+    def closed_qpos(self, name: str, joint: str | None = None) -> float:
+        return self._joint_record(name, joint).closed_qpos
+
+    def joint_open_fraction(self, name: str, joint: str | None = None) -> torch.Tensor:
+        """[N] 0 when closed, 1 when at the open target (may exceed 1)."""
+        jr = self._joint_record(name, joint)
+        return (self.joint_qpos(name, joint) - jr.closed_qpos) / (jr.open_qpos - jr.closed_qpos)
+
+    @property
+    def goal_pos(self) -> torch.Tensor:
+        """[N, 3] goal position; TaskSpecError when the task has no goal."""
+        if self.goal_site is None:
+            raise TaskSpecError(f"task {self.task_spec.name!r} has no goal")
+        return self.goal_site.pose.p
+
+    def init_obj_pos(self, name: str) -> torch.Tensor:
+        """[N, 3] position of object ``name`` at the last reset."""
+        return self._obj_reset_pos[name]
+
+    def obj_height(self, name: str) -> torch.Tensor:
+        """[N] how far object ``name`` has risen above its reset height, metres."""
+        return self.obj(name).pose.p[:, 2] - self._obj_reset_pos[name][:, 2]
+
+    def _condition(self, c: ConditionSpec) -> torch.Tensor:
+        if c.type == "lifted":
+            return self.obj_height(c.object) >= c.min_height_m
+        if c.type == "joint_open":
+            return self.joint_open_fraction(c.object, c.joint) >= c.min_fraction
+        if c.type == "near":
+            target = self.goal_pos if c.target == "goal" else self.obj(c.target).pose.p
+            return torch.linalg.norm(self.obj(c.object).pose.p - target, dim=-1) <= c.max_dist_m
+        if c.type == "inside":
+            rec, scale = self._records[c.target], self.task_spec.object(c.target).scale
+            inner_r = 0.8 * min(rec.size_m[0], rec.size_m[1]) / 2 * scale
+            top = rec.bbox_max_m[2] * scale
+            box = self.obj(c.target).pose.p
+            p = self.obj(c.object).pose.p
+            dz = p[:, 2] - box[:, 2]
+            return (xy_distance(p, box) <= inner_r) & (dz >= -0.01) & (dz <= top)
+        raise TaskSpecError(f"unknown condition type {c.type!r}")
+
+    def spec_success(self) -> torch.Tensor:
+        """[N] bool: every condition of the spec's ``success`` holds now."""
+        ok = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
+        for c in self.task_spec.success.conditions:
+            ok &= self._condition(c)
+        return ok
+
+    # ------------------------------------------------------------------ task hooks
+    def evaluate(self) -> dict:
+        info = dict(self.reward.evaluate(self))
+        n = self.num_envs
+        for key in ("success", "fail"):
+            if key not in info:
+                if key == "success":
+                    raise RewardModuleError(f"{self.reward.path}: evaluate() must return 'success'")
+                info[key] = torch.zeros(n, dtype=torch.bool, device=self.device)
+            value = info[key]
+            if not isinstance(value, torch.Tensor) or value.shape != (n,) or value.dtype != torch.bool:
+                raise RewardModuleError(f"{self.reward.path}: evaluate()[{key!r}] must be a bool tensor of shape "
+                                        f"[{n}], got {getattr(value, 'dtype', type(value))} "
+                                        f"{tuple(getattr(value, 'shape', ()))}")
+        hold = self.task_spec.success.hold_steps
+        if hold > 0:  # count each control step once, however often evaluate() is called within it
+            fresh = self._streak_counted_at != self.elapsed_steps
+            self._success_streak = torch.where(fresh, (self._success_streak + 1) * info["success"],
+                                               self._success_streak)
+            self._streak_counted_at = self.elapsed_steps.clone()
+            info["success"] = self._success_streak > hold
+        info["fail"] = info["fail"] & ~info["success"]
+        return info
+
+    def _get_obs_extra(self, info: dict) -> dict:
+        extra = dict(palm_pose=self.agent.palm_link.pose.raw_pose, tip_pos=self.agent.tip_positions.flatten(1))
+        for name, entity in self.objects.items():
+            extra[f"{name}_pose"] = entity.pose.raw_pose
+            if name in self.articulations:
+                extra[f"{name}_qpos"] = self.articulations[name].get_qpos()
+        if self.goal_site is not None:
+            extra["goal_pos"] = self.goal_site.pose.p
+        if self.reward.get_obs_extra is not None:
+            extra.update(self.reward.get_obs_extra(self, info))
+        return extra
+
+    def compute_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
+        return self.reward.compute_dense_reward(self, obs, action, info)
+
+    def compute_normalized_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
+        return self.compute_dense_reward(obs, action, info) / self.reward.reward_max
+
+    # ------------------------------------------------------------------ rendering
+    def render_views(self, names: tuple[str, ...] = VIEW_CAMERAS) -> dict[str, np.ndarray]:
+        """uint8 RGB images [N, H, W, 3] of the named human-render cameras (the three scene views)."""
+        unknown = [n for n in names if n not in self.scene.human_render_cameras]
+        if unknown:
+            raise TaskSpecError(f"unknown cameras {unknown}; cameras: {sorted(self.scene.human_render_cameras)}")
+        return {n: self.render_rgb_array(camera_name=n).cpu().numpy() for n in names}

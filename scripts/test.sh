@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Set up (if needed) and run the test suite. Extra arguments go to pytest.
+#   scripts/test.sh            fast + physics tests (what CI runs)
+#   scripts/test.sh --slow     also the slow checks (marker "slow")
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+bash "$ROOT/scripts/setup.sh"
+cd "$ROOT"
+args=()
+marker="not slow and not gpu"
+for a in "$@"; do
+  if [ "$a" = "--slow" ]; then marker="not gpu"; else args+=("$a"); fi
+done
+exec "$ROOT/.venv/bin/python" -m pytest -m "$marker" "${args[@]}"
