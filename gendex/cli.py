@@ -44,9 +44,18 @@ def list_tasks() -> None:
                    f"    folder:  {entry.task_dir}")
 
 
-def _render_views(env_id: str, out: Path, seed: int) -> dict[str, Path]:
-    import gymnasium as gym  # noqa: PLC0415
+def _save_png(rgb, path: Path) -> Path:
     from PIL import Image  # noqa: PLC0415
+
+    tmp = path.with_suffix(".tmp.png")
+    Image.fromarray(rgb).save(tmp)
+    tmp.replace(path)  # never leave a half-written PNG behind
+    return path
+
+
+def _render_views(env_id: str, out: Path, seed: int, montage: bool = False) -> dict[str, Path]:
+    import gymnasium as gym  # noqa: PLC0415
+    import numpy as np  # noqa: PLC0415
 
     from gendex_envs.registry import task_entry  # noqa: PLC0415
 
@@ -59,26 +68,24 @@ def _render_views(env_id: str, out: Path, seed: int) -> dict[str, Path]:
         env.close()
     out.mkdir(parents=True, exist_ok=True)
     stem = env_id.split("/")[-1]
-    paths = {}
-    for name, rgb in views.items():
-        path = out / f"{stem}_{name}.png"
-        tmp = path.with_suffix(".tmp.png")
-        Image.fromarray(rgb[0]).save(tmp)
-        tmp.replace(path)
-        paths[name] = path
+    paths = {name: _save_png(rgb[0], out / f"{stem}_{name}.png") for name, rgb in views.items()}
+    if montage:
+        paths["montage"] = _save_png(np.concatenate([rgb[0] for rgb in views.values()], axis=1),
+                                     out / f"{stem}_views.png")
     return paths
 
 
 @app.command()
 def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"),
            out: Path = typer.Option(Path("out/render"), "--out", help="Folder for the PNGs."),
-           seed: int = typer.Option(0, help="Reset seed (object randomization).")) -> None:
+           seed: int = typer.Option(0, help="Reset seed (object randomization)."),
+           montage: bool = typer.Option(False, help="Also write the three views side by side.")) -> None:
     """Render a task's three views (left-overhead, right-overhead, top-down) to PNG."""
     import gendex_envs  # noqa: F401, PLC0415
     from gendex_envs.errors import GenDexError  # noqa: PLC0415
 
     try:
-        paths = _render_views(task_id, out, seed)
+        paths = _render_views(task_id, out, seed, montage)
     except GenDexError as exc:
         _die(exc)
     for name, path in paths.items():

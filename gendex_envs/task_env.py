@@ -9,6 +9,9 @@ Members that reward code may use (all batched over ``num_envs``, tensors on ``en
   ``get_fsr_*``, ``get_hand_group_obj_mean_force``, ...).
 * ``env.obj(name)`` / ``env.objects`` — ManiSkill ``Actor`` or ``Articulation`` per spec object;
   ``env.articulations`` — the articulated ones.
+* ``env.obj_pose(name)``, ``env.palm_pose`` (``Pose``: ``p`` [N, 3], ``q`` [N, 4]) and ``env.tip_positions``
+  [N, 5, 3] — the same as reading the entities, but read once per step and shared by observation, evaluation and
+  reward (prefer them in reward code).
 * ``env.handle_link(name)``, ``env.handle_pos(name)`` [N, 3] — the link and world grip point of an articulated
   object's handle; ``env.joint_qpos(name)`` [N], ``env.open_qpos(name)``, ``env.closed_qpos(name)`` (floats),
   ``env.joint_open_fraction(name)`` [N].
@@ -78,6 +81,7 @@ class TaskEnv(BaseEnv):
         self.sensor_resolution = sensor_resolution
         self.table_height = 0.0
         self.objects: dict[str, Actor | Articulation] = {}
+        self._frame: dict | None = None
         self.articulations: dict[str, Articulation] = {}
         self._records: dict[str, AssetRecord] = {o.name: get_asset(o.asset) for o in self.task_spec.objects}
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
@@ -90,7 +94,7 @@ class TaskEnv(BaseEnv):
             sim_freq=SIM_FREQ,
             control_freq=CONTROL_FREQ,
             scene_config=SceneConfig(solver_position_iterations=15, solver_velocity_iterations=1,
-                                     contact_offset=0.01, enable_tgs=True),
+                                     contact_offset=0.01, enable_tgs=True, enable_enhanced_determinism=True),
             default_materials_config=DefaultMaterialsConfig(static_friction=1.0, dynamic_friction=0.8),
         )
 
@@ -208,7 +212,29 @@ class TaskEnv(BaseEnv):
             seed = seeds[0] if self.num_envs == 1 else seeds
         return super().reset(seed=seed, options=options)
 
+    def _after_simulation_step(self):
+        self.agent.contacts.invalidate()
+
+    def _after_control_step(self):
+        # From here to the end of step() the state is frozen: observation, evaluation and reward may share reads.
+        self._frame = {}
+
+    def step(self, action):
+        try:
+            return super().step(action)
+        finally:
+            self._frame = None
+
+    def _cached(self, key, compute):
+        """Memoise ``compute()`` for the rest of the current step (no caching outside ``step``)."""
+        if self._frame is None:
+            return compute()
+        if key not in self._frame:
+            self._frame[key] = compute()
+        return self._frame[key]
+
     def _initialize_episode(self, env_idx: torch.Tensor, options: dict):
+        self.agent.contacts.invalidate()
         with torch.device(self.device):
             b = len(env_idx)
             qpos = torch.as_tensor(self.agent.qpos_from_names(KEYFRAME_QPOS_BY_NAME[self.task_spec.robot.init_keyframe]))
@@ -242,6 +268,20 @@ class TaskEnv(BaseEnv):
             self._streak_counted_at[env_idx] = -1
 
     # ------------------------------------------------------------------ API for reward code
+    def obj_pose(self, name: str) -> Pose:
+        """Pose of object ``name`` (p [N, 3], q [N, 4]); read once per step."""
+        return self._cached(("pose", name), lambda: self.obj(name).pose)
+
+    @property
+    def palm_pose(self) -> Pose:
+        """Pose of the palm link; read once per step."""
+        return self._cached("palm", lambda: self.agent.palm_link.pose)
+
+    @property
+    def tip_positions(self) -> torch.Tensor:
+        """[N, 5, 3] fingertip positions (th, ff, mf, rf, lf); read once per step."""
+        return self._cached("tips", lambda: self.agent.tip_positions)
+
     def obj(self, name: str) -> Actor | Articulation:
         """The scene entity of spec object ``name``."""
         try:
@@ -301,7 +341,7 @@ class TaskEnv(BaseEnv):
 
     def obj_height(self, name: str) -> torch.Tensor:
         """[N] how far object ``name`` has risen above its reset height, metres."""
-        return self.obj(name).pose.p[:, 2] - self._obj_reset_pos[name][:, 2]
+        return self.obj_pose(name).p[:, 2] - self._obj_reset_pos[name][:, 2]
 
     def _condition(self, c: ConditionSpec) -> torch.Tensor:
         if c.type == "lifted":
@@ -309,14 +349,14 @@ class TaskEnv(BaseEnv):
         if c.type == "joint_open":
             return self.joint_open_fraction(c.object, c.joint) >= c.min_fraction
         if c.type == "near":
-            target = self.goal_pos if c.target == "goal" else self.obj(c.target).pose.p
-            return torch.linalg.norm(self.obj(c.object).pose.p - target, dim=-1) <= c.max_dist_m
+            target = self.goal_pos if c.target == "goal" else self.obj_pose(c.target).p
+            return torch.linalg.norm(self.obj_pose(c.object).p - target, dim=-1) <= c.max_dist_m
         if c.type == "inside":
             rec, scale = self._records[c.target], self.task_spec.object(c.target).scale
             inner_r = 0.8 * min(rec.size_m[0], rec.size_m[1]) / 2 * scale
             top = rec.bbox_max_m[2] * scale
-            box = self.obj(c.target).pose.p
-            p = self.obj(c.object).pose.p
+            box = self.obj_pose(c.target).p
+            p = self.obj_pose(c.object).p
             dz = p[:, 2] - box[:, 2]
             return (xy_distance(p, box) <= inner_r) & (dz >= -0.01) & (dz <= top)
         raise TaskSpecError(f"unknown condition type {c.type!r}")
@@ -353,9 +393,9 @@ class TaskEnv(BaseEnv):
         return info
 
     def _get_obs_extra(self, info: dict) -> dict:
-        extra = dict(palm_pose=self.agent.palm_link.pose.raw_pose, tip_pos=self.agent.tip_positions.flatten(1))
-        for name, entity in self.objects.items():
-            extra[f"{name}_pose"] = entity.pose.raw_pose
+        extra = dict(palm_pose=self.palm_pose.raw_pose, tip_pos=self.tip_positions.flatten(1))
+        for name in self.objects:
+            extra[f"{name}_pose"] = self.obj_pose(name).raw_pose
             if name in self.articulations:
                 extra[f"{name}_qpos"] = self.articulations[name].get_qpos()
         if self.goal_site is not None:

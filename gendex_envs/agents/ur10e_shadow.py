@@ -32,8 +32,9 @@ import sapien
 import torch
 from mani_skill.agents.base_agent import BaseAgent, Keyframe
 from mani_skill.agents.registration import register_agent
-from mani_skill.utils.structs import Actor, Link
+from mani_skill.utils.structs import Actor, Articulation, Link
 
+from gendex_envs.agents.contacts import ContactTable
 from gendex_envs.agents.controller import FreezingJointPosControllerConfig
 from gendex_envs.agents.robot_model import robot_urdf_path
 from gendex_envs.errors import ControlModeError
@@ -164,6 +165,13 @@ class UR10eShadowHand(BaseAgent):
             g: [self.robot.links_map[n] for n in names] for g, names in HAND_GROUP_LINKS.items()
         }
         self._tip_offsets = torch.tensor(TIP_OFFSETS_M, dtype=torch.float32, device=self.device)
+        self._group_link_list = [link for links in self.group_links.values() for link in links]
+        self._group_index = torch.tensor([g for g, links in enumerate(self.group_links.values()) for _ in links],
+                                         device=self.device)
+        self._group_sizes = torch.tensor([len(links) for links in self.group_links.values()], dtype=torch.float32,
+                                         device=self.device)
+        self.contacts = ContactTable(self.scene, self.robot.get_links())
+        """Contact impulses, one pass per physics step; the env must ``contacts.invalidate()`` after stepping."""
 
     @property
     def _controller_configs(self):
@@ -186,30 +194,39 @@ class UR10eShadowHand(BaseAgent):
         )
 
     # ------------------------------------------------------------------ reward-code API (batched)
+    def _link_poses(self, links: list[Link]) -> torch.Tensor:
+        """[N, L, 7] world poses (x, y, z, qw, qx, qy, qz) of ``links``, fetched in one go."""
+        if self.scene.gpu_sim_enabled:
+            return torch.stack([link.pose.raw_pose for link in links], dim=1)
+        poses = [link._objs[0].entity_pose for link in links]  # CPU: one env, sapien.Pose each
+        rows = np.array([[*pose.p, *pose.q] for pose in poses], dtype=np.float32)
+        return torch.from_numpy(rows).to(self.device)[None]
+
     @property
     def tip_poses(self) -> torch.Tensor:
         """[N, 5*7] fingertip poses (x, y, z, qw, qx, qy, qz) of th, ff, mf, rf, lf, concatenated."""
-        poses = []
-        for i, link in enumerate(self.tip_links):
-            pose = link.pose  # Pose, p [N, 3], q [N, 4]
-            offset = torch.zeros_like(pose.p)
-            offset[:, 2] = self._tip_offsets[i]
-            p = pose.p + quat_rotate(pose.q, offset)
-            poses.append(torch.cat([p, pose.q], dim=-1))
-        return torch.cat(poses, dim=-1)
+        poses = self._link_poses(self.tip_links)  # [N, 5, 7]
+        offsets = torch.zeros(poses.shape[:2] + (3,), device=self.device)
+        offsets[..., 2] = self._tip_offsets
+        tips = poses[..., :3] + quat_rotate(poses[..., 3:], offsets)
+        return torch.cat([tips, poses[..., 3:]], dim=-1).flatten(1)
 
     @property
     def tip_positions(self) -> torch.Tensor:
         """[N, 5, 3] fingertip positions (th, ff, mf, rf, lf), metres."""
         return self.tip_poses.view(-1, 5, 7)[..., :3]
 
-    def _contact_forces(self, links: list[Link], obj: Actor | Link | None) -> torch.Tensor:
-        """[N, len(links), 3] net (obj None) or pairwise contact forces on each link, newtons."""
+    def _contact_forces(self, links: list[Link], obj: Actor | Link | Articulation | None) -> torch.Tensor:
+        """[N, len(links), 3] net (obj None) or pairwise contact forces on each link, newtons.
+
+        ``obj`` may be an articulation: forces from all its links are summed.
+        """
         if obj is None:
-            forces = [link.get_net_contact_forces() for link in links]
+            impulses = self.contacts.net_impulses(links)
         else:
-            forces = [self.scene.get_pairwise_contact_forces(link, obj) for link in links]
-        return torch.stack(forces, dim=1)
+            others = obj.get_links() if isinstance(obj, Articulation) else [obj]
+            impulses = self.contacts.pair_impulses(links, others)
+        return impulses / self.scene.timestep
 
     def get_fsr_force(self) -> torch.Tensor:
         """[N, 5, 3] net contact force on each fingertip link (th, ff, mf, rf, lf), N."""
@@ -227,11 +244,12 @@ class UR10eShadowHand(BaseAgent):
         """[N, 5, 3] contact impulse between each fingertip and ``obj`` over the last physics step, N·s."""
         return self.get_fsr_obj_force(obj) * self.scene.timestep
 
-    def get_hand_group_obj_mean_force(self, obj: Actor | Link) -> torch.Tensor:
+    def get_hand_group_obj_mean_force(self, obj: Actor | Link | Articulation) -> torch.Tensor:
         """[N, 6, 1] mean contact-force magnitude between ``obj`` and each link group (th, ff, mf, rf, lf, palm), N."""
-        means = [torch.linalg.norm(self._contact_forces(links, obj), dim=-1).mean(dim=1)
-                 for links in self.group_links.values()]
-        return torch.stack(means, dim=1).unsqueeze(-1)
+        magnitude = torch.linalg.norm(self._contact_forces(self._group_link_list, obj), dim=-1)  # [N, L]
+        sums = torch.zeros(magnitude.shape[0], len(HAND_GROUP_LINKS), device=self.device)
+        sums.index_add_(1, self._group_index, magnitude)
+        return (sums / self._group_sizes).unsqueeze(-1)
 
     def is_grasping(self, obj: Actor | Link, min_force: float = 0.5) -> torch.Tensor:
         """[N] bool: the thumb and at least one other finger press on ``obj`` with more than ``min_force`` N."""

@@ -100,3 +100,18 @@ def test_cabinet_handle_and_joint_api(make_env):
     assert u.evaluate()["success"].all()
     moved = u.handle_pos("cabinet")
     assert torch.linalg.norm(moved - handle).item() > 0.2, "opening the door must swing the handle"
+
+
+@pytest.mark.parametrize("env_id", REFERENCE_TASKS)
+def test_robot_starts_clear_of_the_scene(make_env, env_id):
+    """At reset the robot touches nothing: no link penetrates the table or an object."""
+    env = make_env(env_id, gym_api=False)
+    u = env.unwrapped
+    for seed in range(3):
+        env.reset(seed=seed)
+        u.scene.step()
+        robot = {link._objs[0].entity.per_scene_id for link in u.agent.robot.get_links()}
+        touching = [(c.bodies[0].entity.name, c.bodies[1].entity.name) for c in u.scene.px.get_contacts()
+                    if (c.bodies[0].entity.per_scene_id in robot) != (c.bodies[1].entity.per_scene_id in robot)
+                    and min(p.separation for p in c.points) < 0.0]
+        assert not touching, f"seed {seed}: robot penetrates {touching}"

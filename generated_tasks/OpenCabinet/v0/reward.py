@@ -14,7 +14,7 @@ def evaluate(env):
 
 def compute_dense_reward(env, obs, action, info):
     handle = env.handle_pos("cabinet")  # [N, 3]
-    reach = rt.reach(torch.linalg.norm(env.agent.palm_link.pose.p - handle, dim=-1))
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - handle, dim=-1))
     hook = rt.contact(env.agent.get_hand_group_obj_mean_force(env.handle_link("cabinet")))
     opened = rt.fraction(info["open_fraction"])
     reward = reach + hook + 2.0 * opened
@@ -23,4 +23,4 @@ def compute_dense_reward(env, obs, action, info):
 
 def _get_obs_extra(env, info):
     return {"handle_pos": env.handle_pos("cabinet"), "palm_to_handle": env.handle_pos("cabinet")
-            - env.agent.palm_link.pose.p}
+            - env.palm_pose.p}

@@ -10,15 +10,15 @@ LIFT_M = 0.1
 
 def evaluate(env):
     inside = env.spec_success()  # the apple rests in the bowl
-    apple = env.obj("apple").pose.p
+    apple = env.obj_pose("apple").p
     fell_off = apple[:, 2] < env.table_height - 0.05  # rolled off the table
     return {"success": inside, "fail": fell_off, "apple_height": env.obj_height("apple")}
 
 
 def compute_dense_reward(env, obs, action, info):
-    apple = env.obj("apple").pose.p  # [N, 3]
-    bowl = env.obj("bowl").pose.p
-    palm = env.agent.palm_link.pose.p
+    apple = env.obj_pose("apple").p  # [N, 3]
+    bowl = env.obj_pose("bowl").p
+    palm = env.palm_pose.p
     reach = rt.reach(torch.linalg.norm(palm - apple, dim=-1))
     grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj("apple")))
     lifted = rt.lift(info["apple_height"], LIFT_M)
@@ -28,4 +28,4 @@ def compute_dense_reward(env, obs, action, info):
 
 
 def _get_obs_extra(env, info):
-    return {"apple_to_bowl": env.obj("bowl").pose.p - env.obj("apple").pose.p}
+    return {"apple_to_bowl": env.obj_pose("bowl").p - env.obj_pose("apple").p}
