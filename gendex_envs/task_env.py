@@ -84,6 +84,12 @@ class TaskEnv(BaseEnv):
         self._frame: dict | None = None
         self.articulations: dict[str, Articulation] = {}
         self._records: dict[str, AssetRecord] = {o.name: get_asset(o.asset) for o in self.task_spec.objects}
+        self._container_extent: dict[str, tuple[float, float]] = {
+            o.name: (0.8 * min(self._records[o.name].size_m[:2]) / 2 * o.scale,
+                     self._records[o.name].bbox_max_m[2] * o.scale)
+            for o in self.task_spec.objects
+        }
+        """Per object: radius (80 % of the half footprint) and height of the space an ``inside`` condition checks."""
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
         super().__init__(*args, **kwargs)
 
@@ -352,9 +358,7 @@ class TaskEnv(BaseEnv):
             target = self.goal_pos if c.target == "goal" else self.obj_pose(c.target).p
             return torch.linalg.norm(self.obj_pose(c.object).p - target, dim=-1) <= c.max_dist_m
         if c.type == "inside":
-            rec, scale = self._records[c.target], self.task_spec.object(c.target).scale
-            inner_r = 0.8 * min(rec.size_m[0], rec.size_m[1]) / 2 * scale
-            top = rec.bbox_max_m[2] * scale
+            inner_r, top = self._container_extent[c.target]
             box = self.obj_pose(c.target).p
             p = self.obj_pose(c.object).p
             dz = p[:, 2] - box[:, 2]

@@ -24,6 +24,7 @@ class ContactTable:
 
     def __init__(self, scene, bodies: list[Actor | Link]):
         self.scene = scene
+        self._keys: dict[int, tuple[Actor | Link, int]] = {}  # id(wrapper) -> (wrapper, kept alive; entity id)
         self._ids = frozenset(self._id(b) for b in bodies)
         self._net: dict[int, np.ndarray] | None = None
         self._pair: dict[tuple[int, int], np.ndarray] = {}
@@ -56,9 +57,12 @@ class ContactTable:
                 out[0, i] = v
         return torch.from_numpy(out).to(self.scene.device)
 
-    @staticmethod
-    def _id(body: Actor | Link) -> int:
-        return body._bodies[0].entity.per_scene_id
+    def _id(self, body: Actor | Link) -> int:
+        """PhysX entity id of a (CPU, single-env) body, memoised per wrapper object."""
+        hit = self._keys.get(id(body))
+        if hit is None:
+            hit = self._keys[id(body)] = (body, body._bodies[0].entity.per_scene_id)
+        return hit[1]
 
     def _check(self, bodies: list[Actor | Link]) -> None:
         outside = [b.name for b in bodies if self._id(b) not in self._ids]

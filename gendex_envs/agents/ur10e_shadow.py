@@ -165,6 +165,8 @@ class UR10eShadowHand(BaseAgent):
             g: [self.robot.links_map[n] for n in names] for g, names in HAND_GROUP_LINKS.items()
         }
         self._tip_offsets = torch.tensor(TIP_OFFSETS_M, dtype=torch.float32, device=self.device)
+        self._tip_offsets_np = np.asarray(TIP_OFFSETS_M, dtype=np.float32)
+        self._px_tip_links = [link._objs[0] for link in self.tip_links]
         self._group_link_list = [link for links in self.group_links.values() for link in links]
         self._group_index = torch.tensor([g for g, links in enumerate(self.group_links.values()) for _ in links],
                                          device=self.device)
@@ -194,22 +196,22 @@ class UR10eShadowHand(BaseAgent):
         )
 
     # ------------------------------------------------------------------ reward-code API (batched)
-    def _link_poses(self, links: list[Link]) -> torch.Tensor:
-        """[N, L, 7] world poses (x, y, z, qw, qx, qy, qz) of ``links``, fetched in one go."""
-        if self.scene.gpu_sim_enabled:
-            return torch.stack([link.pose.raw_pose for link in links], dim=1)
-        poses = [link._objs[0].entity_pose for link in links]  # CPU: one env, sapien.Pose each
-        rows = np.array([[*pose.p, *pose.q] for pose in poses], dtype=np.float32)
-        return torch.from_numpy(rows).to(self.device)[None]
-
     @property
     def tip_poses(self) -> torch.Tensor:
         """[N, 5*7] fingertip poses (x, y, z, qw, qx, qy, qz) of th, ff, mf, rf, lf, concatenated."""
-        poses = self._link_poses(self.tip_links)  # [N, 5, 7]
-        offsets = torch.zeros(poses.shape[:2] + (3,), device=self.device)
-        offsets[..., 2] = self._tip_offsets
-        tips = poses[..., :3] + quat_rotate(poses[..., 3:], offsets)
-        return torch.cat([tips, poses[..., 3:]], dim=-1).flatten(1)
+        if self.scene.gpu_sim_enabled:
+            poses = torch.stack([link.pose.raw_pose for link in self.tip_links], dim=1)  # [N, 5, 7]
+            offsets = torch.zeros(poses.shape[:2] + (3,), device=self.device)
+            offsets[..., 2] = self._tip_offsets
+            tips = poses[..., :3] + quat_rotate(poses[..., 3:], offsets)
+            return torch.cat([tips, poses[..., 3:]], dim=-1).flatten(1)
+        # CPU, one env: read the five link poses from PhysX and offset them along their z axes in numpy
+        rows = np.array([[*pose.p, *pose.q] for pose in (link.entity_pose for link in self._px_tip_links)],
+                        dtype=np.float32)  # [5, 7]
+        w, x, y, z = rows[:, 3], rows[:, 4], rows[:, 5], rows[:, 6]
+        z_axis = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=1)
+        rows[:, :3] += z_axis * self._tip_offsets_np[:, None]
+        return torch.from_numpy(rows.reshape(1, 35)).to(self.device)
 
     @property
     def tip_positions(self) -> torch.Tensor:
