@@ -39,7 +39,7 @@ from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, 
 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import AssetRecord, JointRecord, asset_ids, get_asset, lowest_point_z
-from gendex_envs.errors import RewardModuleError, TaskSpecError, suggest
+from gendex_envs.errors import ControlModeError, RewardModuleError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.spec import ConditionSpec, TaskSpec, load_task_spec
@@ -73,8 +73,8 @@ class TaskEnv(BaseEnv):
             rl = [s for s in self.task_spec.stages if s.method == "RL"]
             control_joint = rl[0].control_joint if rl else "both"
         if control_joint not in CONTROL_JOINT_GROUPS:
-            raise TaskSpecError(f"control_joint={control_joint!r} is not a mode; allowed: "
-                                f"{sorted(CONTROL_JOINT_GROUPS)}.{suggest(control_joint, CONTROL_JOINT_GROUPS)}")
+            raise ControlModeError(f"control_joint={control_joint!r} is not a mode; allowed: "
+                                   f"{sorted(CONTROL_JOINT_GROUPS)}.{suggest(control_joint, CONTROL_JOINT_GROUPS)}")
         self.control_joint = control_joint
         """Joint group actions drive (default: the first RL stage's ``control_joint``, else ``both``)."""
         self.view_resolution = view_resolution
@@ -115,16 +115,18 @@ class TaskEnv(BaseEnv):
     @property
     def _default_sensor_configs(self) -> list[CameraConfig]:
         res = self.sensor_resolution
-        views = [CameraConfig(n, p, res, res, 1.0, 0.01, 10.0) for n, p in self._view_poses().items()]
+        views = [CameraConfig(uid=n, pose=p, width=res, height=res, fov=1.0, near=0.01, far=10.0)
+                 for n, p in self._view_poses().items()]
         # hand camera: on the palm, looking out of the palm (-y of the palm frame) towards the grasp
-        hand = CameraConfig(HAND_CAMERA, sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068]),
-                            res, res, 1.4, 0.01, 5.0, mount=self.agent.palm_link)
+        hand = CameraConfig(uid=HAND_CAMERA, pose=sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068]),
+                            width=res, height=res, fov=1.4, near=0.01, far=5.0, mount=self.agent.palm_link)
         return [*views, hand]
 
     @property
     def _default_human_render_camera_configs(self) -> list[CameraConfig]:
         res = self.view_resolution
-        return [CameraConfig(n, p, res, res, 1.0, 0.01, 10.0) for n, p in self._view_poses().items()]
+        return [CameraConfig(uid=n, pose=p, width=res, height=res, fov=1.0, near=0.01, far=10.0)
+                for n, p in self._view_poses().items()]
 
     # ------------------------------------------------------------------ loading
     def _load_agent(self, options: dict, initial_agent_poses=None, build_separate: bool = False):
