@@ -201,8 +201,10 @@ class Model:
             out.append(link.inertial_xml())
             for k, s in enumerate(link.shapes):
                 origin = f'<origin xyz="{_v(s.centre)}" rpy="{_v(s.rpy())}"/>'
-                out.append(f'  <visual name="{link.name}_{k}">\n   {origin}\n   <geometry>{s.geometry_xml()}</geometry>\n'
-                           f'   <material name="{link.name}_{k}"><color rgba="{_v(s.rgba)}"/></material>\n  </visual>\n')
+                geom = f"<geometry>{s.geometry_xml()}</geometry>"
+                out.append(f'  <visual name="{link.name}_{k}">\n   {origin}\n   {geom}\n'
+                           f'   <material name="{link.name}_{k}"><color rgba="{_v(s.rgba)}"/></material>\n'
+                           f'  </visual>\n')
                 out.append(f'  <collision name="{link.name}_{k}">\n   {origin}\n'
                            f'   <geometry>{s.geometry_xml()}</geometry>\n  </collision>\n')
             out.append(" </link>\n")
@@ -309,7 +311,8 @@ def cabinet(id: str, hinge: Literal["left", "right"], depth: float = 0.40, width
             height: float = 0.50, handle: Literal["bar", "knob_bar"] = "bar") -> Model:
     """Wooden cabinet with one shelf and a full-front side-hinged door."""
     d, w, h, t, dt = depth, width, height, 0.015, 0.018
-    body = shell(d, w, h, t, WOOD) + [box((-d / 2 + 0.02, -w / 2 + t, h / 2 - t / 2), (d / 2 - t, w / 2 - t, h / 2 + t / 2), WOOD)]
+    shelf = box((-d / 2 + 0.02, -w / 2 + t, h / 2 - t / 2), (d / 2 - t, w / 2 - t, h / 2 + t / 2), WOOD)
+    body = shell(d, w, h, t, WOOD) + [shelf]
     bar_len = 0.14 if handle == "bar" else 0.10
     origin, axis, door, grip = side_door(d, w, -w / 2, w / 2, 0.002, h - 0.002, hinge, dt, WOOD, bar_len, 0.55 * h,
                                          knobs=handle == "knob_bar")
@@ -340,7 +343,8 @@ def drawer_chest(id: str, n: int, depth: float = 0.40, width: float = 0.45, heig
         ]
         handle, grip = bar_handle(-dt, 0.0, bay / 2, 0.14, "y")
         links.append(Link(f"drawer_{i}", 1.2, tuple(shapes + handle)))
-        joints.append(Joint(f"drawer_{i}_slide", "prismatic", "body", f"drawer_{i}", (-d / 2, 0.0, bot), (-1.0, 0.0, 0.0),
+        joints.append(Joint(f"drawer_{i}_slide", "prismatic", "body", f"drawer_{i}", (-d / 2, 0.0, bot),
+                            (-1.0, 0.0, 0.0),
                             (0.0, 0.3), 0.0, 0.2, grip, damping=1.0, friction=0.05))
     return Model(id, "drawer_chest", ("furniture", "container", "drawer"),
                  (Link("body", 9.0, tuple(body)), *links), tuple(joints),
@@ -395,7 +399,8 @@ def dishwasher(id: str, rack: bool, depth: float = 0.46, width: float = 0.45, he
         joints.append(Joint("rack_slide", "prismatic", "body", "rack", (-d / 2 + 0.02, 0.0, base + 0.09),
                             (-1.0, 0.0, 0.0), (0.0, 0.32), 0.0, 0.25, (-0.009, 0.0, rim), damping=1.0, friction=0.05))
     return Model(id, "dishwasher", ("appliance", "kitchen", "container", "door") + (("drawer",) if rack else ()),
-                 tuple(links), tuple(joints), params={"depth": d, "width": w, "height": h, "rack": "yes" if rack else "no"})
+                 tuple(links), tuple(joints),
+                 params={"depth": d, "width": w, "height": h, "rack": "yes" if rack else "no"})
 
 
 def refrigerator(id: str, hinge: Literal["left", "right"], depth: float, width: float, height: float) -> Model:

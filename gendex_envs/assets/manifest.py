@@ -69,7 +69,7 @@ class AssetEntry:
     bbox_max_m: tuple[float, float, float]
     """Axis-aligned bounds in the asset frame at scale 1 (bbox_min_m z is 0 by the frame convention)."""
     mass_kg: float
-    """Real-world mass at scale 1 (articulated: the moving parts; the body is usually fixed)."""
+    """Real-world mass at scale 1 (articulated: all links together)."""
     friction: float
     """Static friction coefficient (dynamic = 0.8 x static)."""
     visual: str | None = None

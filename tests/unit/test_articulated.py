@@ -134,7 +134,7 @@ def test_joints_drive_open_and_rest_closed(entry: AssetEntry):
         target[i] = spec.open_qpos
         q = _settle(scene, art, start, target, 1000.0, 2.0)
         assert abs(q[i] - spec.open_qpos) <= 0.1 * abs(spec.open_qpos - spec.closed_qpos), (spec.name, q)
-    # undriven and frictionless, gravity alone keeps every joint closed (bottom-hinged doors and lids rest on their limit)
+    # undriven and frictionless, gravity alone keeps every joint closed (bottom-hinged doors, lids rest on the limit)
     q = _settle(scene, art, closed, closed, 0.0, 1.0)
     np.testing.assert_allclose(q, closed, atol=0.02, err_msg=entry.id)
 
