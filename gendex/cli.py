@@ -93,6 +93,39 @@ def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"
 
 
 @app.command()
+def assets(as_json: bool = typer.Option(False, "--json", help="Machine-readable catalog."),
+           guidance: bool = typer.Option(False, "--guidance", help="The text block proposal prompts consume.")) -> None:
+    """List the asset catalog (shipped objects, articulated models and user datasets found on disk)."""
+    import json  # noqa: PLC0415
+
+    from gendex_envs.assets.guidance import catalog_json, guidance_text  # noqa: PLC0415
+
+    if as_json:
+        typer.echo(json.dumps(catalog_json(), indent=1))
+    elif guidance:
+        typer.echo(guidance_text())
+    else:
+        data = catalog_json()
+        for a in data["assets"]:
+            size = " x ".join(f"{100 * v:.1f}" for v in a["size_m"])
+            typer.echo(f"{a['id']:28s} {a['category']:18s} {a['kind']:11s} {size:>22s} cm  {a['mass_kg']:7.3f} kg  "
+                       f"{a['licence']}")
+        c = data["counts"]
+        typer.echo(f"\n{c['rigid']} rigid assets, {c['articulated']} articulated in "
+                   f"{len(c['articulated_categories'])} categories")
+
+
+@app.command()
+def gallery(out: Path = typer.Option(Path("docs/assets"), "--out", help="Folder for thumbnails and index."),
+            size: int = typer.Option(256, help="Thumbnail size in pixels.")) -> None:
+    """Render a thumbnail of every asset (on the task table, next to the hand) and write ``<out>.md``."""
+    from gendex.gallery import render_gallery  # noqa: PLC0415
+
+    index = render_gallery(out, size)
+    typer.echo(f"wrote {index}")
+
+
+@app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for renders."),
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),
          seed: int = typer.Option(0, help="Seed of resets and random actions.")) -> None:

@@ -38,7 +38,8 @@ from mani_skill.utils.structs import Actor, Articulation, Link, Pose
 from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
-from gendex_envs.assets.catalog import AssetRecord, JointRecord, asset_ids, get_asset, lowest_point_z
+from gendex_envs.assets.catalog import AssetRecord, asset_ids, get_asset, lowest_point_z
+from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.errors import ControlModeError, RewardModuleError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
 from gendex_envs.reward_module import RewardModule, load_reward_module
@@ -51,6 +52,8 @@ CONTROL_FREQ = 20
 VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 """The three scene views used by rendering, refinement and the docs."""
 HAND_CAMERA = "hand_camera"
+DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "default_reward.py"
+"""Reward module of an in-memory spec: success = the spec's conditions, reward = reaching the first target."""
 
 
 def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
@@ -63,12 +66,20 @@ class TaskEnv(BaseEnv):
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
     agent: UR10eShadowHand
 
-    def __init__(self, *args, task_dir: str, control_joint: str | None = None, view_resolution: int = 512,
-                 sensor_resolution: int = 128, **kwargs):
-        self.task_dir = Path(task_dir)
-        """The task's version folder (holds task.yaml and reward.py)."""
-        self.task_spec: TaskSpec = load_task_spec(self.task_dir / "task.yaml", known_assets=asset_ids())
-        self.reward: RewardModule = load_reward_module(self.task_dir / "reward.py")
+    def __init__(self, *args, task_dir: str | None = None, task_spec: TaskSpec | None = None,
+                 control_joint: str | None = None, view_resolution: int = 512, sensor_resolution: int = 128,
+                 **kwargs):
+        if (task_dir is None) == (task_spec is None):
+            raise TaskSpecError("TaskEnv needs exactly one of task_dir (a task folder) or task_spec (in memory)")
+        self.task_dir = Path(task_dir) if task_dir is not None else None
+        """The task's version folder (holds task.yaml and reward.py); None for an in-memory spec."""
+        if task_spec is None:
+            task_spec = load_task_spec(self.task_dir / "task.yaml", known_assets=asset_ids())
+            reward_path = self.task_dir / "reward.py"
+        else:
+            reward_path = DEFAULT_REWARD_MODULE
+        self.task_spec: TaskSpec = task_spec
+        self.reward: RewardModule = load_reward_module(reward_path)
         if control_joint is None:
             rl = [s for s in self.task_spec.stages if s.method == "RL"]
             control_joint = rl[0].control_joint if rl else "both"
@@ -156,16 +167,17 @@ class TaskEnv(BaseEnv):
 
         self.objects.clear()
         self.articulations.clear()
+        self._art_init_qpos: dict[str, torch.Tensor] = {}
         self._init_pose: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
         for obj in self.task_spec.objects:
             rec = self._records[obj.name]
             p, q = self._spec_pose(obj)
             entity = rec.build(self.scene, obj.name, obj.scale, obj.color_rgba, obj.fixed,
-                               sapien.Pose(p=p.tolist(), q=q.tolist()), rec)
+                               sapien.Pose(p=p.tolist(), q=q.tolist()))
             self.objects[obj.name] = entity
             if rec.articulated:
                 self.articulations[obj.name] = entity
-                self._check_joint_state(obj.name, rec)
+                self._art_init_qpos[obj.name] = self._initial_joint_state(obj.name, rec, entity)
             self._init_pose[obj.name] = (torch.tensor(p, dtype=torch.float32, device=self.device),
                                          torch.tensor(q, dtype=torch.float32, device=self.device))
         with torch.device(self.device):
@@ -197,16 +209,23 @@ class TaskEnv(BaseEnv):
         z = self.table_height + clearance - lowest_point_z(rec, obj.scale, q)
         return np.array([x, y, z]), q
 
-    def _check_joint_state(self, name: str, rec: AssetRecord) -> None:
-        known = [j.name for j in rec.joints]
-        for joint, value in self.task_spec.object(name).joint_state.items():
-            if joint not in known:
-                raise TaskSpecError(f"{self.task_dir / 'task.yaml'}: objects[{name}].joint_state has joint {joint!r}, "
-                                    f"which asset {rec.id!r} lacks; joints: {known}.{suggest(joint, known)}")
-            lo, hi = rec.joint(joint).limits
-            if not lo <= value <= hi:
-                raise TaskSpecError(f"{self.task_dir / 'task.yaml'}: objects[{name}].joint_state.{joint}={value} "
-                                    f"is outside the joint limits [{lo}, {hi}]")
+    def _initial_joint_state(self, name: str, rec: AssetRecord, art: Articulation) -> torch.Tensor:
+        """[dof] joint positions at reset: the spec's joint_state, else the joint's closed value, else its lower limit."""
+        where = self.task_dir / "task.yaml" if self.task_dir else "<in-memory spec>"
+        names = [j.name for j in art.get_active_joints()]
+        lower = art.get_qlimits()[0, :, 0].cpu()
+        spec_state = self.task_spec.object(name).joint_state
+        for joint, value in spec_state.items():
+            if joint not in names:
+                raise TaskSpecError(f"{where}: objects[{name}].joint_state has joint {joint!r}, which asset "
+                                    f"{rec.id!r} lacks; joints: {names}.{suggest(joint, names)}")
+            lo, hi = art.get_qlimits()[0, names.index(joint)].tolist()
+            if not lo - 1e-6 <= value <= hi + 1e-6:
+                raise TaskSpecError(f"{where}: objects[{name}].joint_state.{joint}={value} is outside the joint "
+                                    f"limits [{lo:.4f}, {hi:.4f}]")
+        closed = {j.name: j.closed_qpos for j in rec.joints}
+        return torch.tensor([spec_state.get(n, closed.get(n, float(lower[i]))) for i, n in enumerate(names)],
+                            dtype=torch.float32, device=self.device)
 
     # ------------------------------------------------------------------ episodes
     def reset(self, seed: int | list[int] | None = None, options: dict | None = None):
@@ -261,12 +280,9 @@ class TaskEnv(BaseEnv):
                 entity = self.objects[obj.name]
                 entity.set_pose(Pose.create_from_pq(p, q))
                 if obj.name in self.articulations:
-                    art = self.articulations[obj.name]
-                    names = [j.name for j in art.get_active_joints()]
-                    state = torch.tensor([obj.joint_state.get(n, self._joint_record(obj.name, n).closed_qpos)
-                                          for n in names])
-                    art.set_qpos(state.expand(b, -1).clone())
-                    art.set_qvel(torch.zeros(b, len(names)))
+                    state = self._art_init_qpos[obj.name]
+                    self.articulations[obj.name].set_qpos(state.expand(b, -1).clone())
+                    self.articulations[obj.name].set_qvel(torch.zeros(b, state.shape[0]))
                 elif not obj.fixed:
                     entity.set_linear_velocity(torch.zeros(b, 3))
                     entity.set_angular_velocity(torch.zeros(b, 3))
@@ -298,7 +314,7 @@ class TaskEnv(BaseEnv):
             raise TaskSpecError(f"task {self.task_spec.name!r} has no object {name!r}; objects: {sorted(self.objects)}."
                                 f"{suggest(name, self.objects)}") from None
 
-    def _joint_record(self, name: str, joint: str | None = None) -> JointRecord:
+    def _joint_record(self, name: str, joint: str | None = None) -> JointEntry:
         rec = self._records[name]
         if not rec.articulated:
             raise TaskSpecError(f"object {name!r} (asset {rec.id!r}) is not articulated")

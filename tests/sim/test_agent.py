@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 import torch
 
+from gendex_envs.assets.catalog import get_asset
+
 from gendex_envs.agents.ur10e_shadow import (
     ALL_JOINTS,
     COUPLED_DISTAL,
@@ -110,7 +112,7 @@ def _push_bottle(env, target_p: torch.Tensor, steps: int = 12) -> tuple[torch.Te
     bottle._bodies[0].disable_gravity = True
     pose = bottle.pose
     p = target_p.clone()[None]
-    p[0, 2] -= 0.2 + 0.004  # the bottle is 0.20 m tall, its origin at the base
+    p[0, 2] -= get_asset("bottle").size_m[2] + 0.004  # the origin is at the bottle's base
     bottle.set_pose(type(pose).create_from_pq(p, pose.q))
     hold = u.agent.controller._target_qpos[0, u.agent.controller.free_idx].cpu().numpy()
     tips, groups = torch.zeros(5), torch.zeros(6)

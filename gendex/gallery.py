@@ -1,0 +1,88 @@
+"""The asset gallery: a thumbnail of every catalog asset, rendered by GenDex's own env, and a Markdown index."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+from mani_skill.utils import sapien_utils
+from PIL import Image
+from tqdm import tqdm
+
+from gendex_envs.assets.catalog import AssetRecord, catalog
+from gendex_envs.spec import parse_task_spec
+
+log = logging.getLogger(__name__)
+
+FRONT_X_M = 0.32
+"""Each asset stands with its front (its -x face) here: in front of the robot, clear of the hand."""
+
+
+def _spot(record: AssetRecord) -> tuple[float, float]:
+    return FRONT_X_M - record.bbox_min_m[0], 0.0
+
+
+def _spec(record: AssetRecord):
+    x, y = _spot(record)
+    return parse_task_spec({
+        "name": "Gallery",
+        "instruction": f"Look at the {record.category}.",
+        "objects": [{"name": "item", "asset": record.id, "pos_m": [x, y, 0.0],
+                     "fixed": record.articulated}],
+        "stages": [{"name": "look", "instruction": "Nothing to do.", "method": "RL", "control_joint": "hand",
+                    "target": "item"}],
+        "success": {"description": "never", "conditions": [{"type": "lifted", "object": "item",
+                                                             "min_height_m": 10.0}]},
+    }, source=f"<gallery:{record.id}>")
+
+
+def render_thumbnail(record: AssetRecord, size: int = 256) -> np.ndarray:
+    """[size, size, 3] uint8 close-up of ``record`` standing on the task table."""
+    from gendex_envs.task_env import TaskEnv  # noqa: PLC0415
+
+    extent = max(max(record.size_m), 0.06)
+    x, y = _spot(record)
+    centre = [x + (record.bbox_min_m[0] + record.bbox_max_m[0]) / 2, y, record.size_m[2] / 2]
+    d = 1.6 * extent + 0.12
+    eye = [centre[0] - 0.75 * d, centre[1] - 0.75 * d, centre[2] + 0.7 * d]
+    cameras = {"left_overhead": {"pose": sapien_utils.look_at(eye, centre), "width": size, "height": size,
+                                 "fov": 0.8}}
+    env = TaskEnv(task_spec=_spec(record), render_mode="rgb_array", render_backend="cpu",
+                  human_render_camera_configs=cameras)
+    try:
+        env.reset(seed=0)
+        return env.render_views(("left_overhead",))["left_overhead"][0]
+    finally:
+        env.close()
+
+
+def render_gallery(out: Path, size: int = 256) -> Path:
+    """Write ``out/<id>.png`` for every asset and the index ``out.md``; returns the index path."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    records = sorted(catalog().values(), key=lambda r: (r.articulated, r.category, r.id))
+    rows = []
+    for record in tqdm(records, desc="gallery", unit="asset"):
+        png = out / f"{record.id}.png"
+        tmp = png.with_suffix(".tmp.png")
+        Image.fromarray(render_thumbnail(record, size)).save(tmp)
+        tmp.replace(png)
+        size_cm = " × ".join(f"{100 * v:.1f}" for v in record.size_m)
+        joints = ", ".join(f"{j.name} ({j.type})" for j in record.joints) or "—"
+        rows.append(f"| ![{record.id}]({out.name}/{png.name}) | `{record.id}` | {record.category} | {size_cm} | "
+                    f"{record.mass_kg:.3g} | {joints} | {', '.join(record.tags)} | {record.entry.licence} |")
+    index = out.with_suffix(".md")
+    header = [
+        "# Asset gallery",
+        "",
+        f"{len(records)} assets, each rendered on the task table by `gendex gallery` (the project's own env; the "
+        "ShadowHand may appear at the edge for scale). Sizes are real-world at scale 1.",
+        "",
+        "| view | id | category | size cm (x × y × z) | mass kg | joints | tags | licence |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    tmp = index.with_suffix(".tmp")
+    tmp.write_text("\n".join(header + rows) + "\n")
+    tmp.replace(index)
+    return index

@@ -1,0 +1,57 @@
+"""The catalog as users and prompts see it: `gendex assets --json` / `--guidance`, and lookup errors."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from gendex.cli import app
+from gendex_envs.assets.catalog import get_asset
+from gendex_envs.errors import AssetNotFoundError
+
+
+@pytest.fixture(scope="module")
+def listing():
+    result = CliRunner().invoke(app, ["assets", "--json"])
+    assert result.exit_code == 0, result.output
+    return json.loads(result.output)
+
+
+def test_json_listing_meets_the_library_targets(listing):
+    rigid = [a for a in listing["assets"] if a["kind"] == "rigid"]
+    articulated = [a for a in listing["assets"] if a["kind"] == "articulated"]
+    assert len(rigid) >= 40
+    categories: dict[str, int] = {}
+    for a in articulated:
+        categories[a["category"]] = categories.get(a["category"], 0) + 1
+    assert len(categories) >= 10 and min(categories.values()) >= 2, categories
+    assert listing["counts"]["articulated_categories"] == categories
+    for a in listing["assets"]:
+        assert len(a["size_m"]) == 3 and all(0.005 < v < 1.5 for v in a["size_m"]), a["id"]
+        assert 0.001 < a["mass_kg"] < 60, a["id"]
+        assert a["licence"], a["id"]
+    for a in articulated:
+        assert a["joints"] and all(j["handle_link"] for j in a["joints"]), a["id"]
+
+
+def test_yaml_vocabulary_is_covered(listing):
+    categories = {a["category"] for a in listing["assets"]}
+    for noun in ("apple", "banana", "orange", "lemon", "pear", "peach", "plum", "tennis_ball", "baseball",
+                 "golf_ball", "softball", "mug", "cup", "bowl", "plate", "pitcher", "bottle", "can", "jar",
+                 "cracker_box", "sugar_box", "pudding_box", "hammer", "screwdriver", "spatula", "marker", "scissors",
+                 "spoon", "fork", "knife", "sponge"):
+        assert noun in categories, noun
+
+
+def test_guidance_names_every_asset_with_size():
+    result = CliRunner().invoke(app, ["assets", "--guidance"])
+    assert result.exit_code == 0
+    text = result.output
+    for asset_id in ("apple", "bowl", "cabinet_left_hinge", "drawer_chest_2"):
+        assert f"- {asset_id} |" in text
+    assert "door_hinge revolute [0, 1.9] 0->1.4, handle door" in text
+
+
+def test_unknown_asset_suggests_close_ids():
+    with pytest.raises(AssetNotFoundError, match=r"unknown asset 'appel'.*'apple'"):
+        get_asset("appel")
