@@ -150,7 +150,7 @@ def test_free_base_rests_upright(entry: AssetEntry):
 
 def test_rebuild_is_byte_identical(tmp_path: Path):
     written = build(tmp_path)
-    assert len(written) == len(ENTRIES) + 1
+    assert len(written) == len(ENTRIES) + 2  # URDFs, LICENSE, manifest
     for path in written:
         rel = path.relative_to(tmp_path)
         assert filecmp.cmp(path, DEFAULT_OUT / rel, shallow=False), f"{rel} differs from the shipped file"
