@@ -31,6 +31,7 @@ import torch
 from sapien import physx
 from sapien.wrapper.actor_builder import ActorBuilder
 from sapien.wrapper.articulation_builder import ArticulationBuilder
+from sapien.wrapper.urdf_loader import URDFLoader
 
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex_envs.agents.robot_model import robot_urdf_path
@@ -66,6 +67,27 @@ class PhysicsOnlyScene(sapien.Scene):
     def create_articulation_builder(self):
         return _NoVisualArticulationBuilder().set_scene(self)
 
+    def create_urdf_loader(self):
+        return _DictURDFLoader.for_scene(self)
+
+
+class _DictURDFLoader(URDFLoader):
+    """SAPIEN's URDF loader with ManiSkill's ``parse`` result (a dict) and ``name`` attribute, physics only."""
+
+    name = None
+
+    @classmethod
+    def for_scene(cls, scene):
+        loader = cls()
+        loader.set_scene(scene)
+        return loader
+
+    def parse(self, urdf_file, srdf_file=None, package_dir=None):
+        articulation_builders, actor_builders, cameras = super().parse(urdf_file, srdf_file, package_dir)
+        for b in articulation_builders:
+            b.__class__ = _NoVisualArticulationBuilder
+        return {"articulation_builders": articulation_builders, "actor_builders": actor_builders, "cameras": cameras}
+
 
 class RawScene:
     """The physical scene of a :class:`~gendex_envs.task_env.TaskEnv`, rebuilt with plain SAPIEN."""
@@ -93,7 +115,7 @@ class RawScene:
         robot = spec.robot  # the robot first, as ManiSkill loads the agent before the scene (same PhysX order)
         loader = self.scene.create_urdf_loader()
         loader.fix_root_link = True
-        builder = loader.parse(str(robot_urdf_path()))[0][0]
+        builder = loader.parse(str(robot_urdf_path()))["articulation_builders"][0]
         yaw = math.radians(robot.base_yaw_deg)
         builder.initial_pose = sapien.Pose(list(robot.base_pos_m), [math.cos(yaw / 2), 0, 0, math.sin(yaw / 2)])
         self.robot = builder.build(fix_root_link=True)
@@ -134,7 +156,7 @@ class RawScene:
             rec = get_asset(obj.asset)
             x, y, clearance = obj.pos_m
             pose = sapien.Pose([x, y, clearance - lowest_point_z(rec, obj.scale, obj.quat_wxyz)], list(obj.quat_wxyz))
-            entity = rec.build(self.scene, obj.name, obj.scale, obj.color_rgba, obj.fixed, pose, rec)
+            entity = rec.build(self.scene, obj.name, obj.scale, obj.color_rgba, obj.fixed, pose)
             qpos = None
             if rec.articulated:
                 qpos = np.array([obj.joint_state.get(j.name, rec.joint(j.name).closed_qpos)

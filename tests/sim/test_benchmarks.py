@@ -1,0 +1,20 @@
+"""Benchmarks must keep running as the package changes (their numbers are printed, not asserted)."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize("task", ["GenDex/PutAppleBowl-v0", "GenDex/OpenCabinet-v0"])
+def test_step_rate_benchmark_runs_and_builds_an_equivalent_scene(task):
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_rate.py"), "--task", task, "--steps", "20",
+                          "--warmup", "5", "--repeats", "1"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    bodies = re.search(r"bodies \(dynamic, static, links\): env (\(.*?\))\s+raw (\(.*?\))", out.stdout)
+    assert bodies and bodies.group(1) == bodies.group(2), out.stdout
+    assert re.search(r"ratio env / raw\s+\d+\.\d+", out.stdout), out.stdout
