@@ -1,37 +1,20 @@
-"""User-supplied YCB and PartNet-Mobility data, read from ManiSkill's asset directory into :class:`AssetEntry` form.
+"""PartNet-Mobility models from ManiSkill's asset directory, as articulated :class:`AssetEntry` objects.
 
-GenDex never downloads these datasets. Users who already have them (ManiSkill downloads them with
-``python -m mani_skill.utils.download_asset ycb`` / ``partnet_mobility_cabinet`` ...) get them in the catalog too.
-Nothing here creates, downloads or writes a file; it only reads what is on disk.
+Layout read (``<data>`` is :func:`~gendex_envs.assets.user_datasets.common.maniskill_asset_dir`)::
 
-Layout read (as ManiSkill 3.0.1 lays it out and reads it; ``<data>`` is :func:`maniskill_asset_dir`)::
-
-    <data>/assets/mani_skill2_ycb/info_pick_v0.json          # {model_id: {"bbox": {"min", "max"}, "scales", "density"}}
-    <data>/assets/mani_skill2_ycb/models/<model_id>/textured.obj     # visual
-    <data>/assets/mani_skill2_ycb/models/<model_id>/collision.ply    # convex parts (collision.obj also accepted)
     <data>/partnet_mobility/dataset/<model_id>/mobility_cvx.urdf     # or mobility_fixed.urdf, or mobility.urdf
     <data>/partnet_mobility/meta/info_*_train.json           # optional, user-supplied metadata (same format as below)
     mani_skill/assets/partnet_mobility/meta/info_*_train.json    # shipped with ManiSkill: {model_id: {"scale", ...}}
 
-Units and frames of the entries made here (the manifest convention, see :mod:`gendex_envs.assets.manifest`):
-the files are *not* rewritten, so each entry carries two ``params`` the catalog must apply when it loads them:
-
-* ``params["file_scale"]``: the dataset's own scale (YCB ``scales[0]``, PartNet-Mobility ``scale``, as ManiSkill
-  passes them to its builders); the files must be loaded at ``file_scale x`` the user's scale. Every metric value
-  of the entry (bbox, volume, mass, prismatic limits, handle points, ``origin_dz_m``) is already at ``file_scale``,
-  i.e. real-world metres at GenDex scale 1.
-* ``params["origin_dz_m"]``: how far (metres, at GenDex scale 1) the loaded geometry must be raised so that its
-  lowest point is at z = 0. ``bbox_min_m`` z is therefore 0. x/y are left as the dataset has them (YCB and
-  ManiSkill's PartNet-Mobility models are centred near the origin; the bbox records the exact extent).
+The URDF is read here (links, joints, geometries; forward kinematics at the closed configuration) to measure the
+model, its joints and their handles without SAPIEN. Units and frames (``file_scale``, ``origin_dz_m``): see
+:mod:`gendex_envs.assets.user_datasets`.
 """
 
 from __future__ import annotations
 
-import importlib.util
-import json
 import logging
 import math
-import os
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
@@ -41,28 +24,14 @@ from pathlib import Path
 import numpy as np
 
 from gendex_envs.assets.manifest import AssetEntry, JointEntry
+from gendex_envs.assets.user_datasets.common import (_bounds, _dataset_entry, _grounded, _hull_volume, _load_json,
+                                                   _load_parts, _maniskill_package_meta_dir, _number,
+                                                   _parts_vertices, _snake, _tuple3, _vec3, maniskill_asset_dir)
 from gendex_envs.errors import AssetNotFoundError
 
 log = logging.getLogger(__name__)
 
 # ---------------------------------------------------------------------------------------------- layout constants
-YCB_DIR = Path("assets") / "mani_skill2_ycb"
-"""mani_skill/utils/assets/data.py: DATA_SOURCES["ycb"].target_path = "assets/mani_skill2_ycb"."""
-YCB_INFO = "info_pick_v0.json"
-"""mani_skill/utils/building/actors/ycb.py: load_json(ASSET_DIR / "assets/mani_skill2_ycb/info_pick_v0.json")."""
-YCB_MODELS = "models"
-YCB_VISUAL = "textured.obj"
-YCB_COLLISIONS = ("collision.ply", "collision.obj")
-"""ycb.py reads models/<id>/collision.ply and models/<id>/textured.obj; collision.obj is accepted as well."""
-YCB_SOURCE = "YCB via ManiSkill asset dir"
-YCB_LICENCE = "CC-BY-4.0 (YCB)"
-YCB_DEFAULT_DENSITY = 1000.0
-"""ycb.py: density = metadata.get("density", 1000)."""
-YCB_FRICTION = 0.8
-"""Static friction given to YCB objects (ManiSkill leaves the scene default of 0.3; household objects are higher)."""
-YCB_HARD_TO_GRASP = frozenset({"022_windex_bottle", "028_skillet_lid", "029_plate", "059_chain"})
-"""pick_single_ycb.py excludes these as non-graspable / hard to grasp; they do not get the ``graspable`` tag."""
-
 PM_DIR = Path("partnet_mobility") / "dataset"
 """data.py: target_path = ASSET_DIR / "partnet_mobility" / "dataset" / model_id."""
 PM_USER_META_DIR = Path("partnet_mobility") / "meta"
@@ -83,226 +52,6 @@ PM_CONTAINERS = frozenset({"cabinet", "bucket", "storage_furniture", "refrigerat
                            "oven", "dishwasher", "washing_machine", "trash_can", "table"})
 PM_PRIORITY_LABELS = ("door", "drawer", "lid", "switch", "handle", "button", "knob")
 """Joints whose moving link has one of these semantic labels come first (the first joint is the main one)."""
-
-# YCB id token -> tags (tokens of the category, e.g. "tomato_soup_can" -> tomato, soup, can)
-_FRUIT = ("banana", "strawberry", "apple", "lemon", "peach", "pear", "orange", "plum")
-_YCB_TAGS: dict[str, tuple[str, ...]] = {
-    **{k: ("fruit", "food") for k in _FRUIT},
-    **{k: ("food",) for k in ("chips", "chef", "soup", "mustard", "tuna", "pudding", "gelatin", "meat", "sugar",
-                              "cracker")},
-    "box": ("box",),
-    "brick": ("box",),
-    "bottle": ("container",),
-    **{k: ("kitchenware", "tableware", "container") for k in ("bowl", "mug", "cups", "pitcher")},
-    **{k: ("kitchenware", "tableware") for k in ("plate",)},
-    "skillet": ("kitchenware",),
-    **{k: ("kitchenware", "utensil") for k in ("fork", "spoon", "knife", "spatula")},
-    **{k: ("tool",) for k in ("drill", "scissors", "marker", "wrench", "screwdriver", "hammer", "clamp", "padlock")},
-    **{k: ("ball",) for k in ("ball", "softball", "baseball", "marbles")},
-    **{k: ("toy",) for k in ("block", "blocks", "dice", "cube", "lego", "duplo", "airplane", "peg")},
-    **{k: ("household",) for k in ("sponge", "cleanser", "chain")},
-}
-
-
-# ---------------------------------------------------------------------------------------------- small helpers
-def maniskill_asset_dir() -> Path:
-    """ManiSkill's data folder: ``$MS_ASSET_DIR/data``, default ``~/.maniskill/data`` (as ``mani_skill.ASSET_DIR``).
-
-    Computed the same way as ``mani_skill/__init__.py`` without importing ManiSkill; creates nothing.
-    """
-    return Path(os.path.join(os.getenv("MS_ASSET_DIR", os.path.join(os.path.expanduser("~"), ".maniskill")),
-                             "data"))
-
-
-def _maniskill_package_meta_dir() -> Path | None:
-    """``mani_skill/assets/partnet_mobility/meta`` of the installed ManiSkill (found without importing it)."""
-    try:
-        spec = importlib.util.find_spec("mani_skill")
-    except (ImportError, ValueError):
-        return None
-    if spec is None or not spec.origin:
-        return None
-    d = Path(spec.origin).parent / "assets" / "partnet_mobility" / "meta"
-    return d if d.is_dir() else None
-
-
-def _snake(text: str) -> str:
-    """``StorageFurniture`` -> ``storage_furniture``; ``065-a cups`` -> ``065_a_cups``."""
-    text = re.sub(r"(?<=[a-z0-9])(?=[A-Z])", "_", str(text))
-    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
-
-
-def _asset_id(prefix: str, model_id: str) -> str:
-    return f"{prefix}_{_snake(model_id)}"
-
-
-def ycb_category(model_id: str) -> str:
-    """Noun of a YCB model id: ``002_master_chef_can`` -> ``master_chef_can``, ``065-a_cups`` -> ``cups``."""
-    noun = re.sub(r"^\d+(-[a-z])?_", "", model_id.strip())
-    return _snake(noun) or _snake(model_id)
-
-
-def ycb_tags(model_id: str) -> tuple[str, ...]:
-    tags: list[str] = [] if model_id in YCB_HARD_TO_GRASP else ["graspable"]
-    for token in ycb_category(model_id).split("_"):
-        for t in _YCB_TAGS.get(token, ()):
-            if t not in tags:
-                tags.append(t)
-    return tuple(tags)
-
-
-def _load_json(path: Path) -> object:
-    try:
-        return json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise AssetNotFoundError(f"{path}: cannot read JSON: {exc}") from exc
-
-
-def _vec3(value: object, where: str) -> np.ndarray:
-    arr = np.asarray(value, dtype=float) if isinstance(value, list | tuple) else None
-    if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise AssetNotFoundError(f"{where}: expected a list of 3 finite numbers, got {value!r}")
-    return arr
-
-
-def _number(value: object, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) or value <= 0:
-        raise AssetNotFoundError(f"{where}: expected a positive number, got {value!r}")
-    return float(value)
-
-
-def _tuple3(a: np.ndarray) -> tuple[float, float, float]:
-    return (float(a[0]), float(a[1]), float(a[2]))
-
-
-# ---------------------------------------------------------------------------------------------- meshes
-def _load_parts(path: Path) -> list:
-    """The convex parts SAPIEN makes of a collision file: one per ``o`` block of an .obj, one per connected
-    component of any other format (what ``add_multiple_convex_collisions_from_file`` does)."""
-    import trimesh  # noqa: PLC0415 (heavy; only needed when a dataset is present)
-
-    try:
-        if path.suffix.lower() == ".obj":
-            loaded = trimesh.load(str(path), split_object=True, group_material=False, process=False)
-            parts = loaded.dump() if isinstance(loaded, trimesh.Scene) else [loaded]
-        else:
-            mesh = trimesh.load(str(path), force="mesh", process=False)
-            parts = mesh.split(only_watertight=False) if len(mesh.faces) else [mesh]
-    except Exception as exc:  # trimesh raises many types for unreadable files
-        raise AssetNotFoundError(f"{path}: cannot read mesh: {exc}") from exc
-    parts = [p for p in parts if isinstance(p, trimesh.Trimesh) and len(p.vertices)]
-    if not parts:
-        raise AssetNotFoundError(f"{path}: mesh has no vertices")
-    return parts
-
-
-def _vertices(path: Path) -> np.ndarray:
-    return np.concatenate([np.asarray(p.vertices, dtype=float) for p in _load_parts(path)])
-
-
-def _hull_volume(parts: Iterable) -> float:
-    vol = 0.0
-    for p in parts:
-        try:
-            vol += abs(float(p.convex_hull.volume))
-        except Exception:  # degenerate (flat) parts have no hull volume
-            log.debug("degenerate convex part ignored in volume")
-    return vol
-
-
-# ---------------------------------------------------------------------------------------------- YCB
-def _ycb_dir(root: Path | None) -> Path:
-    return (Path(root) if root is not None else maniskill_asset_dir()) / YCB_DIR
-
-
-def _ycb_metadata(info_path: Path) -> dict[str, dict]:
-    raw = _load_json(info_path)
-    if not isinstance(raw, dict):
-        raise AssetNotFoundError(f"{info_path}: expected a JSON object mapping model ids to metadata")
-    for model_id, meta in raw.items():
-        if not isinstance(meta, dict):
-            raise AssetNotFoundError(f"{info_path}: {model_id!r}: expected an object, got {type(meta).__name__}")
-        if "bbox" in meta:
-            bbox = meta["bbox"]
-            if not isinstance(bbox, dict) or "min" not in bbox or "max" not in bbox:
-                raise AssetNotFoundError(f"{info_path}: {model_id!r}.bbox: expected {{'min': [x,y,z], 'max': [x,y,z]}}")
-            lo = _vec3(bbox["min"], f"{info_path}: {model_id!r}.bbox.min")
-            hi = _vec3(bbox["max"], f"{info_path}: {model_id!r}.bbox.max")
-            if np.any(hi < lo):
-                raise AssetNotFoundError(f"{info_path}: {model_id!r}.bbox: max < min")
-        if "scales" in meta:
-            scales = meta["scales"]
-            if not isinstance(scales, list) or not scales:
-                raise AssetNotFoundError(f"{info_path}: {model_id!r}.scales: expected a non-empty list")
-            _number(scales[0], f"{info_path}: {model_id!r}.scales[0]")
-        if "density" in meta:
-            _number(meta["density"], f"{info_path}: {model_id!r}.density")
-    return raw
-
-
-def _ycb_entry(model_id: str, meta: dict, model_dir: Path) -> AssetEntry | None:
-    visual = model_dir / YCB_VISUAL
-    collision = next((model_dir / c for c in YCB_COLLISIONS if (model_dir / c).is_file()), None)
-    if collision is None or not visual.is_file():
-        log.debug("YCB %s skipped: %s or %s missing in %s", model_id, YCB_VISUAL, "/".join(YCB_COLLISIONS),
-                  model_dir)
-        return None
-    scale = float(meta.get("scales", [1.0])[0])
-    density = float(meta.get("density", YCB_DEFAULT_DENSITY))
-    parts = _load_parts(collision)
-    if "bbox" in meta:
-        lo = np.asarray(meta["bbox"]["min"], dtype=float) * scale
-        hi = np.asarray(meta["bbox"]["max"], dtype=float) * scale
-    else:
-        verts = np.concatenate([np.asarray(p.vertices, dtype=float) for p in parts]) * scale
-        lo, hi = verts.min(axis=0), verts.max(axis=0)
-    dz = -float(lo[2])
-    lo = lo + [0.0, 0.0, dz]
-    hi = hi + [0.0, 0.0, dz]
-    volume = _hull_volume(parts) * scale**3
-    mass = density * volume if volume > 0 else density * float(np.prod(hi - lo))
-    return AssetEntry(
-        id=_asset_id("ycb", model_id),
-        category=ycb_category(model_id),
-        kind="rigid",
-        source=YCB_SOURCE,
-        licence=YCB_LICENCE,
-        tags=ycb_tags(model_id),
-        bbox_min_m=_tuple3(lo),
-        bbox_max_m=_tuple3(hi),
-        mass_kg=float(mass),
-        friction=YCB_FRICTION,
-        visual=str(visual.resolve()),
-        collision=str(collision.resolve()),
-        volume_m3=float(volume) if volume > 0 else None,
-        params={"origin_dz_m": dz, "file_scale": scale, "density_kg_m3": density, "model_id": model_id},
-    )
-
-
-def load_ycb(root: Path | None = None) -> list[AssetEntry]:
-    """YCB models present under ``root`` (ManiSkill's data folder; default :func:`maniskill_asset_dir`).
-
-    Model ids come from ``info_pick_v0.json`` (as in ManiSkill); entries whose files are missing are skipped. Without
-    the json, every ``models/<id>/`` folder with both files is read, its bbox taken from the collision mesh.
-    """
-    ycb = _ycb_dir(root)
-    info_path = ycb / YCB_INFO
-    models = ycb / YCB_MODELS
-    if info_path.is_file():
-        metadata = _ycb_metadata(info_path)
-    elif models.is_dir():
-        log.debug("%s missing: reading every model folder in %s", info_path, models)
-        metadata = {d.name: {} for d in models.iterdir() if d.is_dir()}
-    else:
-        log.debug("no YCB data at %s", ycb)
-        return []
-    entries = []
-    for model_id in sorted(metadata):
-        entry = _ycb_entry(model_id, metadata[model_id], models / model_id)
-        if entry is not None:
-            entries.append(entry)
-    log.debug("YCB: %d of %d models found in %s", len(entries), len(metadata), ycb)
-    return entries
 
 
 # ---------------------------------------------------------------------------------------------- URDF
@@ -513,7 +262,7 @@ class _Meshes:
     def vertices(self, g: _Geom) -> np.ndarray:
         """Vertices of a geometry in its link's frame."""
         if g.kind == "mesh":
-            v = np.concatenate([np.asarray(p.vertices, dtype=float) for p in self.parts(g.filename)]) * g.scale
+            v = _parts_vertices(self.parts(g.filename)) * g.scale
         elif g.kind == "box":
             h = np.asarray(g.size) / 2
             v = np.array([[x, y, z] for x in (-h[0], h[0]) for y in (-h[1], h[1]) for z in (-h[2], h[2])])
@@ -533,10 +282,6 @@ class _Meshes:
         if g.kind == "cylinder":
             return math.pi * g.size[0] ** 2 * g.size[1]
         return 4 / 3 * math.pi * g.size[0] ** 3
-
-
-def _bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return points.min(axis=0), points.max(axis=0)
 
 
 # ---------------------------------------------------------------------------------------------- PartNet-Mobility
@@ -642,9 +387,7 @@ def _pm_entry(model_id: str, model_dir: Path, urdf: Path, meta: _PMMeta | None) 
         if not pts:
             raise AssetNotFoundError(f"{urdf}: no geometry to measure")
         lo, hi = _bounds(np.concatenate(pts) * fs)
-    dz = -float(lo[2])
-    lo = lo + [0.0, 0.0, dz]
-    hi = hi + [0.0, 0.0, dz]
+    lo, hi, dz = _grounded(lo, hi)
 
     labels = _pm_semantics(model_dir, meta)
     entries: list[tuple[int, JointEntry]] = []
@@ -703,16 +446,16 @@ def _pm_entry(model_id: str, model_dir: Path, urdf: Path, meta: _PMMeta | None) 
     params: dict[str, float | str] = {"origin_dz_m": dz, "file_scale": fs, "model_id": model_id}
     if meta is not None:
         params["metadata"] = str(meta.file)
-    return AssetEntry(
-        id=_asset_id("pm", model_id),
+    return _dataset_entry(
+        "pm", model_id,
         category=category,
         kind="articulated",
         source=PM_SOURCE,
         licence=PM_LICENCE,
-        tags=tuple(tags),
-        bbox_min_m=_tuple3(lo),
-        bbox_max_m=_tuple3(hi),
-        mass_kg=float(mass),
+        tags=tags,
+        lo=lo,
+        hi=hi,
+        mass=mass,
         friction=PM_FRICTION,
         urdf=str(urdf.resolve()),
         fixed_base=True,
@@ -747,12 +490,3 @@ def load_partnet_mobility(root: Path | None = None, *, meta_files: Iterable[Path
             entries.append(entry)
     log.debug("PartNet-Mobility: %d models found in %s", len(entries), dataset)
     return entries
-
-
-def user_dataset_entries(root: Path | None = None) -> list[AssetEntry]:
-    """Every YCB and PartNet-Mobility entry found under ``root`` (default :func:`maniskill_asset_dir`); [] if none."""
-    root = Path(root) if root is not None else maniskill_asset_dir()
-    if not root.is_dir():
-        log.debug("ManiSkill asset folder %s does not exist: no user datasets", root)
-        return []
-    return load_ycb(root) + load_partnet_mobility(root)
