@@ -118,7 +118,9 @@ class AssetRecord:
         b = scene.create_actor_builder()
         b.add_multiple_convex_collisions_from_file(str(self.path(e.collision)), pose=offset, scale=s,
                                                    material=self._material(), density=density)
-        look = sapien.render.RenderMaterial(base_color=list(rgba or e.rgba), roughness=0.6)
+        textured = e.visual.endswith((".glb", ".gltf"))  # keep the file's own materials unless a colour is asked for
+        look = None if textured and rgba is None else sapien.render.RenderMaterial(base_color=list(rgba or e.rgba),
+                                                                                    roughness=0.6)
         b.add_visual_from_file(str(self.path(e.visual)), pose=offset, scale=s, material=look)
         b.initial_pose = pose
         return b.build_kinematic(name) if fixed else b.build(name)

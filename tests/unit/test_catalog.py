@@ -55,3 +55,16 @@ def test_guidance_names_every_asset_with_size():
 def test_unknown_asset_suggests_close_ids():
     with pytest.raises(AssetNotFoundError, match=r"unknown asset 'appel'.*'apple'"):
         get_asset("appel")
+
+
+def test_shipped_meshes_rebuild_identically(tmp_path):
+    """The converted package meshes are reproducible from the installed packages."""
+    import filecmp
+
+    from gendex_envs.assets.build_shipped import DEFAULT_OUT, build
+
+    build(tmp_path)
+    for path in sorted(p for p in tmp_path.rglob("*") if p.is_file()):
+        assert filecmp.cmp(path, DEFAULT_OUT / path.relative_to(tmp_path), shallow=False), path.name
+    record = get_asset("apple_scan")
+    assert record.entry.visual.endswith(".glb") and 0.07 < record.size_m[0] < 0.09
