@@ -38,7 +38,7 @@ from mani_skill.utils.structs import Actor, Articulation, Link, Pose
 from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
-from gendex_envs.assets.catalog import AssetRecord, asset_ids, get_asset, lowest_point_z
+from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, asset_ids, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.errors import ControlModeError, RewardModuleError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
@@ -152,7 +152,7 @@ class TaskEnv(BaseEnv):
         sx, sy = table.size_m
         b = self.scene.create_actor_builder()
         top = sapien.Pose(p=[0.0, 0.0, -0.025])
-        mat = sapien.physx.PhysxMaterial(table.friction, 0.8 * table.friction, 0.0)
+        mat = sapien.physx.PhysxMaterial(table.friction, DYNAMIC_FRICTION_RATIO * table.friction, 0.0)
         b.add_box_collision(top, [sx / 2, sy / 2, 0.025], material=mat)
         b.add_box_visual(top, [sx / 2, sy / 2, 0.025],
                          material=sapien.render.RenderMaterial(base_color=[0.72, 0.62, 0.5, 1.0], roughness=0.8))
@@ -410,7 +410,7 @@ class TaskEnv(BaseEnv):
             self._success_streak = torch.where(fresh, (self._success_streak + 1) * info["success"],
                                                self._success_streak)
             self._streak_counted_at = self.elapsed_steps.clone()
-            info["success"] = self._success_streak > hold
+            info["success"] = self._success_streak >= hold
         info["fail"] = info["fail"] & ~info["success"]
         return info
 

@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> None:
     logging.getLogger("trimesh").setLevel(logging.WARNING)
     entries = build(args.out)
     size = sum(f.stat().st_size for f in Path(args.out).rglob("*") if f.is_file())
-    print(f"wrote {len(entries)} objects to {args.out} ({size / 1e6:.2f} MB)")
+    log.info("wrote %d objects to %s (%.2f MB)", len(entries), args.out, size / 1e6)
 
 
 if __name__ == "__main__":

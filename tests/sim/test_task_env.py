@@ -115,3 +115,27 @@ def test_robot_starts_clear_of_the_scene(make_env, env_id):
                     if (c.bodies[0].entity.per_scene_id in robot) != (c.bodies[1].entity.per_scene_id in robot)
                     and min(p.separation for p in c.points) < 0.0]
         assert not touching, f"seed {seed}: robot penetrates {touching}"
+
+
+def test_success_must_hold_for_hold_steps():
+    """With success.hold_steps = 3 the task succeeds only on the third consecutive step the condition holds."""
+    import yaml
+
+    from gendex_envs.registry import REPO_TASKS_DIR
+    from gendex_envs.spec import parse_task_spec
+    from gendex_envs.task_env import TaskEnv
+
+    raw = yaml.safe_load((REPO_TASKS_DIR / "PutAppleBowl" / "v0" / "task.yaml").read_text())
+    raw["success"]["hold_steps"] = 3
+    env = TaskEnv(task_spec=parse_task_spec(raw), render_backend="none")
+    try:
+        env.reset(seed=0)
+        apple, bowl = env.obj("apple"), env.obj("bowl")
+        p = bowl.pose.p.clone()
+        p[:, 2] += 0.01
+        apple.set_pose(type(apple.pose).create_from_pq(p, apple.pose.q))
+        hold = env.agent.controller._target_qpos[:, env.agent.controller.free_idx].clone()
+        seen = [bool(env.step(hold)[4]["success"][0]) for _ in range(4)]
+        assert seen == [False, False, True, True], seen
+    finally:
+        env.close()
