@@ -239,6 +239,27 @@ class TaskEnv(BaseEnv):
             seed = seeds[0] if self.num_envs == 1 else seeds
         return super().reset(seed=seed, options=options)
 
+    def set_state_dict(self, state: dict, env_idx: torch.Tensor | None = None):
+        # ManiSkill restores actors and articulations only; frozen-joint and delta targets live in the controller
+        super().set_state_dict(state, env_idx)
+        if "controller" in state:
+            self.agent.set_controller_state(state["controller"])
+        self.agent.contacts.invalidate()
+
+    def set_state(self, state: torch.Tensor, env_idx: torch.Tensor | None = None):
+        """Restore a flat state from :meth:`get_state`, controller targets included (ManiSkill drops them)."""
+        state = torch.as_tensor(state, device=self.device)
+        sim_dim = 13 * len(self._init_raw_state["actors"]) + sum(
+            s.shape[-1] for s in self._init_raw_state["articulations"].values())
+        super().set_state(state[:, :sim_dim], env_idx)
+        tail = state[:, sim_dim:]
+        target = self.agent.controller._target_qpos
+        if tail.shape[-1] == target.shape[-1]:
+            self.agent.set_controller_state({"target_qpos": tail.clone()})
+        elif tail.shape[-1] != 0:
+            raise TaskSpecError(f"state has {tail.shape[-1]} values after the simulation state; expected 0 or "
+                                f"{target.shape[-1]} controller targets")
+
     def _after_simulation_step(self):
         self.agent.contacts.invalidate()
 

@@ -104,19 +104,7 @@ def set_flat_env_state(env: gym.Env, state: np.ndarray, layout: dict[str, slice]
     expected = max(s.stop for s in layout.values())
     if state.shape[0] != expected:
         raise EpisodeError(f"env state has {state.shape[0]} values; this env's state has {expected}")
-    tensor = torch.as_tensor(state, device=u.device)[None]
-    u.set_state(tensor)  # actors + articulations only
-    controller: dict = {}
-    for path, sl in layout.items():
-        if not path.startswith("controller/"):
-            continue
-        *parents, leaf = path.split("/")[1:]
-        node = controller
-        for p in parents:
-            node = node.setdefault(p, {})
-        node[leaf] = tensor[:, sl].clone()
-    if controller:
-        u.agent.set_controller_state(controller)
+    u.set_state(torch.as_tensor(state, device=u.device)[None])  # TaskEnv restores controller targets too
 
 
 def object_positions(env: gym.Env, state: np.ndarray | None = None,

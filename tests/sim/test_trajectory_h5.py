@@ -134,8 +134,11 @@ def test_set_flat_env_state_restores_controller_targets(env):
     saved = flat_env_state(env)
     for _ in range(3):
         env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
-    u.set_state(torch.as_tensor(saved)[None])  # ManiSkill's set_state restores the sim, not the controller
-    assert np.abs(flat_env_state(env)[ctrl] - saved[ctrl]).max() > 1e-3
+    assert np.abs(flat_env_state(env)[ctrl] - saved[ctrl]).max() > 1e-3  # the targets did move since
+    u.set_state(torch.as_tensor(saved)[None])  # ManiSkill's own set_state would drop the controller part
+    np.testing.assert_allclose(flat_env_state(env), saved, atol=1e-6)
+    for _ in range(2):
+        env.step(rng.uniform(-1, 1, env.action_space.shape).astype(np.float32))
     set_flat_env_state(env, saved, layout)
     np.testing.assert_allclose(flat_env_state(env), saved, atol=1e-6)
 
