@@ -126,6 +126,77 @@ def gallery(out: Path = typer.Option(Path("docs/assets"), "--out", help="Folder 
 
 
 @app.command()
+def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"),
+            num_success: int = typer.Option(..., "--num-success", min=1, help="Successful episodes to keep."),
+            out: Path = typer.Option(..., "--out", help="Dataset folder (resumes if it holds a collection)."),
+            fmt: str = typer.Option("lerobot", "--format", help="lerobot | h5 | both"),
+            cameras: str = typer.Option("", help="Comma-separated camera names to record (e.g. left_overhead)."),
+            workers: int = typer.Option(1, min=1, help="Parallel worker processes."),
+            seed: int = typer.Option(0, help="Attempt k resets with seed + k."),
+            solver: str = typer.Option("hold", help="Solver name."),
+            max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
+    """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
+    import json  # noqa: PLC0415
+
+    import gendex_envs  # noqa: F401, PLC0415
+    from tqdm import tqdm  # noqa: PLC0415
+
+    from gendex_envs.data.collector import SOLVERS, CollectConfig, collect as run_collect  # noqa: PLC0415
+    from gendex_envs.data.lerobot_v3 import write_dataset_card  # noqa: PLC0415
+    from gendex_envs.errors import GenDexError, suggest  # noqa: PLC0415
+    from gendex_envs.registry import task_entry  # noqa: PLC0415
+    from gendex_envs.spec import load_task_spec  # noqa: PLC0415
+
+    formats = {"lerobot": ("lerobot",), "h5": ("h5",), "both": ("lerobot", "h5")}
+    if fmt not in formats:
+        _die(ValueError(f"--format {fmt!r} is not one of {sorted(formats)}.{suggest(fmt, formats)}"))
+    if solver not in SOLVERS:
+        _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
+    if workers != 1:
+        _die(ValueError("--workers > 1 is not implemented yet; run several collections with different --seed and --out"))
+    cfg = CollectConfig(task_id=task_id, num_success=num_success, out=out, formats=formats[fmt],
+                        cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
+                        control_mode="pd_joint_delta_pos")
+    try:
+        spec = load_task_spec(task_entry(task_id).task_dir / "task.yaml")
+        with tqdm(total=num_success, desc="successes", unit="ep") as bar:
+            def progress(state):
+                bar.n = state.successes
+                bar.set_postfix(attempts=state.attempts, steps=state.env_steps)
+                bar.refresh()
+            state = run_collect(cfg, SOLVERS[solver], progress)
+        if "lerobot" in cfg.formats and state.successes:
+            info = json.loads((out / "lerobot" / "meta" / "info.json").read_text())
+            write_dataset_card(out / "lerobot", task_id=task_id, instruction=spec.instruction,
+                               robot="ShadowHand on UR10e (30 joints)", control_mode=cfg.control_mode,
+                               n_episodes=info["total_episodes"], n_frames=info["total_frames"],
+                               how_made=f"gendex collect with solver '{solver}', seeds {seed}..{seed + state.attempts - 1}")
+    except GenDexError as exc:
+        _die(exc)
+    typer.echo(f"{state.successes}/{state.attempts} attempts succeeded; {state.env_steps} env steps "
+               f"({state.env_steps_per_success:.0f} per success); output in {out}")
+
+
+@app.command()
+def replay(file: Path = typer.Argument(..., help="A trajectories .h5 file written by gendex collect.")) -> None:
+    """Re-simulate every episode of an HDF5 trajectory file and confirm its end state and success."""
+    from gendex_envs.data.trajectory_h5 import replay_file  # noqa: PLC0415
+    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+
+    try:
+        results = replay_file(file)
+    except GenDexError as exc:
+        _die(exc)
+    bad = 0
+    for r in results:
+        ok = r.reproduced()
+        bad += not ok
+        typer.echo(f"episode {r.episode_id}: {r.steps} steps, success {r.success_recorded} -> {r.success_replayed}, "
+                   f"max object error {1000 * r.max_object_pos_err_m:.3f} mm: {'OK' if ok else 'DIFFERS'}")
+    raise typer.Exit(code=1 if bad else 0)
+
+
+@app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for renders."),
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),
          seed: int = typer.Option(0, help="Seed of resets and random actions.")) -> None:

@@ -6,9 +6,8 @@ linear and angular velocity), the articulations (root pose and velocities, qpos,
 GenDex's controller always reports its drive targets (``controller/target_qpos``: frozen joints hold their target, and
 ``pd_joint_delta_pos`` adds each action to the previous target), so the vector holds everything an action's effect
 depends on except PhysX's internal caches (contacts, solver warm start) and the task's per-episode bookkeeping
-(reset positions, success streak, elapsed steps), which a reset with the recorded seed rebuilds. ManiSkill's
-``set_state`` (and ``set_state_dict``) restore only actors and articulations and drop the controller part;
-:func:`set_flat_env_state` restores both.
+(reset positions, success streak, elapsed steps), which a reset with the recorded seed rebuilds. ManiSkill's own
+``set_state`` drops the controller part; ``TaskEnv.set_state`` (used by :func:`set_flat_env_state`) restores it.
 """
 
 from __future__ import annotations
@@ -154,33 +153,66 @@ def env_info(env: gym.Env) -> dict:
     return dict(env_id=spec.id, env_kwargs=kwargs, max_episode_steps=max_episode_steps(env))
 
 
+class EpisodeRecorder:
+    """Record an episode step by step (closed-loop solvers): ``begin(seed)``, ``step(action)``..., ``episode()``."""
+
+    def __init__(self, env: gym.Env):
+        self.env = env
+        self._u = _base(env)
+
+    def begin(self, seed: int):
+        """Reset with ``seed`` and record the initial state; returns the reset's (obs, info)."""
+        out = self.env.reset(seed=int(seed))
+        self.seed = int(seed)
+        self._states, self._env_states = [robot_state(self.env)], [flat_env_state(self.env)]
+        self._actions, self._rewards, self._success, self._fail = [], [], [], []
+        return out
+
+    def step(self, action):
+        """Step ``action`` and record it; returns ``env.step``'s result."""
+        action = np.asarray(action, dtype=np.float32).reshape(self.env.action_space.shape[-1:])
+        out = self.env.step(action)
+        _, reward, _, _, step_info = out
+        self._actions.append(action.copy())
+        self._rewards.append(_scalar(reward))
+        self._success.append(bool(_scalar(step_info["success"])))
+        self._fail.append(bool(_scalar(step_info.get("fail", False))))
+        self._states.append(robot_state(self.env))
+        self._env_states.append(flat_env_state(self.env))
+        return out
+
+    @property
+    def steps(self) -> int:
+        return len(self._actions)
+
+    def episode(self, info: dict | None = None) -> Episode:
+        u = self._u
+        if not self._actions:
+            raise EpisodeError("an episode needs at least one action")
+        spec = self.env.spec if self.env.spec is not None else u.spec
+        return Episode(
+            task_id=spec.id if spec is not None else u.task_spec.name, instruction=u.task_spec.instruction,
+            seed=self.seed, control_mode=u.control_mode, control_joint=u.control_joint, fps=int(u.control_freq),
+            state=np.stack(self._states), action=np.stack(self._actions),
+            reward=np.asarray(self._rewards, dtype=np.float32), success=np.asarray(self._success, dtype=bool),
+            fail=np.asarray(self._fail, dtype=bool), env_states=np.stack(self._env_states),
+            reset_kwargs={"seed": self.seed}, info=dict(info or {}))
+
+
 def record_rollout(env: gym.Env, seed: int, actions: np.ndarray | Sequence, *, info: dict | None = None) -> Episode:
     """Reset ``env`` with ``seed``, step every action and return the :class:`Episode` (env states included).
 
     All actions are stepped, also after success or failure (ManiSkill envs do not auto-reset). ``env`` is a
     one-env GenDex env, with the Gymnasium (numpy) API or the batched one."""
-    u = _base(env)
     actions = np.asarray(actions, dtype=np.float32)
     shape = env.action_space.shape[-1:]
     if actions.ndim != 2 or actions.shape[1:] != shape or len(actions) == 0:
         raise EpisodeError(f"actions must be [T, {shape[0]}] with T >= 1, got {list(actions.shape)}")
-    env.reset(seed=int(seed))
-    states, env_states = [robot_state(env)], [flat_env_state(env)]
-    rewards, success, fail = [], [], []
+    recorder = EpisodeRecorder(env)
+    recorder.begin(seed)
     for a in actions:
-        _, reward, _, _, step_info = env.step(a)
-        rewards.append(_scalar(reward))
-        success.append(bool(_scalar(step_info["success"])))
-        fail.append(bool(_scalar(step_info.get("fail", False))))
-        states.append(robot_state(env))
-        env_states.append(flat_env_state(env))
-    spec = env.spec if env.spec is not None else u.spec
-    return Episode(
-        task_id=spec.id if spec is not None else u.task_spec.name, instruction=u.task_spec.instruction,
-        seed=int(seed), control_mode=u.control_mode, control_joint=u.control_joint, fps=int(u.control_freq),
-        state=np.stack(states), action=actions.copy(), reward=np.asarray(rewards, dtype=np.float32),
-        success=np.asarray(success, dtype=bool), fail=np.asarray(fail, dtype=bool),
-        env_states=np.stack(env_states), reset_kwargs={"seed": int(seed)}, info=dict(info or {}))
+        recorder.step(a)
+    return recorder.episode(info)
 
 
 def replay_rollout(env: gym.Env, actions: np.ndarray, env_states: np.ndarray, success: np.ndarray, *,

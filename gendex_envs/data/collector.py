@@ -1,0 +1,245 @@
+"""Collect successful episodes of a task with a solver and export them (LeRobot v3.0 and/or HDF5 + JSON).
+
+Only successful episodes are kept. Attempt ``k`` resets with seed ``base_seed + k``; GenDex envs are deterministic,
+so a collection is reproducible and resumable:
+
+* each exporter appends an episode atomically (see :mod:`~gendex_envs.data.lerobot_v3` and
+  :mod:`~gendex_envs.data.trajectory_h5`), then progress (attempts, env steps, kept seeds) is committed to
+  ``collect_state.json``;
+* on restart the collector continues after the last committed attempt. If it was killed after some exporter had
+  taken the next successful episode but before the commit, that attempt is re-run (same seed, same episode) and
+  given to the exporters that lack it, so every format ends with the same episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+import gymnasium as gym
+import numpy as np
+
+from gendex_envs.data.episode import Episode, EpisodeError
+from gendex_envs.data.rollout import EpisodeRecorder, env_info
+
+log = logging.getLogger(__name__)
+
+STATE_FILE = "collect_state.json"
+FORMATS = ("lerobot", "h5")
+
+
+class Solver(Protocol):
+    """Drives one episode: ``reset`` after the env reset, then ``act`` until it returns None or the episode ends."""
+
+    name: str
+
+    def reset(self, env: gym.Env, obs) -> None: ...
+
+    def act(self, env: gym.Env, obs) -> np.ndarray | None: ...
+
+
+@dataclass
+class HoldSolver:
+    """Baseline: holds every joint target for ``steps`` steps (succeeds only where the scene already does)."""
+
+    steps: int = 10
+    name: str = "hold"
+
+    def reset(self, env: gym.Env, obs) -> None:
+        self._left = self.steps
+
+    def act(self, env: gym.Env, obs) -> np.ndarray | None:
+        if self._left == 0:
+            return None
+        self._left -= 1
+        ctrl = env.unwrapped.agent.controller
+        if ctrl.config.use_delta:
+            return np.zeros(env.action_space.shape, dtype=np.float32)
+        return ctrl._target_qpos[0, ctrl.free_idx].cpu().numpy()
+
+
+@dataclass
+class RandomSolver:
+    """Baseline: uniform random actions for ``steps`` steps, seeded per episode from the env's RNG."""
+
+    steps: int = 50
+    name: str = "random"
+
+    def reset(self, env: gym.Env, obs) -> None:
+        self._left = self.steps
+        self._rng = np.random.default_rng(int(env.unwrapped.np_random.integers(2**31)))
+
+    def act(self, env: gym.Env, obs) -> np.ndarray | None:
+        if self._left == 0:
+            return None
+        self._left -= 1
+        space = env.action_space
+        return self._rng.uniform(space.low, space.high).astype(np.float32)
+
+
+SOLVERS: dict[str, Callable[[], Solver]] = {"hold": HoldSolver, "random": RandomSolver}
+"""Solvers available to ``gendex collect``; the task solvers (motion planning + grasping) register here too."""
+
+
+@dataclass(frozen=True)
+class CollectConfig:
+    task_id: str
+    num_success: int
+    out: Path
+    formats: tuple[str, ...] = ("lerobot",)
+    cameras: tuple[str, ...] = ()
+    seed: int = 0
+    max_attempts: int | None = None
+    """Stop after this many attempts even if ``num_success`` is not reached (default: 20 x num_success)."""
+    control_mode: str = "pd_joint_pos"
+    control_joint: str = "both"
+
+
+@dataclass
+class CollectState:
+    """Committed progress of a collection."""
+
+    task_id: str
+    seed: int
+    attempts: int = 0
+    env_steps: int = 0
+    kept_seeds: list[int] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def successes(self) -> int:
+        return len(self.kept_seeds)
+
+    @property
+    def env_steps_per_success(self) -> float:
+        return self.env_steps / self.successes if self.successes else float("inf")
+
+
+def _write_json_atomic(path: Path, data: dict) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    with os.fdopen(fd, "w") as f:
+        json.dump(data, f, indent=1)
+    os.replace(tmp, path)
+
+
+def _load_state(cfg: CollectConfig) -> CollectState:
+    path = cfg.out / STATE_FILE
+    if not path.is_file():
+        return CollectState(task_id=cfg.task_id, seed=cfg.seed)
+    raw = json.loads(path.read_text())
+    state = CollectState(**raw)
+    if (state.task_id, state.seed) != (cfg.task_id, cfg.seed):
+        raise EpisodeError(f"{path} belongs to a collection of {state.task_id} with seed {state.seed}; asked for "
+                           f"{cfg.task_id} with seed {cfg.seed} (use another --out or the same task and seed)")
+    return state
+
+
+def _open_exporters(cfg: CollectConfig, env: gym.Env, state: CollectState) -> dict[str, object]:
+    from gendex_envs.data.lerobot_v3 import LeRobotV3Writer  # noqa: PLC0415
+    from gendex_envs.data.trajectory_h5 import TrajectoryWriter  # noqa: PLC0415
+
+    unknown = [f for f in cfg.formats if f not in FORMATS]
+    if unknown:
+        raise EpisodeError(f"unknown formats {unknown}; allowed: {list(FORMATS)}")
+    u = env.unwrapped
+    names = [j.name for j in u.agent.robot.get_active_joints()]
+    writers: dict[str, object] = {}
+    if "lerobot" in cfg.formats:
+        action_names = list(u.agent.controller.free_joint_names)
+        res = u.sensor_resolution
+        writers["lerobot"] = LeRobotV3Writer(
+            cfg.out / "lerobot", fps=int(u.control_freq), robot_type="ur10e_shadowhand",
+            state_names=[f"{n}.pos" for n in names] + [f"{n}.vel" for n in names], action_names=action_names,
+            cameras={c: (res, res) for c in cfg.cameras} or None)
+    if "h5" in cfg.formats:
+        writers["h5"] = TrajectoryWriter(cfg.out / "trajectories", **env_info(env))
+    return writers
+
+
+def collect(cfg: CollectConfig, make_solver: Callable[[], Solver], progress: Callable[[CollectState], None] | None = None
+            ) -> CollectState:
+    """Run attempts until ``cfg.num_success`` episodes succeeded (or ``max_attempts``); returns the final state."""
+    import gendex_envs  # noqa: F401, PLC0415  (registers the task ids)
+
+    cfg.out.mkdir(parents=True, exist_ok=True)
+    state = _load_state(cfg)
+    obs_mode = "rgb" if cfg.cameras else "state"
+    env = gym.make(cfg.task_id, control_mode=cfg.control_mode, control_joint=cfg.control_joint, obs_mode=obs_mode)
+    writers = _open_exporters(cfg, env, state)
+    solver = make_solver()
+    limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
+    recorder = EpisodeRecorder(env)
+    try:
+        pending = {name: _exported(w) - state.successes for name, w in writers.items()}
+        if any(n < 0 or n > 1 for n in pending.values()):
+            raise EpisodeError(f"{cfg.out}: exported episode counts {dict((k, _exported(w)) for k, w in writers.items())}"
+                               f" do not match the {state.successes} committed in {STATE_FILE}")
+        while state.successes < cfg.num_success and state.attempts < limit:
+            seed = cfg.seed + state.attempts
+            t0 = time.perf_counter()
+            episode, images = _attempt(env, recorder, solver, seed, cfg.cameras)
+            if episode is not None and episode.succeeded:
+                episode.images.update(images)
+                episode.info.update(solver=solver.name, attempt=state.attempts)
+                for name, writer in writers.items():
+                    if pending.get(name, 0) > 0:  # this writer already took it before an interruption
+                        log.info("attempt %d (seed %d) was already exported to %s", state.attempts, seed, name)
+                        continue
+                    writer.add_episode(episode)
+                state.kept_seeds.append(seed)
+            elif any(pending.values()):
+                raise EpisodeError(f"attempt {state.attempts} (seed {seed}) was exported before an interruption but "
+                                   f"did not succeed when re-run: the solver or env is not deterministic")
+            pending = {}
+            state.attempts += 1
+            state.env_steps += recorder.steps
+            state.seconds += time.perf_counter() - t0
+            _write_json_atomic(cfg.out / STATE_FILE, asdict(state))
+            if progress is not None:
+                progress(state)
+    finally:
+        for writer in writers.values():
+            writer.close()
+        env.close()
+    return state
+
+
+def _exported(writer) -> int:
+    """Episodes an exporter holds."""
+    from gendex_envs.data.lerobot_v3 import LeRobotV3Writer  # noqa: PLC0415
+
+    return writer.total_episodes if isinstance(writer, LeRobotV3Writer) else len(writer)
+
+
+def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int, cameras: tuple[str, ...]
+             ) -> tuple[Episode | None, dict[str, np.ndarray]]:
+    obs, _ = recorder.begin(seed)
+    solver.reset(env, obs)
+    frames = {c: [_image(obs, c)] for c in cameras}
+    while True:
+        action = solver.act(env, obs)
+        if action is None:
+            break
+        obs, _, terminated, truncated, _ = recorder.step(action)
+        for c in cameras:
+            frames[c].append(_image(obs, c))
+        if terminated or truncated:
+            break
+    if recorder.steps == 0:
+        return None, {}
+    return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}
+
+
+def _image(obs, camera: str) -> np.ndarray:
+    try:
+        return np.asarray(obs["sensor_data"][camera]["rgb"])
+    except (KeyError, TypeError) as exc:
+        raise EpisodeError(f"camera {camera!r} is not in the observation; cameras: "
+                           f"{sorted(obs.get('sensor_data', {})) if isinstance(obs, dict) else []}") from exc

@@ -1,0 +1,91 @@
+"""Collector: keeps successful episodes only, resumes after interruption, formats agree, replay reproduces."""
+
+import json
+import shutil
+
+import gymnasium as gym
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+import gendex_envs.data.collector as collector
+from gendex.cli import app
+from gendex_envs.data.collector import CollectConfig, HoldSolver, collect
+from gendex_envs.registry import REPO_TASKS_DIR, register_tasks
+
+TASK = "GenDex/ScratchNear-v0"
+
+
+@pytest.fixture(scope="module")
+def near_task(tmp_path_factory):
+    """PutAppleBowl with success 'apple within 28 cm of the bowl': true for some reset seeds, false for others."""
+    root = tmp_path_factory.mktemp("tasks")
+    folder = root / "ScratchNear" / "v0"
+    shutil.copytree(REPO_TASKS_DIR / "PutAppleBowl" / "v0", folder)
+    raw = yaml.safe_load((folder / "task.yaml").read_text())
+    raw["name"] = "ScratchNear"
+    raw["success"] = {"description": "apple near the bowl",
+                      "conditions": [{"type": "near", "object": "apple", "target": "bowl", "max_dist_m": 0.28}]}
+    (folder / "task.yaml").write_text(yaml.safe_dump(raw))
+    register_tasks([root])
+    yield TASK
+    del gym.registry[TASK]
+
+
+def _cfg(out, **kw):
+    return CollectConfig(task_id=TASK, num_success=3, out=out, formats=("lerobot", "h5"), seed=0,
+                         control_mode="pd_joint_delta_pos", **kw)
+
+
+def _counts(out):
+    info = json.loads((out / "lerobot" / "meta" / "info.json").read_text())
+    rows = sum(pq.read_table(f).num_rows for f in (out / "lerobot" / "data").rglob("file-*.parquet"))
+    h5 = json.loads((out / "trajectories.json").read_text())
+    return info["total_episodes"], info["total_frames"], rows, len(h5["episodes"])
+
+
+def test_keeps_only_successes_and_formats_agree(near_task, tmp_path):
+    state = collect(_cfg(tmp_path / "a"), lambda: HoldSolver(steps=4))
+    assert state.successes == 3 and state.attempts > 3, "some seeds must fail the 'near' condition"
+    episodes, frames, rows, h5_episodes = _counts(tmp_path / "a")
+    # success terminates an episode: kept ones end at their first step, failed attempts run the solver's 4 steps
+    assert episodes == h5_episodes == 3 and frames == rows == 3
+    h5 = json.loads((tmp_path / "a" / "trajectories.json").read_text())
+    assert [e["episode_seed"] for e in h5["episodes"]] == state.kept_seeds
+    assert all(e["success"] for e in h5["episodes"])
+    assert state.env_steps == 4 * (state.attempts - 3) + 3
+
+
+def test_resume_after_kill_between_export_and_commit(near_task, tmp_path, monkeypatch):
+    """Killed after the exporters took an episode but before the state commit: resuming does not duplicate it."""
+    out = tmp_path / "b"
+    real_write = collector._write_json_atomic
+    calls = {"n": 0}
+
+    def dying_write(path, data):
+        if data["kept_seeds"] and len(data["kept_seeds"]) == 2 and calls["n"] == 0:
+            calls["n"] += 1
+            raise KeyboardInterrupt("killed")
+        real_write(path, data)
+
+    monkeypatch.setattr(collector, "_write_json_atomic", dying_write)
+    with pytest.raises(KeyboardInterrupt):
+        collect(_cfg(out), lambda: HoldSolver(steps=4))
+    assert _counts(out)[0] == 2  # the second success reached the exporters, the state says one
+    state = collect(_cfg(out), lambda: HoldSolver(steps=4))
+    episodes, frames, rows, h5_episodes = _counts(out)
+    assert state.successes == episodes == h5_episodes == 3 and frames == rows == 3
+    reference = collect(_cfg(tmp_path / "ref"), lambda: HoldSolver(steps=4))
+    assert state.kept_seeds == reference.kept_seeds and state.attempts == reference.attempts
+
+
+def test_cli_collect_then_replay(near_task, tmp_path):
+    out = tmp_path / "c"
+    result = CliRunner().invoke(app, ["collect", TASK, "--num-success", "2", "--out", str(out), "--format", "both"])
+    assert result.exit_code == 0, result.output
+    assert "2/" in result.output and (out / "lerobot" / "README.md").is_file()
+    replayed = CliRunner().invoke(app, ["replay", str(out / "trajectories.h5")])
+    assert replayed.exit_code == 0, replayed.output
+    assert replayed.output.count(": OK") == 2
