@@ -155,34 +155,26 @@ def test_articulated_joints_move_through_their_limits(articulated_scene, asset_i
 @pytest.mark.parametrize("asset_id", ARTICULATED)
 def test_handles_are_reachable_from_the_robot_base(asset_id):
     """With the asset at x = 0.45 m, the palm can be put 6 cm in front of each handle, facing it (IK)."""
-    from gendex_envs.agents.ur10e_shadow import ARM_JOINTS
+    from gendex_envs.solve.ik import ArmIK
 
     record = catalog()[asset_id]
     env = _make([{"name": "item", "asset": asset_id, "pos_m": [REACH_TEST_X, 0.0, 0.0], "fixed": True}])
     try:
-        model = env.agent.robot._objs[0].create_pinocchio_model()
-        names = [j.name for j in env.agent.robot.get_active_joints()]
-        links = [link.name for link in env.agent.robot.get_links()]
-        mask = np.array([n in ARM_JOINTS for n in names], dtype=np.int32)
-        base = env.agent.robot.pose.sp
+        ik = ArmIK(env.agent)
         q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
         for joint in record.joints:
             handle = env.handle_pos("item", joint.name)[0].numpy().astype(np.float64)
-            ok = False
+            found = None
             for roll in (0.0, math.pi / 2, -math.pi / 2):  # fingers up, then sideways
                 # palm axes in the world: normal (-y) along +x (towards the object), fingers (+z) up, rolled about x
                 c, s = math.cos(roll), math.sin(roll)
-                rot = np.array([[1, 0, 0], [0, c, -s], [0, s, c]]) @ PALM_FACING_X
                 pose_w = np.eye(4)
-                pose_w[:3, :3] = rot
+                pose_w[:3, :3] = np.array([[1, 0, 0], [0, c, -s], [0, s, c]]) @ PALM_FACING_X
                 pose_w[:3, 3] = handle - np.array([0.06, 0.0, 0.0])
-                goal = base.inv() * sapien.Pose(pose_w)
-                _, success, _ = model.compute_inverse_kinematics(links.index("palm"), goal, q0, mask,
-                                                                 max_iterations=300)
-                if success:
-                    ok = True
+                found = ik.solve(sapien.Pose(pose_w), q0, restarts=6)
+                if found is not None:
                     break
-            assert ok, f"{asset_id}: no IK solution to the handle of {joint.name} at {handle.round(3)}"
+            assert found is not None, f"{asset_id}: no IK solution to the handle of {joint.name} at {handle.round(3)}"
     finally:
         env.close()
 
