@@ -131,7 +131,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             out: Path = typer.Option(..., "--out", help="Dataset folder (resumes if it holds a collection)."),
             fmt: str = typer.Option("lerobot", "--format", help="lerobot | h5 | both"),
             cameras: str = typer.Option("", help="Comma-separated camera names to record (e.g. left_overhead)."),
-            workers: int = typer.Option(1, min=1, help="Parallel worker processes."),
+            workers: int = typer.Option(1, min=1, help="Worker processes running attempts (one env each)."),
             seed: int = typer.Option(0, help="Attempt k resets with seed + k."),
             solver: str = typer.Option("hold", help="Solver name."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
@@ -152,8 +152,6 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
         _die(ValueError(f"--format {fmt!r} is not one of {sorted(formats)}.{suggest(fmt, formats)}"))
     if solver not in SOLVERS:
         _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
-    if workers != 1:
-        _die(ValueError("--workers > 1 is not implemented yet; run several collections with different --seed and --out"))
     cfg = CollectConfig(task_id=task_id, num_success=num_success, out=out, formats=formats[fmt],
                         cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
                         control_mode="pd_joint_delta_pos")
@@ -164,7 +162,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
                 bar.n = state.successes
                 bar.set_postfix(attempts=state.attempts, steps=state.env_steps)
                 bar.refresh()
-            state = run_collect(cfg, SOLVERS[solver], progress)
+            state = run_collect(cfg, SOLVERS[solver], progress, workers=workers)
         if "lerobot" in cfg.formats and state.successes:
             info = json.loads((out / "lerobot" / "meta" / "info.json").read_text())
             write_dataset_card(out / "lerobot", task_id=task_id, instruction=spec.instruction,

@@ -163,51 +163,121 @@ def _open_exporters(cfg: CollectConfig, env: gym.Env, state: CollectState) -> di
     return writers
 
 
-def collect(cfg: CollectConfig, make_solver: Callable[[], Solver], progress: Callable[[CollectState], None] | None = None
-            ) -> CollectState:
-    """Run attempts until ``cfg.num_success`` episodes succeeded (or ``max_attempts``); returns the final state."""
-    import gendex_envs  # noqa: F401, PLC0415  (registers the task ids)
+@dataclass
+class AttemptResult:
+    """What one attempt produced (picklable, so worker processes can return it)."""
 
+    seed: int
+    episode: Episode | None
+    """The recorded episode when it succeeded, else None."""
+    steps: int
+    seconds: float
+
+
+def _make_env(cfg: CollectConfig) -> gym.Env:
+    obs_mode = "rgb" if cfg.cameras else "state"
+    return gym.make(cfg.task_id, control_mode=cfg.control_mode, control_joint=cfg.control_joint, obs_mode=obs_mode)
+
+
+class _Attempter:
+    """Runs attempts by seed with its own env and solver (in this process or in a worker)."""
+
+    def __init__(self, cfg: CollectConfig, make_solver: Callable[[], Solver]):
+        self.cfg = cfg
+        self.env = _make_env(cfg)
+        self.recorder = EpisodeRecorder(self.env)
+        self.solver = make_solver()
+
+    def __call__(self, seed: int) -> AttemptResult:
+        t0 = time.perf_counter()
+        episode, images = _attempt(self.env, self.recorder, self.solver, seed, self.cfg.cameras)
+        kept = None
+        if episode is not None and episode.succeeded:
+            episode.images.update(images)
+            episode.info.update(solver=self.solver.name)
+            kept = episode
+        return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0)
+
+
+_WORKER: _Attempter | None = None
+
+
+def _worker_init(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> None:
+    global _WORKER  # noqa: PLW0603  (one attempter per worker process)
+    import torch  # noqa: PLC0415
+
+    import gendex_envs  # noqa: F401, PLC0415
+    from gendex_envs.registry import register_tasks  # noqa: PLC0415
+
+    torch.set_num_threads(1)  # one process per core
+    if cfg.task_id not in gym.registry:  # a task registered at run time in the parent (e.g. a scratch root)
+        register_tasks([Path(task_root)])
+    _WORKER = _Attempter(cfg, make_solver)
+
+
+def _worker_attempt(seed: int) -> AttemptResult:
+    return _WORKER(seed)
+
+
+def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
+            progress: Callable[[CollectState], None] | None = None, workers: int = 1) -> CollectState:
+    """Run attempts until ``cfg.num_success`` episodes succeeded (or ``max_attempts``); returns the final state.
+
+    With ``workers > 1`` attempts run in that many processes (one env each); results are still committed in attempt
+    order, so the dataset is the same as with one worker.
+    """
+    import gendex_envs  # noqa: F401, PLC0415  (registers the task ids)
+    from gendex_envs.registry import task_entry  # noqa: PLC0415
+
+    if workers < 1:
+        raise EpisodeError(f"workers={workers}; allowed: 1 or more")
     cfg.out.mkdir(parents=True, exist_ok=True)
     state = _load_state(cfg)
-    obs_mode = "rgb" if cfg.cameras else "state"
-    env = gym.make(cfg.task_id, control_mode=cfg.control_mode, control_joint=cfg.control_joint, obs_mode=obs_mode)
-    writers = _open_exporters(cfg, env, state)
-    solver = make_solver()
     limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
-    recorder = EpisodeRecorder(env)
+    local = _Attempter(cfg, make_solver)
+    writers = _open_exporters(cfg, local.env, state)
+    pool = None
     try:
         pending = {name: _exported(w) - state.successes for name, w in writers.items()}
         if any(n < 0 or n > 1 for n in pending.values()):
             raise EpisodeError(f"{cfg.out}: exported episode counts {dict((k, _exported(w)) for k, w in writers.items())}"
                                f" do not match the {state.successes} committed in {STATE_FILE}")
-        while state.successes < cfg.num_success and state.attempts < limit:
-            seed = cfg.seed + state.attempts
-            t0 = time.perf_counter()
-            episode, images = _attempt(env, recorder, solver, seed, cfg.cameras)
-            if episode is not None and episode.succeeded:
-                episode.images.update(images)
-                episode.info.update(solver=solver.name, attempt=state.attempts)
+        seeds = (cfg.seed + k for k in range(state.attempts, limit))
+        if workers == 1:
+            results = map(local, seeds)
+        else:
+            import multiprocessing  # noqa: PLC0415
+
+            root = str(task_entry(cfg.task_id).task_dir.parent.parent)
+            pool = multiprocessing.get_context("spawn").Pool(workers, _worker_init, (cfg, make_solver, root))
+            results = pool.imap(_worker_attempt, seeds)  # in order, computed ahead in parallel
+        for result in results if state.successes < cfg.num_success else ():
+            if result.episode is not None:
+                result.episode.info.update(attempt=state.attempts)
                 for name, writer in writers.items():
                     if pending.get(name, 0) > 0:  # this writer already took it before an interruption
-                        log.info("attempt %d (seed %d) was already exported to %s", state.attempts, seed, name)
+                        log.info("attempt %d (seed %d) was already exported to %s", state.attempts, result.seed, name)
                         continue
-                    writer.add_episode(episode)
-                state.kept_seeds.append(seed)
+                    writer.add_episode(result.episode)
+                state.kept_seeds.append(result.seed)
             elif any(pending.values()):
-                raise EpisodeError(f"attempt {state.attempts} (seed {seed}) was exported before an interruption but "
-                                   f"did not succeed when re-run: the solver or env is not deterministic")
+                raise EpisodeError(f"attempt {state.attempts} (seed {result.seed}) was exported before an "
+                                   "interruption but did not succeed when re-run: the solver or env is not deterministic")
             pending = {}
             state.attempts += 1
-            state.env_steps += recorder.steps
-            state.seconds += time.perf_counter() - t0
+            state.env_steps += result.steps
+            state.seconds += result.seconds
             _write_json_atomic(cfg.out / STATE_FILE, asdict(state))
             if progress is not None:
                 progress(state)
+            if state.successes >= cfg.num_success:
+                break
     finally:
+        if pool is not None:
+            pool.terminate()
         for writer in writers.values():
             writer.close()
-        env.close()
+        local.env.close()
     return state
 
 

@@ -89,3 +89,10 @@ def test_cli_collect_then_replay(near_task, tmp_path):
     replayed = CliRunner().invoke(app, ["replay", str(out / "trajectories.h5")])
     assert replayed.exit_code == 0, replayed.output
     assert replayed.output.count(": OK") == 2
+
+
+def test_two_workers_give_the_same_dataset(near_task, tmp_path):
+    one = collect(_cfg(tmp_path / "w1"), HoldSolver)
+    two = collect(_cfg(tmp_path / "w2"), HoldSolver, workers=2)
+    assert two.kept_seeds == one.kept_seeds and two.attempts == one.attempts and two.env_steps == one.env_steps
+    assert _counts(tmp_path / "w2") == _counts(tmp_path / "w1")
