@@ -141,7 +141,7 @@ def _load_state(cfg: CollectConfig) -> CollectState:
     return state
 
 
-def _open_exporters(cfg: CollectConfig, env: gym.Env, state: CollectState) -> dict[str, object]:
+def _open_exporters(cfg: CollectConfig, env: gym.Env) -> dict[str, object]:
     from gendex_envs.data.lerobot_v3 import LeRobotV3Writer  # noqa: PLC0415
     from gendex_envs.data.trajectory_h5 import TrajectoryWriter  # noqa: PLC0415
 
@@ -235,7 +235,7 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
     state = _load_state(cfg)
     limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
     local = _Attempter(cfg, make_solver)
-    writers = _open_exporters(cfg, local.env, state)
+    writers = _open_exporters(cfg, local.env)
     pool = None
     try:
         pending = {name: _exported(w) - state.successes for name, w in writers.items()}

@@ -4,7 +4,6 @@ import json
 import shutil
 
 import gymnasium as gym
-import numpy as np
 import pyarrow.parquet as pq
 import pytest
 import yaml

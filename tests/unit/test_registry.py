@@ -1,7 +1,6 @@
 """Task discovery and registration into a scratch registry, and the errors of bad task folders."""
 
 import shutil
-from pathlib import Path
 
 import gymnasium as gym
 import pytest
