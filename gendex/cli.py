@@ -133,7 +133,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             cameras: str = typer.Option("", help="Comma-separated camera names to record (e.g. left_overhead)."),
             workers: int = typer.Option(1, min=1, help="Worker processes running attempts (one env each)."),
             seed: int = typer.Option(0, help="Attempt k resets with seed + k."),
-            solver: str = typer.Option("hold", help="Solver name."),
+            solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
     """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
     import json  # noqa: PLC0415
@@ -141,7 +141,8 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
     import gendex_envs  # noqa: F401, PLC0415
     from tqdm import tqdm  # noqa: PLC0415
 
-    from gendex_envs.data.collector import SOLVERS, CollectConfig, collect as run_collect  # noqa: PLC0415
+    from gendex_envs.data.collector import (SOLVER_CONTROL_MODES, SOLVERS, CollectConfig,  # noqa: PLC0415
+                                            collect as run_collect)
     from gendex_envs.data.lerobot_v3 import write_dataset_card  # noqa: PLC0415
     from gendex_envs.errors import GenDexError, suggest  # noqa: PLC0415
     from gendex_envs.registry import task_entry  # noqa: PLC0415
@@ -154,7 +155,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
         _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
     cfg = CollectConfig(task_id=task_id, num_success=num_success, out=out, formats=formats[fmt],
                         cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
-                        control_mode="pd_joint_delta_pos")
+                        control_mode=SOLVER_CONTROL_MODES.get(solver, "pd_joint_pos"))
     try:
         spec = load_task_spec(task_entry(task_id).task_dir / "task.yaml")
         with tqdm(total=num_success, desc="successes", unit="ep") as bar:

@@ -64,7 +64,7 @@ class RobotSpec:
 
     uid: RobotUid = "ur10e_shadow"
     """Robot id; one of ROBOT_UIDS."""
-    base_pos_m: tuple[float, float, float] = (-0.5, 0.0, 0.0)
+    base_pos_m: tuple[float, float, float] = (-0.8, 0.0, 0.0)
     """World position of the arm base (m)."""
     base_yaw_deg: float = 0.0
     """Rotation of the arm base about world z (degrees)."""

@@ -105,8 +105,10 @@ DELTA_LIMIT_RAD = {"arm": 0.05, "hand": 0.1}
 """Per-control-step bound of ``pd_joint_delta_pos`` actions, for arm and hand joints."""
 
 # Keyframes, by joint name (coupled distal joints equal their leader).
-_REST_ARM = (2.022, -0.994, 3.017, 1.118, -0.451, -3.142)
-"""Elbow up, palm facing the table 0.30 m above it at x = 0.10 m, fingers pointing +x (found by IK)."""
+_REST_ARM = (2.683, -1.71, 2.408, -0.699, 1.112, 0.0)
+"""Elbow and wrist up, palm facing the table 0.30 m above it 0.80 m in front of the base, fingers pointing away from
+the base (found by IK). The wrist-up branch keeps the UR wrist links above the hand when it reaches down to the table;
+the wrist-down branch drives them into the table top."""
 _OPEN_HAND = {j: 0.0 for j in HAND_JOINTS}
 _RELAXED_HAND = _OPEN_HAND | {"FFJ2": 0.3, "FFJ1": 0.3, "FFJ0": 0.3, "MFJ2": 0.3, "MFJ1": 0.3, "MFJ0": 0.3,
                               "RFJ2": 0.3, "RFJ1": 0.3, "RFJ0": 0.3, "LFJ2": 0.3, "LFJ1": 0.3, "LFJ0": 0.3,

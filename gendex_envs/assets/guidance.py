@@ -52,5 +52,5 @@ def guidance_text() -> str:
         base = "fixed" if r.entry.fixed_base else "free"
         lines.append(f"- {r.id} | {r.category} | {_cm(r.size_m)} | {base} | {joints}")
     lines += ["", "Sizes are real-world at scale 1; a scale in [0.3, 2.0] multiplies every dimension. The table top is "
-                  "z = 0; the robot base stands at (-0.5, 0, 0) facing +x; fronts of articulated objects face -x."]
+                  "z = 0; the robot base stands at (-0.8, 0, 0) facing +x; fronts of articulated objects face -x."]
     return "\n".join(lines)

@@ -28,6 +28,7 @@ import numpy as np
 
 from gendex_envs.data.episode import Episode, EpisodeError
 from gendex_envs.data.rollout import EpisodeRecorder, env_info
+from gendex_envs.solve.executor import make_stage_executor
 
 log = logging.getLogger(__name__)
 
@@ -84,8 +85,12 @@ class RandomSolver:
         return self._rng.uniform(space.low, space.high).astype(np.float32)
 
 
-SOLVERS: dict[str, Callable[[], Solver]] = {"hold": HoldSolver, "random": RandomSolver}
-"""Solvers available to ``gendex collect``; the task solvers (motion planning + grasping) register here too."""
+SOLVERS: dict[str, Callable[[], Solver]] = {"stages": make_stage_executor, "hold": HoldSolver, "random": RandomSolver}
+"""Solvers available to ``gendex collect``: ``stages`` runs the task's stages (motion planning + synthesized grasps,
+:mod:`gendex_envs.solve.executor`); ``hold`` and ``random`` are baselines."""
+SOLVER_CONTROL_MODES: dict[str, str] = {"stages": "pd_joint_pos", "hold": "pd_joint_delta_pos",
+                                        "random": "pd_joint_delta_pos"}
+"""Control mode each solver's actions are meant for (the stage executor emits absolute joint targets)."""
 
 
 @dataclass(frozen=True)

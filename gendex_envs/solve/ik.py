@@ -9,6 +9,7 @@ env on the CPU (like ManiSkill's motion-planning solutions); inputs and outputs 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 import numpy as np
 import sapien
@@ -50,11 +51,13 @@ class ArmIK:
         return bool(np.all(q[self.arm] >= lo - 1e-6) and np.all(q[self.arm] <= hi + 1e-6))
 
     def solve(self, target: sapien.Pose, q_start: np.ndarray, link: str = "palm", restarts: int = 12, seed: int = 0,
-              pos_tol_m: float = 1e-3, rot_tol_rad: float = 1e-2) -> np.ndarray | None:
+              pos_tol_m: float = 1e-3, rot_tol_rad: float = 1e-2,
+              valid: Callable[[np.ndarray], bool] | None = None) -> np.ndarray | None:
         """Arm joint positions putting ``link`` at world pose ``target``; hand joints keep ``q_start``'s values.
 
-        Tries from ``q_start`` first, then from seeded random arm configurations; among the valid answers returns
-        the one nearest ``q_start`` (joint-space distance), or None when no start converges within the limits.
+        Tries from ``q_start`` first, then from seeded random arm configurations; among the answers that are within
+        the limits and pass ``valid`` (e.g. a collision check) returns the one nearest ``q_start`` (joint-space
+        distance), or None when none does.
         """
         q_start = np.asarray(q_start, dtype=np.float64)
         goal = self.base.inv() * target
@@ -64,10 +67,13 @@ class ArmIK:
         for attempt in range(restarts + 1):
             init = q_start.copy()
             if attempt:
-                init[self.arm] = rng.uniform(self.limits[self.arm, 0] / 2, self.limits[self.arm, 1] / 2)
+                init[self.arm] = q_start[self.arm] + rng.uniform(-np.pi, np.pi, len(self.arm))
+                init[self.arm] = np.clip(init[self.arm], self.limits[self.arm, 0], self.limits[self.arm, 1])
             q, _, _ = self.model.compute_inverse_kinematics(idx, goal, init, self.mask, max_iterations=300)
             q = self._wrap(np.asarray(q, dtype=np.float64), q_start)
             if not self._within_limits(q) or not self._close(self.fk(q, link), target, pos_tol_m, rot_tol_rad):
+                continue
+            if valid is not None and not valid(q):
                 continue
             dist = float(np.linalg.norm(q[self.arm] - q_start[self.arm]))
             if dist < best_dist:

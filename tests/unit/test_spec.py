@@ -112,7 +112,7 @@ def test_example_loads_with_defaults(tmp_path: Path) -> None:
     assert spec.object("bowl").color_rgba == (0.9, 0.9, 0.9, 1.0)
     assert spec.table.friction == 0.8
     assert spec.robot.uid == "ur10e_shadow" and spec.robot.init_keyframe == "pregrasp_open"
-    assert spec.robot.base_pos_m == (-0.5, 0.0, 0.0)
+    assert spec.robot.base_pos_m == (-0.8, 0.0, 0.0)
     assert spec.goal is None
     assert [s.horizon for s in spec.stages] == [60, 100, 100, 40]
     assert spec.stages[3].target is None
