@@ -136,14 +136,11 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
     """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
-    import json  # noqa: PLC0415
-
     import gendex_envs  # noqa: F401, PLC0415
     from tqdm import tqdm  # noqa: PLC0415
 
     from gendex_envs.data.collector import (SOLVER_CONTROL_MODES, SOLVERS, CollectConfig,  # noqa: PLC0415
                                             collect as run_collect)
-    from gendex_envs.data.lerobot_v3 import write_dataset_card  # noqa: PLC0415
     from gendex_envs.errors import GenDexError, suggest  # noqa: PLC0415
     from gendex_envs.registry import task_entry  # noqa: PLC0415
     from gendex_envs.spec import load_task_spec  # noqa: PLC0415
@@ -165,15 +162,24 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
                 bar.refresh()
             state = run_collect(cfg, SOLVERS[solver], progress, workers=workers)
         if "lerobot" in cfg.formats and state.successes:
-            info = json.loads((out / "lerobot" / "meta" / "info.json").read_text())
-            write_dataset_card(out / "lerobot", task_id=task_id, instruction=spec.instruction,
-                               robot="ShadowHand on UR10e (30 joints)", control_mode=cfg.control_mode,
-                               n_episodes=info["total_episodes"], n_frames=info["total_frames"],
-                               how_made=f"gendex collect with solver '{solver}', seeds {seed}..{seed + state.attempts - 1}")
+            _write_card(cfg, spec.instruction, solver, state)
     except GenDexError as exc:
         _die(exc)
     typer.echo(f"{state.successes}/{state.attempts} attempts succeeded; {state.env_steps} env steps "
                f"({state.env_steps_per_success:.0f} per success); output in {out}")
+
+
+def _write_card(cfg, instruction: str, solver: str, state) -> None:
+    import json  # noqa: PLC0415
+
+    from gendex_envs.data.lerobot_v3 import write_dataset_card  # noqa: PLC0415
+
+    root = cfg.out / "lerobot"
+    info = json.loads((root / "meta" / "info.json").read_text())
+    write_dataset_card(root, task_id=cfg.task_id, instruction=instruction, robot="ShadowHand on UR10e (30 joints)",
+                       control_mode=cfg.control_mode, n_episodes=info["total_episodes"],
+                       n_frames=info["total_frames"],
+                       how_made=f"gendex collect with solver '{solver}', seeds {cfg.seed}..{cfg.seed + state.attempts - 1}")
 
 
 @app.command()
@@ -198,8 +204,12 @@ def replay(file: Path = typer.Argument(..., help="A trajectories .h5 file writte
 @app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for renders."),
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),
-         seed: int = typer.Option(0, help="Seed of resets and random actions.")) -> None:
-    """The main job on embedded defaults: build every task, render its views, roll out random actions."""
+         seed: int = typer.Option(0, help="Seed of resets and random actions."),
+         collect_n: int = typer.Option(3, "--collect", min=0,
+                                       help="Successful PutAppleBowl episodes to collect into a LeRobot dataset.")
+         ) -> None:
+    """The main job on embedded defaults: build every task, render its views, roll out random actions, then collect
+    a few successful PutAppleBowl episodes with the stage executor into a LeRobot v3.0 dataset."""
     import gymnasium as gym  # noqa: PLC0415
     import numpy as np  # noqa: PLC0415
     from tqdm import tqdm  # noqa: PLC0415
@@ -229,6 +239,25 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
                    f"mean reward {mean_r:.3f}")
         for name, path in paths.items():
             typer.echo(f"      {name:15s} {path}")
+    if collect_n:
+        _demo_collect(out / "PutAppleBowl_dataset", collect_n, seed)
+
+
+def _demo_collect(out: Path, n: int, seed: int) -> None:
+    from gendex_envs.data.collector import SOLVERS, CollectConfig, collect as run_collect  # noqa: PLC0415
+    from gendex_envs.registry import task_entry  # noqa: PLC0415
+    from gendex_envs.spec import load_task_spec  # noqa: PLC0415
+
+    task_id = "GenDex/PutAppleBowl-v0"
+    cfg = CollectConfig(task_id=task_id, num_success=n, out=out, formats=("lerobot",), seed=seed,
+                        max_attempts=5 * n, control_mode="pd_joint_pos")
+    state = run_collect(cfg, SOLVERS["stages"])
+    if state.successes:
+        _write_card(cfg, load_task_spec(task_entry(task_id).task_dir / "task.yaml").instruction, "stages", state)
+    typer.echo(f"\nCollected {state.successes}/{state.attempts} successful {task_id} episodes "
+               f"({state.env_steps_per_success:.0f} env steps per success) into the LeRobot dataset {out / 'lerobot'}")
+    if state.successes < n:
+        raise typer.Exit(code=1)
 
 
 def main() -> None:

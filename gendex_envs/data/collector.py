@@ -28,7 +28,7 @@ import numpy as np
 
 from gendex_envs.data.episode import Episode, EpisodeError
 from gendex_envs.data.rollout import EpisodeRecorder, env_info
-from gendex_envs.solve.executor import make_stage_executor
+from gendex_envs.solve.executor import ExecutionError, make_stage_executor
 
 log = logging.getLogger(__name__)
 
@@ -299,7 +299,11 @@ def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int,
     solver.reset(env, obs)
     frames = {c: [_image(obs, c)] for c in cameras}
     while True:
-        action = solver.act(env, obs)
+        try:
+            action = solver.act(env, obs)
+        except ExecutionError as exc:  # the solver gave up on this attempt: a failed attempt, not a crash
+            log.warning("attempt with seed %d: %s", seed, exc)
+            break
         if action is None:
             break
         obs, _, terminated, truncated, _ = recorder.step(action)

@@ -35,7 +35,7 @@ import sapien
 
 from gendex_envs.errors import GenDexError
 from gendex_envs.solve.collision import ArmCollisionModel, Box
-from gendex_envs.solve.grasp import (FINGER_FLEX_JOINTS, GUARD_RAD, OPEN_HAND, GraspPlan, grasp_candidates)
+from gendex_envs.solve.grasp import GUARD_RAD, OPEN_HAND, GraspPlan, grasp_candidates
 from gendex_envs.solve.ik import ArmIK
 from gendex_envs.solve.planner import ArmPlanner, PlanningError
 
@@ -281,8 +281,8 @@ class StageExecutor:
         c = self.config
         held, target = self.held, stage.target
         held_lo, held_hi = self._world_aabb(held)
-        t_center, _, t_height, _ = self._obj_geometry(target)
-        t_lo, t_hi = self._world_aabb(target)
+        t_center = self._obj_geometry(target)[0]
+        t_hi = self._world_aabb(target)[1]
         obj_p = (held_lo + held_hi) / 2
         goal_center = np.array([t_center[0], t_center[1], t_hi[2] + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
         offset = goal_center - obj_p
@@ -306,5 +306,4 @@ def make_stage_executor() -> StageExecutor:
     return StageExecutor()
 
 
-__all__ = ["ExecutionError", "ExecutorConfig", "StageExecutor", "StageLog", "make_stage_executor",
-           "FINGER_FLEX_JOINTS"]
+__all__ = ["ExecutionError", "ExecutorConfig", "StageExecutor", "StageLog", "make_stage_executor"]

@@ -9,6 +9,7 @@ more than ``max_step_rad`` apart, so a position-controlled arm tracks it closely
 from __future__ import annotations
 
 import logging
+from itertools import pairwise
 
 import numpy as np
 
@@ -62,7 +63,7 @@ class ArmPlanner:
 
     def _densify(self, path: list[np.ndarray]) -> np.ndarray:
         out = []
-        for a, b in zip(path[:-1], path[1:]):
+        for a, b in pairwise(path):
             n = max(1, int(np.ceil(np.max(np.abs(b - a)) / self.max_step_rad)))
             out.extend(a + (b - a) * k / n for k in range(1, n + 1))
         return np.asarray(out)
@@ -76,7 +77,6 @@ class ArmPlanner:
             raise PlanningError("the straight motion is blocked and OMPL is not importable "
                                 "(pip install ompl)") from e
         ou.setLogLevel(ou.LOG_WARN)
-        ou.RNG.setSeed(self.seed) if hasattr(ou, "RNG") else None
         arm = self.ik.arm
         lo, hi = self.ik.limits[arm, 0], self.ik.limits[arm, 1]
         space = ob.RealVectorStateSpace(len(arm))

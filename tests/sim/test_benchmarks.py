@@ -18,3 +18,12 @@ def test_step_rate_benchmark_runs_and_builds_an_equivalent_scene(task):
     bodies = re.search(r"bodies \(dynamic, static, links\): env (\(.*?\))\s+raw (\(.*?\))", out.stdout)
     assert bodies and bodies.group(1) == bodies.group(2), out.stdout
     assert re.search(r"ratio env / raw\s+\d+\.\d+", out.stdout), out.stdout
+
+
+def test_collect_benchmark_reports_success_rate_and_steps_per_success():
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "collect.py"), "--tasks", "GenDex/PutAppleBowl-v0",
+                          "--episodes", "3", "--workers-trial", "0"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    m = re.search(r"PutAppleBowl-v0: (\d+)/3 succeeded .*?([\d.]+) env steps per success", out.stdout)
+    assert m, out.stdout
+    assert int(m.group(1)) == 3 and 0 < float(m.group(2)) < 200, out.stdout

@@ -1,0 +1,131 @@
+"""Collision model, planner, grasp synthesis and the stage executor, on the simulated robot."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import gendex_envs  # noqa: F401
+from gendex_envs.solve.collision import ArmCollisionModel, Box
+from gendex_envs.solve.executor import ExecutionError, StageExecutor
+from gendex_envs.solve.grasp import grasp_candidates
+from gendex_envs.solve.ik import ArmIK
+from gendex_envs.solve.planner import ArmPlanner, PlanningError
+
+CONTROL_HZ = 20
+
+
+@pytest.fixture(scope="module")
+def apple_env():
+    env = gym.make("GenDex/PutAppleBowl-v0", control_mode="pd_joint_pos", control_joint="both")
+    yield env
+    env.close()
+
+
+def _run_stages(env, seed, executor, stop_after=None):
+    """Run the executor; with ``stop_after`` stop once that many stages have started and finished."""
+    obs, _ = env.reset(seed=seed)
+    executor.reset(env, obs)
+    info = {}
+    while True:
+        if stop_after is not None and len(executor.logs) > stop_after:
+            break
+        action = executor.act(env, obs)
+        if action is None:
+            break
+        obs, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
+    return info
+
+
+def test_collision_model_separates_rest_from_table_contact(apple_env):
+    env = apple_env.unwrapped
+    apple_env.reset(seed=0)
+    ik = ArmIK(env.agent)
+    model = ArmCollisionModel(ik)
+    q = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
+    assert model.is_free(q)
+    low = q.copy()
+    low[ik.arm[1]] += 0.9  # swing the shoulder down: the forearm goes through the table top
+    assert model.clearance(low) < 0 and not model.is_free(low)
+    # a box around the wrist makes the rest configuration collide
+    centres, _ = model.sphere_centres(q)
+    model.set_obstacles([Box(centres[-1] - 0.02, centres[-1] + 0.02, "probe")])
+    assert not model.is_free(q)
+
+
+def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
+    env = apple_env.unwrapped
+    apple_env.reset(seed=0)
+    ik = ArmIK(env.agent)
+    model = ArmCollisionModel(ik)
+    planner = ArmPlanner(model, time_limit_s=5.0)
+    q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
+    q1 = q0.copy()
+    q1[ik.arm[0]] += 1.2  # pan the arm sideways
+    mid = q0.copy()
+    mid[ik.arm[0]] += 0.6
+    centres, _ = model.sphere_centres(mid)
+    wrist = centres[-1]
+    model.set_obstacles([Box(wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08], "pillar")])
+    assert model.is_free(q0) and model.is_free(q1)
+    assert not planner.segment_free(q0, q1)
+    path = planner.plan(q0, q1)
+    assert np.allclose(path[-1][ik.arm], q1[ik.arm])
+    assert all(model.is_free(q) for q in path)
+    steps = np.abs(np.diff(np.vstack([q0, path])[:, ik.arm], axis=0)).max()
+    assert steps <= planner.max_step_rad + 1e-9
+    # a goal inside the obstacle is refused with the named error
+    with pytest.raises(PlanningError, match="goal configuration in collision"):
+        planner.plan(q0, mid)
+
+
+def test_grasp_candidates_follow_the_object_geometry():
+    tall = grasp_candidates(np.array([0.1, 0.0]), 0.0, 0.22, 0.033)
+    short = grasp_candidates(np.array([0.1, 0.0]), 0.0, 0.07, 0.038)
+    assert {g.kind for g in tall} == {"side"} and {g.kind for g in short} == {"top"}
+    for g in short:
+        # palm skin touching the top, object centre under the palm, approach straight down
+        assert g.palm.p[2] == pytest.approx(0.07 + 0.011)
+        assert np.allclose(g.approach, [0, 0, -1])
+        assert np.linalg.norm(g.palm.p[:2] - [0.1, 0.0]) == pytest.approx(0.075)
+
+
+@pytest.mark.parametrize("seed", [0, 7])
+def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed):
+    env = apple_env.unwrapped
+    executor = StageExecutor()
+    _run_stages(apple_env, seed, executor, stop_after=2)  # reach_apple + grasp_apple (closing and lifting)
+    assert [log.primitive for log in executor.logs[:2]] == ["approach", "grasp"]
+    hold = env.agent.controller._target_qpos[0, executor._free].numpy()
+    for _ in range(2 * CONTROL_HZ):
+        apple_env.step(hold)
+    assert float(env.obj_height("apple")[0]) >= 0.10
+    assert bool(env.agent.is_grasping(env.obj("apple"))[0])
+
+
+def test_stage_executor_solves_put_apple_bowl(apple_env):
+    wins = [bool(_run_stages(apple_env, seed, StageExecutor()).get("success", False)) for seed in range(100, 103)]
+    assert all(wins)
+
+
+def test_stage_executor_refuses_a_stage_it_cannot_script():
+    env = gym.make("GenDex/OpenCabinet-v0", control_mode="pd_joint_pos", control_joint="both")
+    try:
+        obs, _ = env.reset(seed=0)
+        executor = StageExecutor()
+        executor.reset(env, obs)
+        with pytest.raises(ExecutionError, match="articulated"):
+            executor.act(env, obs)
+    finally:
+        env.close()
+
+
+def test_stage_executor_requires_absolute_targets():
+    env = gym.make("GenDex/PutAppleBowl-v0", control_mode="pd_joint_delta_pos")
+    try:
+        obs, _ = env.reset(seed=0)
+        with pytest.raises(ExecutionError, match="pd_joint_pos"):
+            StageExecutor().reset(env, obs)
+    finally:
+        env.close()
