@@ -16,8 +16,8 @@ RL                     hand holds the target                        ``release`` 
                                                                     somewhere, else ``lift`` to the success height
 =====================  ===========================================  ==============================================
 
-RL stages use a trained policy when the task folder has one (``policies/<stage>.zip``, issue 6); until then the
-scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
+RL stages are meant to run a trained policy from the task folder (``policies/<stage>.zip``, issue 6); until
+policies can run, the scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
 absolute joint targets for the ``pd_joint_pos`` / ``both`` action space, one control step at a time, and re-reads
 the object poses between primitives (grasps are planned from the actual pose, never from the nominal one).
 """
@@ -94,6 +94,7 @@ class StageExecutor:
         self.held: str | None = None
         self.carried = False
         self.logs: list[StageLog] = []
+        self._plan: GraspPlan | None = None
         self._actions = self._episode()
 
     def act(self, env: gym.Env, obs) -> np.ndarray | None:
@@ -192,7 +193,8 @@ class StageExecutor:
             self.logs.append(StageLog(stage.name, prim, "scripted" if policy is None else str(policy)))
             if stage.method == "RL":
                 log.info("stage %r (RL, %s): %s", stage.name, stage.control_joint,
-                         f"trained policy {policy}" if policy else f"no trained policy; scripted primitive {prim!r}")
+                         f"policy {policy} found, but running policies lands with `gendex train` (issue 6); "
+                         f"scripted primitive {prim!r}" if policy else f"no trained policy; scripted primitive {prim!r}")
             else:
                 log.info("stage %r (motion planning): primitive %r", stage.name, prim)
             yield from getattr(self, "_" + prim)(stage)
@@ -251,7 +253,7 @@ class StageExecutor:
             yield self._emit(self._target())
 
     def _grasp(self, stage) -> Iterator[np.ndarray]:
-        plan = getattr(self, "_plan", None)
+        plan = self._plan
         if plan is None:
             raise ExecutionError(f"stage {stage.name!r} grasps {stage.target!r} but no stage approached it")
         c = self.config
@@ -265,8 +267,9 @@ class StageExecutor:
         yield from self._cartesian(np.array([0.0, 0.0, c.lift_m]), c.lift_m_per_step, guard=True)
         risen = float(self._env.obj(stage.target).pose.p[0, 2]) - z0
         if risen < 0.5 * c.lift_m:
-            log.info("grasp of %r failed its lift check (rose %.3f m of %.3f m)", stage.target, risen, c.lift_m)
             self.held = None
+            raise ExecutionError(f"grasp of {stage.target!r} failed its lift check (rose {risen:.3f} m of "
+                                 f"{c.lift_m:.3f} m)")
 
     def _lift(self, stage) -> Iterator[np.ndarray]:
         c = self.config
