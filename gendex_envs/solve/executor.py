@@ -273,9 +273,9 @@ class StageExecutor:
 
     def _lift(self, stage) -> Iterator[np.ndarray]:
         c = self.config
-        need = max((cond.min_height_m or 0.0) for cond in self._env.task_spec.success.conditions
-                   if cond.type == "lifted" and cond.object == stage.target) if any(
-            cond.type == "lifted" for cond in self._env.task_spec.success.conditions) else c.lift_m
+        heights = [cond.min_height_m for cond in self._env.task_spec.success.conditions
+                   if cond.type == "lifted" and cond.object == stage.target]
+        need = max(heights) if heights else c.lift_m
         risen = float(self._env.obj_height(stage.target)[0])
         if risen < need + 0.02:
             yield from self._cartesian(np.array([0.0, 0.0, need + 0.03 - risen]), c.lift_m_per_step, guard=True)
