@@ -1,0 +1,83 @@
+"""The backend interface: a :class:`ModelRequest` (text, optional images) in, a :class:`ModelResponse` out.
+
+Stages render a prompt template into ``prompt`` and put the typed inputs the prompt was made from into
+``context`` (JSON-able). Language-model backends send ``system``, ``prompt`` and ``images`` and ignore ``context``;
+the offline backend answers from ``context`` alone. Both answer in the same text format, so every answer goes
+through the same parser and validator.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+STAGES = ("propose", "propose_guided", "scene", "judge", "analyze", "plan", "reward")
+"""Request kinds; the offline backend dispatches on them, transcripts record them."""
+
+
+@dataclass(frozen=True)
+class ImagePart:
+    """One PNG image sent with a request (e.g. a rendered view)."""
+
+    name: str
+    png: bytes
+
+    def b64(self) -> str:
+        return base64.b64encode(self.png).decode("ascii")
+
+
+@dataclass(frozen=True)
+class ModelRequest:
+    """One request to a backend."""
+
+    stage: str
+    """One of STAGES."""
+    prompt: str
+    """The rendered user prompt."""
+    system: str = ""
+    images: tuple[ImagePart, ...] = ()
+    temperature: float = 0.3
+    max_tokens: int = 4096
+    context: dict[str, Any] = field(default_factory=dict)
+    """Structured inputs the prompt was rendered from (JSON-able); used by the offline backend only."""
+
+    def __post_init__(self) -> None:
+        if self.stage not in STAGES:
+            raise ValueError(f"unknown request stage {self.stage!r}; allowed: {', '.join(STAGES)}")
+
+    def digest(self) -> str:
+        """SHA-256 over everything that defines the request (replay checks it)."""
+        h = hashlib.sha256()
+        head = {"stage": self.stage, "system": self.system, "prompt": self.prompt, "temperature": self.temperature,
+                "max_tokens": self.max_tokens, "context": self.context}
+        h.update(json.dumps(head, sort_keys=True, default=str).encode())
+        for im in self.images:
+            h.update(im.name.encode())
+            h.update(hashlib.sha256(im.png).digest())
+        return h.hexdigest()
+
+
+@dataclass(frozen=True)
+class ModelResponse:
+    """A backend's answer."""
+
+    text: str
+    backend: str
+    model: str
+    usage: dict[str, int] = field(default_factory=dict)
+
+
+@runtime_checkable
+class Backend(Protocol):
+    """What every backend provides."""
+
+    name: str
+    model: str
+    sees_images: bool
+    """True when the backend looks at ``ModelRequest.images`` (the vision critic runs only then)."""
+    is_language_model: bool
+
+    def complete(self, request: ModelRequest) -> ModelResponse: ...
