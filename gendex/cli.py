@@ -202,6 +202,71 @@ def replay(file: Path = typer.Argument(..., help="A trajectories .h5 file writte
 
 
 @app.command()
+def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to generate."),
+             instruction: str = typer.Option(None, "--instruction", help='Human request, e.g. "grab the apple".'),
+             backend: str = typer.Option(None, "--backend",
+                                         help="anthropic | offline | replay (default: anthropic when "
+                                              "ANTHROPIC_API_KEY is set, else offline)."),
+             seed: int = typer.Option(0, "--seed", help="Seed of the offline author and of scene resets."),
+             out: Path = typer.Option(Path("generated_tasks"), "--out", help="Task root to commit into."),
+             model: str = typer.Option(None, "--model", help="Model id for the anthropic backend."),
+             transcript: list[Path] = typer.Option(None, "--transcript",
+                                                   help="replay: a transcript.jsonl (or a task folder holding "
+                                                        "one); repeat for several tasks.")) -> None:
+    """Generate new tasks: propose -> scene -> render -> critique/refine -> plan -> reward code -> validate -> commit."""
+    import shlex  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    from tqdm import tqdm  # noqa: PLC0415
+
+    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+    from generator.backends.registry import BACKEND_NAMES, default_backend_name, make_backend  # noqa: PLC0415
+    from generator.backends.transcript import RecordingBackend, ReplayBackend  # noqa: PLC0415
+    from generator.pipeline import generate as run_generate  # noqa: PLC0415
+
+    name = backend or default_backend_name()
+    if name not in BACKEND_NAMES:
+        _die(ValueError(f"--backend {name!r} is not one of {list(BACKEND_NAMES)}"))
+    files = [t / "transcript.jsonl" if t.is_dir() else t for t in (transcript or [])]
+    if name == "replay":
+        if not files:
+            _die(ValueError("--backend replay needs --transcript PATH (a transcript.jsonl or a task folder)"))
+        n = len(files)
+    elif files:
+        _die(ValueError("--transcript is only used with --backend replay"))
+    if name == "offline":
+        typer.secho("Backend: offline — a deterministic, seeded task author built from a task grammar, a layout "
+                    "sampler and a library of reward terms. It is NOT a language model; set ANTHROPIC_API_KEY or "
+                    "pass --backend anthropic for Claude.", fg=typer.colors.YELLOW, err=True)
+    pending = list(files)
+
+    def factory(path: Path):
+        if name == "replay":
+            import shutil  # noqa: PLC0415
+
+            src = pending.pop(0)
+            shutil.copyfile(src, path)  # the replayed task keeps the transcript it was made from
+            return ReplayBackend(src)
+        return RecordingBackend(make_backend(name, seed=seed, model=model), path)
+
+    command = "gendex generate " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+    rows = []
+    try:
+        with tqdm(total=n, desc="tasks", unit="task") as bar:
+            def progress(summary) -> None:
+                rows.append(summary)
+                bar.update(1)
+                bar.set_postfix(last=summary.committed.name)
+            run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress)
+    except GenDexError as exc:
+        _die(exc)
+    typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")
+    for s in rows:
+        typer.echo(f"  {s.committed.env_id}: {s.violations_before} -> {s.violations_after} violations in "
+                   f"{s.refine_rounds} round(s), {s.seconds:.1f} s; folder {s.committed.path}")
+
+
+@app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for renders."),
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),
          seed: int = typer.Option(0, help="Seed of resets and random actions."),

@@ -14,7 +14,7 @@ import json
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
-STAGES = ("propose", "propose_guided", "scene", "judge", "analyze", "plan", "reward")
+STAGES = ("propose", "propose_guided", "scene", "analyze", "plan", "reward")
 """Request kinds; the offline backend dispatches on them, transcripts record them."""
 
 

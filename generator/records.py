@@ -1,0 +1,96 @@
+"""Typed records passed between the generator's stages. Each is JSON-able (``to_json``) and saved with the task."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+ACTIONS = ("approach", "grasp", "lift", "move", "release", "open", "close", "push", "pull")
+"""Atomic step actions a proposal may use."""
+ROLES = ("graspable", "container", "articulated", "support")
+
+
+def to_json(record: Any) -> str:
+    return json.dumps(asdict(record), indent=2, sort_keys=True) + "\n"
+
+
+@dataclass(frozen=True)
+class ProposedObject:
+    name: str
+    asset: str
+    role: str
+
+
+@dataclass(frozen=True)
+class ProposedStep:
+    action: str
+    target: str
+    control_joint: str
+    instruction: str
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """What the task is: objects from the catalog, atomic steps, and one checkable success condition."""
+
+    name: str
+    description: str
+    objects: tuple[ProposedObject, ...]
+    steps: tuple[ProposedStep, ...]
+    success: dict[str, Any]
+    success_text: str
+    instruction: str | None = None
+    """The human instruction this proposal answers (human-guided mode), else None."""
+    substitutions: dict[str, str] = field(default_factory=dict)
+    """Requested object -> catalog asset used instead (human-guided mode)."""
+
+
+@dataclass(frozen=True)
+class SceneCandidate:
+    index: int
+    yaml_text: str
+    score: float
+    """Lower is better: number of static check violations (+100 when the YAML did not parse)."""
+    problems: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class CritiqueRound:
+    """One refinement round: what the critic found and the directives applied."""
+
+    round: int
+    violations: tuple[str, ...]
+    analysis: str
+    directives: tuple[str, ...]
+    rejected: tuple[str, ...] = ()
+    """Directives or answers that could not be applied, with the reason (fed back)."""
+
+
+@dataclass(frozen=True)
+class RefineLog:
+    rounds: tuple[CritiqueRound, ...]
+    violations_before: int
+    violations_after: int
+
+
+@dataclass(frozen=True)
+class RewardAttempt:
+    stage: str
+    attempt: int
+    ok: bool
+    feedback: str
+
+
+@dataclass(frozen=True)
+class GenerationInfo:
+    """Provenance written to ``generation.json``: enough to rerun the exact generation."""
+
+    generator_version: str
+    backend: str
+    model: str
+    is_language_model: bool
+    seed: int
+    index: int
+    instruction: str | None
+    command: str

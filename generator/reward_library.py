@@ -1,0 +1,216 @@
+"""Reward modules composed from vetted terms (:mod:`gendex_envs.reward_terms`): what the offline backend writes.
+
+Each function returns the source of a complete reward module (``REWARD_MAX``, ``evaluate``,
+``compute_dense_reward``, ``_get_obs_extra``). The source still goes through the validator like model-written
+code. Object names are inserted as string literals; they are snake_case by the task schema.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+STAGE_KINDS = ("grasp", "lift", "release", "move", "pull", "open", "push", "close")
+
+_HEADER = '''"""{title}
+
+Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
+"""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+'''
+
+_FAIL_RIGID = '''    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    for name in {rigid}:
+        fail = fail | (env.obj_pose(name).p[:, 2] < env.table_height - 0.05)  # fell off the table
+'''
+
+_FAIL_NONE = '''    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+'''
+
+_HELD = '''    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    touching = force[..., 0] > 0.3  # [N, 6]
+    held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 2)  # thumb opposing at least two fingers
+'''
+
+
+def _success_condition(spec: dict) -> dict:
+    return spec["success"]["conditions"][0]
+
+
+def _stage(spec: dict, name: str) -> dict:
+    for s in spec["stages"]:
+        if s["name"] == name:
+            return s
+    raise KeyError(f"no stage {name!r}; stages: {[s['name'] for s in spec['stages']]}")
+
+
+def stage_kind(stage: dict) -> str:
+    """The action a stage performs, from its name (``grasp_apple`` -> ``grasp``); ``move`` when unknown."""
+    head = stage["name"].split("_")[0]
+    return head if head in STAGE_KINDS else "move"
+
+
+def _rigid(spec: dict, roles: dict[str, str]) -> list[str]:
+    return [o["name"] for o in spec["objects"] if roles.get(o["name"]) != "articulated" and not o.get("fixed")]
+
+
+def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> str:
+    """Reward module for one RL stage of ``spec`` (a task dict), by the stage's kind."""
+    stage = _stage(spec, stage_name)
+    kind, obj = stage_kind(stage), stage["target"]
+    cond = _success_condition(spec)
+    rigid = _rigid(spec, roles)
+    fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
+    title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
+    src = _HEADER.format(title=title)
+    if kind in ("pull", "open", "push", "close"):
+        frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
+        sign = "-" if kind == "close" else ""
+        src += f'''REWARD_MAX = 4.0
+OPEN_FRACTION = {frac}
+
+
+def evaluate(env):
+{fail}    opened = env.joint_open_fraction({obj!r})
+    success = ({sign}opened >= {"-" if sign else ""}OPEN_FRACTION) & ~fail
+    return {{"success": success, "fail": fail, "open_fraction": opened}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    handle = env.handle_pos({obj!r})
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - handle, dim=-1))
+    progress = rt.fraction({sign}info["open_fraction"] / OPEN_FRACTION)
+    reward = reach + 2.0 * progress
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_handle": env.handle_pos({obj!r}) - env.palm_pose.p, "open_fraction": info["open_fraction"][:, None]}}
+'''
+        return src
+    held = _HELD.format(obj=obj)
+    if kind == "grasp":
+        src += f'''REWARD_MAX = 4.0
+
+
+def evaluate(env):
+{fail}{held}    success = held & ~fail
+    return {{"success": success, "fail": fail, "contact": rt.contact(force)}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    tips = rt.tips_reach(env.tip_positions, p, 0.05)
+    reward = reach + tips + info["contact"]
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    pose = env.obj_pose({obj!r})
+    return {{"palm_to_obj": pose.p - env.palm_pose.p, "obj_pose": torch.cat([pose.p, pose.q], dim=-1)}}
+'''
+        return src
+    if kind == "lift":
+        h = float(cond.get("min_height_m") or 0.1) if cond["type"] == "lifted" else 0.1
+        src += f'''REWARD_MAX = 3.0
+LIFT_M = {h}
+
+
+def evaluate(env):
+{fail}{held}    height = env.obj_height({obj!r})
+    success = held & (height >= LIFT_M) & ~fail
+    return {{"success": success, "fail": fail, "height": height, "contact": rt.contact(force)}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    reward = info["contact"] + rt.lift(info["height"], LIFT_M) * (info["contact"] > 0.2)
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"height": info["height"][:, None], "palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p}}
+'''
+        return src
+    # move / release: bring the held object to the success condition's target, then let go
+    target = cond.get("target") or obj
+    release = kind == "release"
+    src += f'''REWARD_MAX = 3.0
+
+
+def evaluate(env):
+{fail}{held}    placed = env.spec_success()
+    success = placed {"& ~held " if release else ""}& ~fail
+    return {{"success": success, "fail": fail, "contact": rt.contact(force)}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    place = rt.place(env.obj_pose({obj!r}).p, env.obj_pose({target!r}).p)
+    reward = 2.0 * place {"+ (1.0 - info['contact']) * (place > 0.8)" if release else "+ info['contact']"}
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"obj_to_target": env.obj_pose({target!r}).p - env.obj_pose({obj!r}).p}}
+'''
+    return src
+
+
+def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
+    """Reward module of the whole task (``reward.py``): staged terms towards the task's success condition."""
+    cond = _success_condition(spec)
+    rigid = _rigid(spec, roles)
+    fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
+    src = _HEADER.format(title=f"{spec['name']}: {spec['instruction']}")
+    obj = cond["object"]
+    if cond["type"] == "joint_open":
+        src += f'''REWARD_MAX = 4.0
+
+
+def evaluate(env):
+{fail}    success = env.spec_success() & ~fail
+    return {{"success": success, "fail": fail, "open_fraction": env.joint_open_fraction({obj!r})}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - env.handle_pos({obj!r}), dim=-1))
+    reward = reach + 2.0 * rt.fraction(info["open_fraction"])
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_handle": env.handle_pos({obj!r}) - env.palm_pose.p}}
+'''
+        return src
+    target = cond.get("target")
+    carry = (f'    carry = rt.place(p, env.obj_pose({target!r}).p) * (lifted > 0.5)\n'
+             if target and target != "goal" else "    carry = torch.zeros_like(reach)\n")
+    src += f'''REWARD_MAX = 5.0
+LIFT_M = 0.1
+
+
+def evaluate(env):
+{fail}    success = env.spec_success() & ~fail
+    return {{"success": success, "fail": fail, "height": env.obj_height({obj!r})}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj({obj!r})))
+    lifted = rt.lift(info["height"], LIFT_M)
+{carry}    reward = reach + grasp + lifted + carry
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p}}
+'''
+    return src
+
+
+def roles_of(proposal: dict[str, Any]) -> dict[str, str]:
+    return {o["name"]: o["role"] for o in proposal["objects"]}

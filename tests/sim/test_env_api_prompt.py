@@ -1,0 +1,58 @@
+"""Every TaskEnv member the environment-API prompt names exists and has the documented shape."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+import torch
+
+from generator.prompts import render
+
+_LINE = re.compile(r"^- `(?P<expr>[^`]+)` : (?P<shape>[^:]+?) : ", re.M)
+
+
+def _members() -> list[tuple[str, str]]:
+    found = [(m["expr"], m["shape"].strip()) for m in _LINE.finditer(render("env_api"))]
+    assert len(found) >= 15, "the env-API prompt lists its members as '- `expr` : shape : meaning'"
+    return found
+
+
+def _check(value, shape: str, n: int, expr: str) -> None:
+    if shape == "int":
+        assert isinstance(value, int), expr
+    elif shape == "float":
+        assert isinstance(value, float), expr
+    elif shape == "torch.device":
+        assert isinstance(value, torch.device), expr
+    else:
+        m = re.fullmatch(r"\[(?P<dims>[^\]]+)\](?: (?P<dtype>bool))?", shape)
+        assert m, f"unparsed shape {shape!r} for {expr}"
+        dims = [n if d.strip() == "N" else int(d) for d in m["dims"].split(",")]
+        assert isinstance(value, torch.Tensor), expr
+        assert list(value.shape) == dims, f"{expr}: documented {shape}, got {list(value.shape)}"
+        if m["dtype"] == "bool":
+            assert value.dtype == torch.bool, expr
+        else:
+            assert value.dtype.is_floating_point, f"{expr}: {value.dtype}"
+
+
+@pytest.mark.parametrize("env_id, placeholder, name", [
+    ("GenDex/PutAppleBowl-v0", "NAME", "apple"),
+    ("GenDex/OpenCabinet-v0", "ARTICULATED", "cabinet"),
+])
+def test_env_api_prompt_matches_task_env(make_env, env_id, placeholder, name):
+    env = make_env(env_id, control_mode="pd_joint_delta_pos")
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    u = env.unwrapped
+    checked = 0
+    for expr, shape in _members():
+        other = "ARTICULATED" if placeholder == "NAME" else "NAME"
+        if other in expr:
+            continue
+        code = expr.replace(placeholder, repr(name))
+        value = eval(code, {"torch": torch}, {"env": u})  # noqa: S307  (our own prompt text, not model output)
+        _check(value, shape, u.num_envs, expr)
+        checked += 1
+    assert checked >= 12

@@ -1,0 +1,49 @@
+"""Prompt templates render with strict variables; the manifest matches the templates."""
+
+from __future__ import annotations
+
+import pytest
+
+from generator.errors import PromptError
+from generator.prompts import PROMPTS_DIR, load_manifest, render, template
+
+
+def test_manifest_lists_every_template_with_the_variables_it_uses():
+    manifest = load_manifest()
+    files = {p.name for p in PROMPTS_DIR.glob("*.txt")}
+    assert files == {t.file.name for t in manifest.values()}
+    # the issue's required prompts all exist
+    for name in ("propose", "propose_guided", "scene", "scene_analysis", "env_api", "patterns",
+                 "function_generation", "substage", "previous_function", "previous_stage"):
+        assert name in manifest
+    assert template("propose").temperature == 1.2
+    assert template("scene").temperature == 0.3
+
+
+def test_missing_variable_is_an_error_naming_it():
+    with pytest.raises(PromptError, match=r"missing variables \['content'\]"):
+        render("previous_stage", source_type="x")
+
+
+def test_unexpected_variable_is_an_error_naming_it():
+    with pytest.raises(PromptError, match=r"unexpected variables \['colour'\]"):
+        render("previous_stage", source_type="x", content="y", colour="red")
+
+
+def test_unknown_template_lists_the_known_ones():
+    with pytest.raises(PromptError, match="propose_guided"):
+        render("proposal_v2")
+
+
+def test_manifest_that_disagrees_with_its_template_is_rejected(tmp_path):
+    (tmp_path / "a.txt").write_text("Hello {{ who }} and {{ other }}")
+    (tmp_path / "manifest.yaml").write_text("a:\n  file: a.txt\n  variables: [who]\n")
+    with pytest.raises(PromptError, match=r"uses \['other', 'who'\] but the manifest declares \['who'\]"):
+        load_manifest(tmp_path)
+
+
+def test_rendered_guided_prompt_carries_the_instruction_and_the_library():
+    text = render("propose_guided", instruction="grab the apple", asset_guidance="- apple | apple",
+                  existing_tasks="- (none)", actions="approach, grasp", condition_types="lifted",
+                  control_joints="arm, hand")
+    assert '"grab the apple"' in text and "- apple | apple" in text and "{{" not in text
