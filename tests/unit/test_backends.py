@@ -1,4 +1,4 @@
-"""Model backends: anthropic (through an injected httpx2 MockTransport, never the network)."""
+"""Model backends: anthropic (through an injected httpx2 MockTransport, never the network), record/replay."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from PIL import Image
 
 from generator.backends.anthropic_backend import DEFAULT_MODEL, AnthropicBackend
 from generator.backends.base import Backend, ImagePart, ModelRequest, ModelResponse
-from generator.errors import BackendError
+from generator.backends.transcript import RecordingBackend, ReplayBackend
+from generator.errors import BackendError, TranscriptMismatchError
 
 
 @pytest.fixture(autouse=True)
@@ -266,3 +267,190 @@ def test_anthropic_injected_sdk_client_is_used_without_key():
     backend = AnthropicBackend(client=types.SimpleNamespace(messages=Messages()), model="m")
     assert backend.complete(text_request()).text == "from fake client"
     assert calls[0]["model"] == "m"
+
+
+# ------------------------------------------------------------------------------------------------ record / replay
+
+
+class EchoBackend:
+    """A deterministic stand-in backend whose answers depend on the whole request (images included)."""
+
+    name = "echo"
+    model = "echo-1"
+    is_language_model = False
+
+    def __init__(self, sees_images: bool = True):
+        self.sees_images = sees_images
+        self.calls = 0
+
+    def complete(self, request: ModelRequest) -> ModelResponse:
+        self.calls += 1
+        text = f"{request.stage} #{self.calls} {request.digest()[:12]}\n  é ✓ \"quoted\"\t\\ \r\n{request.prompt}"
+        return ModelResponse(text=text, backend=self.name, model=self.model, usage={"calls": self.calls})
+
+
+def record(tmp_path, requests, inner=None):
+    path = tmp_path / "run" / "transcript.jsonl"
+    rec = RecordingBackend(inner or EchoBackend(), path)
+    return path, [rec.complete(r) for r in requests]
+
+
+def test_record_then_replay_is_byte_identical_with_images(tmp_path):
+    requests = [text_request(), vision_request(), vision_request(stage="analyze", images=(WRIST,))]
+    path, recorded = record(tmp_path, requests)
+
+    lines = path.read_text(encoding="utf-8").splitlines()
+    assert len(lines) == 1 + len(requests)
+    header = json.loads(lines[0])["header"]
+    assert header | {} == {"format": "gendex-transcript", "version": 1, "backend": "echo", "model": "echo-1",
+                           "sees_images": True, "is_language_model": False}
+    second = json.loads(lines[2])
+    assert (second["index"], second["stage"], second["digest"]) == (1, "judge", requests[1].digest())
+    assert second["request"]["images"] == [{"name": "left_overhead", "sha256": LEFT.sha256(), "bytes": len(LEFT.png)},
+                                           {"name": "wrist", "sha256": WRIST.sha256(), "bytes": len(WRIST.png)}]
+    assert LEFT.b64() not in path.read_text(encoding="utf-8")  # images are not stored inline
+
+    replay = ReplayBackend(path)
+    replayed = [replay.complete(r) for r in requests]
+    assert replayed == recorded
+    assert [r.text.encode() for r in replayed] == [r.text.encode() for r in recorded]
+    assert replay.remaining == 0
+    replay.assert_consumed()
+
+
+def test_recording_flushes_each_exchange_as_it_goes(tmp_path):
+    path = tmp_path / "t.jsonl"
+    rec = RecordingBackend(EchoBackend(), path)
+    assert len(path.read_text().splitlines()) == 1  # header right away
+    rec.complete(text_request())
+    assert len(path.read_text().splitlines()) == 2
+    rec.complete(text_request(prompt="again"))
+    assert len(path.read_text().splitlines()) == 3 and rec.count == 2
+
+
+def test_recording_passes_the_inner_backend_through(tmp_path):
+    inner = EchoBackend(sees_images=False)
+    rec = RecordingBackend(inner, tmp_path / "t.jsonl")
+    assert isinstance(rec, Backend)
+    assert (rec.name, rec.model, rec.sees_images, rec.is_language_model) == ("record", "echo-1", False, False)
+    assert rec.complete(text_request()).backend == "echo"
+
+
+def test_recording_refuses_to_overwrite_unless_asked(tmp_path):
+    path, _ = record(tmp_path, [text_request()])
+    with pytest.raises(BackendError, match="already exists"):
+        RecordingBackend(EchoBackend(), path)
+    RecordingBackend(EchoBackend(), path, overwrite=True)
+    assert len(path.read_text().splitlines()) == 1
+
+
+def test_replay_takes_the_recorded_backend_attributes(tmp_path):
+    path, _ = record(tmp_path, [text_request()], inner=EchoBackend(sees_images=False))
+    replay = ReplayBackend(path)
+    assert isinstance(replay, Backend)
+    assert (replay.name, replay.model, replay.sees_images, replay.is_language_model) == \
+        ("replay", "echo-1", False, False)
+    assert replay.recorded_backend == "echo" and len(replay) == 1
+
+
+def test_replay_of_changed_prompt_names_index_stage_and_where(tmp_path):
+    path, _ = record(tmp_path, [text_request(), text_request(prompt="line one\nline two: apple")])
+    replay = ReplayBackend(path)
+    replay.complete(text_request())
+    with pytest.raises(TranscriptMismatchError) as info:
+        replay.complete(text_request(prompt="line one\nline two: pear"))
+    msg = str(info.value)
+    assert "request 1 (stage propose)" in msg and "prompt differs at line 2 col 11" in msg
+    assert "recorded 'line two: apple'" in msg and "now 'line two: pear'" in msg
+
+
+def test_replay_of_changed_image_bytes_is_a_mismatch(tmp_path):
+    path, _ = record(tmp_path, [vision_request()])
+    with pytest.raises(TranscriptMismatchError, match=r"request 0 \(stage judge\).*image bytes of \['wrist'\]"):
+        ReplayBackend(path).complete(vision_request(images=(LEFT, ImagePart("wrist", png((30, 31, 200))))))
+
+
+def test_replay_of_changed_stage_context_or_settings_is_a_mismatch(tmp_path):
+    path, _ = record(tmp_path, [vision_request()])
+    with pytest.raises(TranscriptMismatchError, match="stage 'judge' -> 'analyze'"):
+        ReplayBackend(path).complete(vision_request(stage="analyze"))
+    with pytest.raises(TranscriptMismatchError, match=r"context keys \['task'\]"):
+        ReplayBackend(path).complete(vision_request(context={"task": "Other"}))
+    with pytest.raises(TranscriptMismatchError, match="max_tokens 512 -> 100"):
+        ReplayBackend(path).complete(vision_request(max_tokens=100))
+    with pytest.raises(TranscriptMismatchError, match=r"image names \['left_overhead', 'wrist'\] -> \['wrist'\]"):
+        ReplayBackend(path).complete(vision_request(images=(WRIST,)))
+
+
+def test_replay_past_the_end_is_a_mismatch(tmp_path):
+    path, _ = record(tmp_path, [text_request()])
+    replay = ReplayBackend(path)
+    replay.complete(text_request())
+    with pytest.raises(TranscriptMismatchError, match=r"request 1 \(stage judge\) is past the end.*holds 1"):
+        replay.complete(vision_request())
+
+
+def test_replay_not_consumed_is_reported(tmp_path):
+    path, _ = record(tmp_path, [text_request(), vision_request()])
+    replay = ReplayBackend(path)
+    replay.complete(text_request())
+    with pytest.raises(TranscriptMismatchError, match=r"made 1 request\(s\) but 2 were recorded.*stage judge"):
+        replay.assert_consumed()
+
+
+def test_recorded_backend_errors_replay_as_the_same_error(tmp_path):
+    class Flaky(EchoBackend):
+        def complete(self, request):
+            if self.calls == 0:
+                self.calls += 1
+                raise BackendError("Anthropic API answered 500 after 4 attempt(s)")
+            return super().complete(request)
+
+    path = tmp_path / "t.jsonl"
+    rec = RecordingBackend(Flaky(), path)
+    with pytest.raises(BackendError):
+        rec.complete(text_request())
+    ok_resp = rec.complete(text_request())
+
+    replay = ReplayBackend(path)
+    with pytest.raises(BackendError, match="replayed.*500 after 4"):
+        replay.complete(text_request())
+    assert replay.complete(text_request()) == ok_resp
+
+
+def test_replay_missing_transcript(tmp_path):
+    with pytest.raises(BackendError, match="nope.jsonl not found"):
+        ReplayBackend(tmp_path / "nope.jsonl")
+
+
+@pytest.mark.parametrize(("mangle", "line", "what"), [
+    (lambda lines: lines[:1] + ['{"index": 0, "stage": "propose", "dig'], 2, "not valid JSON"),
+    (lambda lines: lines[1:], 1, "first line must be the header"),
+    (lambda lines: [], 1, "empty"),
+    (lambda lines: lines[:1] + lines[2:], 2, "index 1, expected 0"),
+    (lambda lines: lines + [lines[0]], 4, "second header"),
+    (lambda lines: lines[:2] + [lines[2].replace('"text": ', '"txt": ')], 3, "'text' must be a string"),
+    (lambda lines: [lines[0].replace('"sees_images": true', '"sees_images": "yes"')] + lines[1:], 1, "sees_images"),
+])
+def test_replay_corrupt_transcript_names_path_and_line(tmp_path, mangle, line, what):
+    path, _ = record(tmp_path, [text_request(), vision_request()])
+    lines = path.read_text(encoding="utf-8").splitlines()
+    path.write_text("\n".join(mangle(lines)) + "\n", encoding="utf-8")
+    with pytest.raises(TranscriptMismatchError) as info:
+        ReplayBackend(path)
+    assert f"{path}:{line}:" in str(info.value) and what in str(info.value)
+
+
+def test_record_and_replay_through_the_anthropic_backend(tmp_path):
+    api = FakeAPI(ok("propose: apple\n"), ok("scene_ok: ", "false  \n"))
+    live, _ = anthropic_backend(api)
+    path = tmp_path / "claude.jsonl"
+    rec = RecordingBackend(live, path)
+    requests = [text_request(), vision_request()]
+    recorded = [rec.complete(r) for r in requests]
+    assert [r.text for r in recorded] == ["propose: apple\n", "scene_ok: false  \n"]
+
+    replay = ReplayBackend(path)
+    assert (replay.model, replay.sees_images, replay.is_language_model) == (DEFAULT_MODEL, True, True)
+    assert [replay.complete(r) for r in requests] == recorded
+    assert len(api.requests) == 2  # the replay made no HTTP call
