@@ -1,10 +1,11 @@
-"""Model backends: anthropic (through an injected httpx2 MockTransport, never the network), record/replay."""
+"""Model backends: anthropic (through an injected httpx2 MockTransport, never the network), record/replay, registry."""
 
 from __future__ import annotations
 
 import base64
 import io
 import json
+import sys
 import types
 
 import httpx2
@@ -13,6 +14,11 @@ from PIL import Image
 
 from generator.backends.anthropic_backend import DEFAULT_MODEL, AnthropicBackend
 from generator.backends.base import Backend, ImagePart, ModelRequest, ModelResponse
+from generator.backends.registry import (
+    BACKEND_NAMES,
+    default_backend_name,
+    make_backend,
+)
 from generator.backends.transcript import RecordingBackend, ReplayBackend
 from generator.errors import BackendError, TranscriptMismatchError
 
@@ -454,3 +460,67 @@ def test_record_and_replay_through_the_anthropic_backend(tmp_path):
     assert (replay.model, replay.sees_images, replay.is_language_model) == (DEFAULT_MODEL, True, True)
     assert [replay.complete(r) for r in requests] == recorded
     assert len(api.requests) == 2  # the replay made no HTTP call
+
+
+# ------------------------------------------------------------------------------------------------------- registry
+
+
+def test_make_backend_unknown_name_lists_the_allowed_ones():
+    with pytest.raises(BackendError, match="unknown backend 'gpt'.*anthropic, offline, replay"):
+        make_backend("gpt")
+    assert BACKEND_NAMES == ("anthropic", "offline", "replay")
+
+
+def test_make_backend_replay_needs_a_transcript(tmp_path):
+    with pytest.raises(BackendError, match="needs a transcript"):
+        make_backend("replay")
+    path, _ = record(tmp_path, [text_request()])
+    replay = make_backend("replay", transcript=path)
+    assert isinstance(replay, ReplayBackend) and replay.model == "echo-1"
+
+
+def test_make_backend_anthropic(tmp_path):
+    with pytest.raises(BackendError, match="ANTHROPIC_API_KEY"):
+        make_backend("anthropic")
+    api = FakeAPI(ok("hi"))
+    client = httpx2.Client(transport=httpx2.MockTransport(api))
+    backend = make_backend("Anthropic", model="claude-x", api_key="k", http_client=client)
+    assert isinstance(backend, AnthropicBackend) and backend.model == "claude-x"
+
+    recorded = make_backend("anthropic", api_key="k", http_client=client, transcript=tmp_path / "t.jsonl")
+    assert isinstance(recorded, RecordingBackend) and isinstance(recorded.inner, AnthropicBackend)
+    assert recorded.complete(text_request()).text == "hi"
+    with pytest.raises(BackendError, match="already exists"):
+        make_backend("anthropic", api_key="k", http_client=client, transcript=tmp_path / "t.jsonl")
+    make_backend("anthropic", api_key="k", http_client=client, transcript=tmp_path / "t.jsonl",
+                 overwrite_transcript=True)
+
+
+def test_make_backend_offline_missing_module(monkeypatch):
+    monkeypatch.setitem(sys.modules, "generator.backends.offline", None)  # import fails as if the file were absent
+    with pytest.raises(BackendError, match="offline backend is not available"):
+        make_backend("offline")
+
+
+def test_make_backend_offline_gets_the_seed(monkeypatch, tmp_path):
+    class OfflineBackend(EchoBackend):
+        name = "offline"
+
+        def __init__(self, seed=0):
+            super().__init__(sees_images=False)
+            self.seed = seed
+
+    fake = types.ModuleType("generator.backends.offline")
+    fake.OfflineBackend = OfflineBackend
+    monkeypatch.setitem(sys.modules, "generator.backends.offline", fake)
+    assert make_backend("offline", seed=7).seed == 7
+    recorded = make_backend("offline", seed=3, transcript=tmp_path / "off.jsonl")
+    assert isinstance(recorded, RecordingBackend) and recorded.inner.seed == 3
+
+
+def test_default_backend_name(monkeypatch):
+    assert default_backend_name() == "offline"
+    monkeypatch.setenv("ANTHROPIC_API_KEY", " ")
+    assert default_backend_name() == "offline"
+    monkeypatch.setenv("ANTHROPIC_API_KEY", "sk-ant-x")
+    assert default_backend_name() == "anthropic"
