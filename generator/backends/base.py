@@ -28,6 +28,10 @@ class ImagePart:
     def b64(self) -> str:
         return base64.b64encode(self.png).decode("ascii")
 
+    def sha256(self) -> str:
+        """Hex SHA-256 of the PNG bytes (transcripts store this instead of the image)."""
+        return hashlib.sha256(self.png).hexdigest()
+
 
 @dataclass(frozen=True)
 class ModelRequest:
@@ -59,6 +63,22 @@ class ModelRequest:
             h.update(hashlib.sha256(im.png).digest())
         return h.hexdigest()
 
+    def to_record(self) -> dict[str, Any]:
+        """A JSON-able summary of the request for transcripts: every field, but images by name, SHA-256 and size.
+
+        ``context`` goes through the same ``json.dumps(default=str)`` as :meth:`digest`, so what is stored is what
+        was hashed. The record cannot be turned back into a request (the image bytes are not in it).
+        """
+        return {
+            "stage": self.stage,
+            "system": self.system,
+            "prompt": self.prompt,
+            "temperature": self.temperature,
+            "max_tokens": self.max_tokens,
+            "context": json.loads(json.dumps(self.context, sort_keys=True, default=str)),
+            "images": [{"name": im.name, "sha256": im.sha256(), "bytes": len(im.png)} for im in self.images],
+        }
+
 
 @dataclass(frozen=True)
 class ModelResponse:
@@ -68,6 +88,23 @@ class ModelResponse:
     backend: str
     model: str
     usage: dict[str, int] = field(default_factory=dict)
+
+    def to_record(self) -> dict[str, Any]:
+        """JSON-able form (transcripts); :meth:`from_record` reads it back unchanged."""
+        return {"text": self.text, "backend": self.backend, "model": self.model, "usage": dict(self.usage)}
+
+    @classmethod
+    def from_record(cls, record: Any) -> ModelResponse:
+        """Inverse of :meth:`to_record`; raises ``TypeError`` naming the first field that is missing or mistyped."""
+        if not isinstance(record, dict):
+            raise TypeError(f"a response record must be an object, got {type(record).__name__}")
+        for key in ("text", "backend", "model"):
+            if not isinstance(record.get(key), str):
+                raise TypeError(f"response field {key!r} must be a string, got {record.get(key)!r:.80}")
+        usage = record.get("usage", {})
+        if not isinstance(usage, dict) or not all(isinstance(k, str) and isinstance(v, int) for k, v in usage.items()):
+            raise TypeError(f"response field 'usage' must map names to integers, got {usage!r:.80}")
+        return cls(text=record["text"], backend=record["backend"], model=record["model"], usage=dict(usage))
 
 
 @runtime_checkable
