@@ -42,7 +42,7 @@ WRIST = ImagePart("wrist", png((30, 30, 200)))
 
 
 def vision_request(**changes) -> ModelRequest:
-    fields = {"stage": "judge", "prompt": "Does the scene match the task?\nAnswer in YAML.",
+    fields = {"stage": "plan", "prompt": "Does the scene match the task?\nAnswer in YAML.",
               "system": "You judge scenes.", "images": (LEFT, WRIST), "temperature": 0.2, "max_tokens": 512,
               "context": {"task": "PutAppleBowl"}}
     fields.update(changes)
@@ -311,7 +311,7 @@ def test_record_then_replay_is_byte_identical_with_images(tmp_path):
     assert header | {} == {"format": "gendex-transcript", "version": 1, "backend": "echo", "model": "echo-1",
                            "sees_images": True, "is_language_model": False}
     second = json.loads(lines[2])
-    assert (second["index"], second["stage"], second["digest"]) == (1, "judge", requests[1].digest())
+    assert (second["index"], second["stage"], second["digest"]) == (1, "plan", requests[1].digest())
     assert second["request"]["images"] == [{"name": "left_overhead", "sha256": LEFT.sha256(), "bytes": len(LEFT.png)},
                                            {"name": "wrist", "sha256": WRIST.sha256(), "bytes": len(WRIST.png)}]
     assert LEFT.b64() not in path.read_text(encoding="utf-8")  # images are not stored inline
@@ -372,13 +372,13 @@ def test_replay_of_changed_prompt_names_index_stage_and_where(tmp_path):
 
 def test_replay_of_changed_image_bytes_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [vision_request()])
-    with pytest.raises(TranscriptMismatchError, match=r"request 0 \(stage judge\).*image bytes of \['wrist'\]"):
+    with pytest.raises(TranscriptMismatchError, match=r"request 0 \(stage plan\).*image bytes of \['wrist'\]"):
         ReplayBackend(path).complete(vision_request(images=(LEFT, ImagePart("wrist", png((30, 31, 200))))))
 
 
 def test_replay_of_changed_stage_context_or_settings_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [vision_request()])
-    with pytest.raises(TranscriptMismatchError, match="stage 'judge' -> 'analyze'"):
+    with pytest.raises(TranscriptMismatchError, match="stage 'plan' -> 'analyze'"):
         ReplayBackend(path).complete(vision_request(stage="analyze"))
     with pytest.raises(TranscriptMismatchError, match=r"context keys \['task'\]"):
         ReplayBackend(path).complete(vision_request(context={"task": "Other"}))
@@ -392,7 +392,7 @@ def test_replay_past_the_end_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [text_request()])
     replay = ReplayBackend(path)
     replay.complete(text_request())
-    with pytest.raises(TranscriptMismatchError, match=r"request 1 \(stage judge\) is past the end.*holds 1"):
+    with pytest.raises(TranscriptMismatchError, match=r"request 1 \(stage plan\) is past the end.*holds 1"):
         replay.complete(vision_request())
 
 
@@ -400,7 +400,7 @@ def test_replay_not_consumed_is_reported(tmp_path):
     path, _ = record(tmp_path, [text_request(), vision_request()])
     replay = ReplayBackend(path)
     replay.complete(text_request())
-    with pytest.raises(TranscriptMismatchError, match=r"made 1 request\(s\) but 2 were recorded.*stage judge"):
+    with pytest.raises(TranscriptMismatchError, match=r"made 1 request\(s\) but 2 were recorded.*stage plan"):
         replay.assert_consumed()
 
 
