@@ -22,9 +22,11 @@ Semantics, precisely:
 
 The parser is tolerant of layout: keywords are case-insensitive, surrounding whitespace, list bullets (``-``, ``*``,
 ``+``, ``1.``), markdown backticks and ``**bold**`` are ignored, ``m`` / ``deg`` units after the value are allowed,
-and so is a trailing ``# comment``. Lines that are not directives are skipped, but a line that *starts* like one
-(``Scale_Action:``, ``Position_Action:``, ``Pose_Action:``) and does not parse raises DirectiveError naming the line
-and the allowed forms. Object names are matched case-insensitively against the scene's objects.
+and so are an en/em dash for the hyphen, a missing colon after the keyword (when the rest of the line parses) and a
+trailing ``# comment``. ``Scale_Action: none`` (or ``n/a``) is a skipped no-op. Lines that are not directives are
+skipped, but a line that *starts* like one (``Scale_Action:``, ``Position_Action:``, ``Pose_Action:``) and does not
+parse raises DirectiveError naming the line and the allowed forms. Object names are matched case-insensitively
+against the scene's objects.
 """
 
 from __future__ import annotations
@@ -60,6 +62,7 @@ _NUMBER = r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?"
 _DASH = r"\s*[-\u2013\u2014]\s*"  # hyphen, en dash, em dash
 _OBJ = r"(?P<obj>[A-Za-z_][A-Za-z0-9_]*)"
 _HEAD = re.compile(r"^(?P<kw>scale|position|pose)[ _]?action\s*:\s*(?P<body>.*)$", re.IGNORECASE)
+_HEAD_NO_COLON = re.compile(r"^(?P<kw>scale|position|pose)[ _]?action\s+(?P<body>.*)$", re.IGNORECASE)
 _BODY = {
     "scale": re.compile(rf"^{_OBJ}{_DASH}(?:x\s*)?(?P<val>{_NUMBER})\s*(?:x)?$", re.IGNORECASE),
     "position": re.compile(rf"^{_OBJ}{_DASH}(?P<op>move_[a-z]+)\s*[:=]?\s*(?P<val>{_NUMBER})\s*"
@@ -152,7 +155,11 @@ def parse_directive_line(line: str, object_names: Collection[str]) -> Directive 
         text = text.split("#", 1)[0].strip()
     head = _HEAD.match(text)
     if head is None:
-        return None
+        # without the colon the line is only a directive if the rest parses (else it is prose: "Scale action is ...")
+        loose = _HEAD_NO_COLON.match(text)
+        if loose is None or _BODY[loose.group("kw").lower()].match(loose.group("body").strip().rstrip(".;,")) is None:
+            return None
+        head = loose
     kind = head.group("kw").lower()
     body = head.group("body").strip().rstrip(".;,").strip()
     if body.lower() in NO_OP_BODIES:

@@ -52,13 +52,15 @@ def test_every_form_parses(line, expected):
     "Scale Action: apple \u2013 0.5",
     "Scale_Action: apple - 0.5x  # too big",
     "Scale_Action: apple - 0.5.",
+    "Scale_Action apple - 0.5",
 ])
 def test_layout_is_tolerated(line):
     assert parse_directives(line, NAMES) == [Directive.scale("apple", 0.5)]
 
 
 def test_units_and_case_of_operations():
-    text = "Position_Action: apple - MOVE_X 0.05 m\nPose_Action: apple - Rotate_Z 90 deg\nPose_Action: apple - rotate_z 90\u00b0"
+    text = ("Position_Action: apple - MOVE_X 0.05 m\nPose_Action: apple - Rotate_Z 90 deg\n"
+            "Pose_Action: apple - rotate_z 90\u00b0")
     assert parse_directives(text, NAMES) == [Directive.move("apple", "x", 0.05), Directive.rotate("apple", "z", 90),
                                              Directive.rotate("apple", "z", 90)]
 
@@ -70,6 +72,7 @@ I suggest these edits (Scale_Action halves it):
 
 Position_Action: apple - move_z -0.3
 Scale_Action: none
+Pose action is not needed.
 Everything else looks fine."""
     assert parse_directives(text, NAMES) == [Directive.scale("apple", 0.5), Directive.move("apple", "z", -0.3)]
     assert parse_directives("no directives here", NAMES) == []
