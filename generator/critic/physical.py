@@ -1,0 +1,777 @@
+"""The critic's physical checks: what GenDex measures itself on a scene, with arithmetic fixes where they exist.
+
+Two entry points:
+
+* :func:`check_scene_static` needs no simulator (milliseconds): reach, off_table, scale, joint_state, unsupported
+  and penetration estimated from bounding boxes.
+* :func:`check_scene` builds the scene in SAPIEN (CPU, randomization off, the robot at the spec's initial keyframe:
+  ``rest`` unless the spec says otherwise; both keyframes share the same arm pose), and replaces the bounding-box
+  penetration estimate with PhysX's own contacts at reset, then lets the scene settle and measures what fell or
+  still moves. About 0.3 s per scene once SAPIEN is loaded (the first env of a process costs ~3 s of imports).
+
+Each :class:`Violation` names its check, object, measured value and limit, and carries a suggested fix: directives
+(:mod:`generator.critic.directives`) where arithmetic can fix it, or a joint-state edit (``joint_fix``, applied with
+:func:`apply_joint_fix`) for a joint that starts in the state the task should produce. Several violations of one
+object may carry the same directive (an object both off the table and out of reach gets one combined move);
+:meth:`PhysicalReport.directives` lists each distinct directive once, so applying that list applies every fix once.
+
+How each check is measured (the thresholds are the module constants below):
+
+``penetration``
+    Simulator: after reset one physics step is taken and PhysX's contact list read; a contact point's
+    ``separation`` < -PENETRATION_TOL_M between two objects, an object and the table, or an object and a robot
+    link is a penetration (contacts inside one articulation, robot-robot and robot-table are ignored). PhysX
+    reports the depth along the contact normal per convex-hull pair, which for deep overlaps understates the true
+    overlap, so the fix is computed from the bodies' collision-shape AABBs instead: the smaller movable object is
+    moved in xy along the line between the two AABB centres until the AABBs no longer overlap in x or y
+    (+ PENETRATION_FIX_MARGIN_M + both objects' randomization half-ranges); a penetration of the table is fixed by
+    raising the object. Static: the same on the catalog bounding boxes placed by the spec; an object whose footprint
+    lies inside a container's footprint and that is above the table is *not* counted (it may rest on the
+    container's floor; only the simulator can tell). Randomization is off for the measurement (nominal poses).
+``unsupported`` (static)
+    An object whose lowest point is more than SUPPORT_TOL_M above the table and whose footprint centre is not over
+    another object whose vertical extent reaches up to it (within SUPPORT_TOL_M). Fix: ``move_z`` down onto the
+    table, onto the top of the non-container object below it, or to CONTAINER_FLOOR_M x scale above the bottom of a
+    container below it.
+``floating`` (simulator)
+    After ``settle_steps`` control steps with the robot holding still (zero ``pd_joint_delta_pos`` actions), a
+    movable object that sank more than FALL_TOL_M or still moves faster than MOVING_TOL_MPS. Objects off the table
+    are left to ``off_table``. Fix: the ``unsupported`` fix if there is one, else ``move_z`` by minus the measured
+    drop (nothing for an object that only keeps moving).
+``out_of_reach`` (static)
+    Horizontal distance from the robot base to the nearest point of the object's footprint, plus the object's xy
+    randomization half-range (worst case), above REACH_MAX_M; or distance from the base to the footprint centre,
+    minus that half-range, below REACH_MIN_M. Only objects the task refers to (stage targets, success-condition
+    objects and targets) are checked; a scene that refers to none has all its objects checked. Fix: move along the
+    line to the base until the distance is REACH_MARGIN_M inside the limit.
+``off_table`` (static)
+    Footprint centre (of the rotated bounding box) outside the table top. Fix: move so the whole footprint is on the
+    table, OFF_TABLE_MARGIN_M from the edge (centred when it is larger than the table), combined with the reach fix.
+``scale``
+    (a) :func:`check_raw_scales` on a raw task mapping: a scale outside SCALE_RANGE (such a spec cannot be parsed);
+    fix: the factor back into range. (b) A graspable, rigid object that the task grasps (a stage targeting it
+    says grasp/pick/lift/hold/grab/wrap/pinch/grip, or a ``lifted`` condition names it, or it is the object of an
+    ``inside`` condition) whose smallest horizontal width as placed exceeds GRASP_MAX_WIDTH_M, or whose largest
+    extent is below GRASP_MIN_SIZE_M; fix: the scale factor that brings it inside. (c) A scale outside
+    REALISTIC_SCALE_RANGE is reported with severity ``warning`` (a catalog asset at 0.3x or 2x is no longer the
+    object it depicts); warnings do not make a report fail.
+``joint_state`` (static)
+    An articulated object whose initial joint state contradicts the first stage that targets it and states an
+    intent: "open" while the joint starts at least JOINT_OPEN_FRACTION open, "close"/"shut" while it starts less
+    than that open. Words about the hand ("open hand", "close the fingers") are not intents. With no stage intent, a
+    ``joint_open`` success condition on the object means "open". The fraction is (q - closed) / (open - closed) of
+    the joint the conditions name, else the asset's main joint. Fix: ``joint_fix`` = {object, joint, value} setting
+    the joint to its closed (resp. open) value; the directive grammar has no joint edit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+import re
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
+from gendex_envs.spec import (
+    SCALE_RANGE,
+    ObjectSpec,
+    RandomizeSpec,
+    TaskSpec,
+    parse_task_spec,
+    spec_to_dict,
+)
+from generator.critic.directives import Directive
+from generator.errors import DirectiveError
+
+log = logging.getLogger(__name__)
+
+CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "scale", "joint_state"]
+CHECKS: tuple[str, ...] = ("penetration", "floating", "unsupported", "out_of_reach", "off_table", "scale",
+                           "joint_state")
+
+# ----------------------------------------------------------------------------------------------- thresholds
+PENETRATION_TOL_M = 0.003
+"""Deepest tolerated interpenetration at reset (m). Objects placed by the spec rest at separation ~0 (measured
+0.0 on the seed tasks); an apple placed at the centre of the bowl sits 6 mm into its floor."""
+PENETRATION_FIX_MARGIN_M = 0.01
+"""Gap left between two bounding boxes moved apart by a penetration fix (m)."""
+SUPPORT_TOL_M = 0.005
+"""An object's lowest point may be this far above the table, or above / below the top of what it stands on (m)."""
+CONTAINER_FLOOR_M = 0.01
+"""Guessed floor thickness of a container at scale 1 (m): an unsupported object above a container is lowered to this
+clearance above the container's bottom (the bowl's floor is ~7 mm thick)."""
+FALL_TOL_M = 0.01
+"""A movable object that sank more than this while settling was floating (m)."""
+MOVING_TOL_MPS = 0.05
+"""A movable object still faster than this after settling is not at rest (m/s)."""
+SETTLE_STEPS = 20
+"""Control steps (20 Hz: 1 s) the scene settles for; an object released 0.3 m up lands in 0.25 s."""
+
+REACH_MAX_M = 1.25
+"""Farthest horizontal distance (m) from the robot base to the nearest point of an object's footprint.
+
+The issue's "> 0.8 m from the base" comes from the seed paper, whose base stood at x = -0.5 in front of a smaller
+workspace; it does not describe this robot. GenDex's UR10e stands at x = -0.8, and its published reach is 1.30 m
+(base axis to wrist flange) plus ~0.2 m of ShadowHand (wrist to fingertips). Reaching down to a table that is level
+with the base, with the palm above or beside the object, costs part of that, so 1.25 m to the object's nearest point
+is kept as the limit. The seed tasks place objects 1.0-1.4 m from the base; their nearest points lie within
+0.89-1.16 m even with their randomization added (the cabinet, 1.4 m away at its centre, has its front 1.13 m away)."""
+REACH_MIN_M = 0.35
+"""Closest horizontal distance (m) from the base to an object's footprint centre: nearer than this the hand cannot
+fold back down to it (the shoulder and elbow take up the space around the base axis)."""
+REACH_MARGIN_M = 0.05
+"""How far inside a reach limit a reach fix puts the object (m)."""
+OFF_TABLE_MARGIN_M = 0.02
+"""Distance from the table edge that an off_table fix leaves (m)."""
+
+GRASP_MAX_WIDTH_M = 0.12
+"""Widest object (smallest horizontal width as placed, m) the ShadowHand closes around: its thumb-to-finger span is
+~0.15 m fully spread, and a stable power / top grasp needs the fingers to wrap past the object's middle."""
+GRASP_MIN_SIZE_M = 0.015
+"""Smallest graspable object (largest extent, m): below this the fingertips (~2 cm wide) cannot pinch it."""
+GRASP_FIX_FILL = 0.9
+"""A grasp-size fix scales the object to this fraction of GRASP_MAX_WIDTH_M (or 1/this of GRASP_MIN_SIZE_M)."""
+REALISTIC_SCALE_RANGE: tuple[float, float] = (0.5, 1.5)
+"""Scales outside this range are reported as warnings: catalog sizes are real-world sizes, and real objects of one
+kind vary about +/-50 %; a 2x apple (15 cm) or a 0.3x bottle (7 cm) no longer looks like what it is."""
+JOINT_OPEN_FRACTION = 0.5
+"""A joint at least this fraction of the way from closed to open counts as open (joint_state check)."""
+
+_GRASP_WORDS = re.compile(r"\b(grasp|grab|pick|lift|hold|wrap|pinch|grip)\w*", re.IGNORECASE)
+_INTENT = re.compile(r"\b(?P<verb>open|opens|opening|close|closes|closing|shut|shuts|shutting)\b"
+                     r"(?P<after>(?:\W+\w+){0,2})", re.IGNORECASE)
+_HAND_WORDS = frozenset({"hand", "hands", "palm", "palms", "finger", "fingers", "gripper", "thumb", "grip", "grasp"})
+
+
+# ------------------------------------------------------------------------------------------------ records
+@dataclass(frozen=True)
+class Violation:
+    """One failed check."""
+
+    check: CheckId
+    """One of CHECKS."""
+    object: str | None
+    """The object at fault (None for scene-level problems)."""
+    message: str
+    """One readable sentence, fit to feed back to the model."""
+    measured: float | None = None
+    """The measured value (m, m/s, scale or fraction; see the message)."""
+    limit: float | None = None
+    """The threshold it broke."""
+    fix: tuple[Directive, ...] = ()
+    """Suggested directives that fix it by arithmetic (empty where none exists)."""
+    joint_fix: dict[str, Any] | None = None
+    """joint_state violations: {"object", "joint", "value"}, for :func:`apply_joint_fix`."""
+    severity: Literal["error", "warning"] = "error"
+    """Warnings are reported but do not make the report fail."""
+    other: str | None = None
+    """The second party of a penetration: an object name, ``table`` or ``robot:<link>``."""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"check": self.check, "object": self.object, "message": self.message,
+                "measured": _r(self.measured), "limit": _r(self.limit), "fix": [str(d) for d in self.fix],
+                "joint_fix": self.joint_fix, "severity": self.severity, "other": self.other}
+
+
+@dataclass
+class PhysicalReport:
+    """Violations and per-check measurements of one scene; JSON-able via :meth:`to_dict`."""
+
+    task: str
+    mode: Literal["static", "sim"]
+    violations: list[Violation] = field(default_factory=list)
+    measurements: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """check id -> object name -> measured quantities (plus ``_method`` entries saying how)."""
+    seconds: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        """No error-severity violation."""
+        return not any(v.severity == "error" for v in self.violations)
+
+    @property
+    def errors(self) -> list[Violation]:
+        return [v for v in self.violations if v.severity == "error"]
+
+    def by_check(self, check: str) -> list[Violation]:
+        return [v for v in self.violations if v.check == check]
+
+    def directives(self, include_warnings: bool = False) -> list[Directive]:
+        """Each distinct suggested directive once, in violation order."""
+        out: list[Directive] = []
+        for v in self.violations:
+            if v.severity == "warning" and not include_warnings:
+                continue
+            out += [d for d in v.fix if d not in out]
+        return out
+
+    def joint_fixes(self) -> list[dict[str, Any]]:
+        return [v.joint_fix for v in self.violations if v.joint_fix is not None]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"task": self.task, "mode": self.mode, "ok": self.ok, "seconds": round(self.seconds, 3),
+                "violations": [v.to_dict() for v in self.violations], "measurements": self.measurements}
+
+    def to_json(self, **kwargs) -> str:
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def summary(self) -> str:
+        """One line per violation with its suggested fix; 'no physical problems found' when there is none."""
+        if not self.violations:
+            return "no physical problems found"
+        lines = []
+        for v in self.violations:
+            fix = "; fix: " + " | ".join(str(d) for d in v.fix) if v.fix else ""
+            if v.joint_fix:
+                fix = f"; fix: set {v.joint_fix['object']}.joint_state.{v.joint_fix['joint']} = {v.joint_fix['value']}"
+            lines.append(f"[{v.severity} {v.check}] {v.message}{fix}")
+        return "\n".join(lines)
+
+
+def _r(x: float | None, nd: int = 4) -> float | None:
+    return None if x is None else round(float(x), nd)
+
+
+# --------------------------------------------------------------------------------------------- geometry
+def _rotation(q_wxyz: Iterable[float]) -> np.ndarray:
+    w, x, y, z = np.asarray(list(q_wxyz), dtype=np.float64) / np.linalg.norm(list(q_wxyz))
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+@dataclass(frozen=True)
+class _Placed:
+    """An object as the spec places it: catalog record and world corners of its rotated, scaled bounding box."""
+
+    spec: ObjectSpec
+    record: AssetRecord
+    corners: np.ndarray  # [8, 3] world
+
+    @property
+    def lo(self) -> np.ndarray:
+        return self.corners.min(axis=0)
+
+    @property
+    def hi(self) -> np.ndarray:
+        return self.corners.max(axis=0)
+
+    @property
+    def centre_xy(self) -> np.ndarray:
+        return (self.lo[:2] + self.hi[:2]) / 2
+
+    @property
+    def area(self) -> float:
+        d = self.hi[:2] - self.lo[:2]
+        return float(d[0] * d[1])
+
+    @property
+    def is_container(self) -> bool:
+        return "container" in self.record.tags
+
+
+def _place(obj: ObjectSpec) -> _Placed:
+    rec = get_asset(obj.asset)
+    lo, hi = np.asarray(rec.bbox_min_m) * obj.scale, np.asarray(rec.bbox_max_m) * obj.scale
+    local = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    origin = np.array([obj.pos_m[0], obj.pos_m[1], obj.pos_m[2] - lowest_point_z(rec, obj.scale, obj.quat_wxyz)])
+    return _Placed(obj, rec, local @ _rotation(obj.quat_wxyz).T + origin)
+
+
+def _min_width_xy(points: np.ndarray) -> float:
+    """Smallest width of the points' horizontal projection over all directions (2 degree steps)."""
+    angles = np.radians(np.arange(0.0, 180.0, 2.0))
+    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    proj = points[:, :2] @ dirs.T
+    return float((proj.max(axis=0) - proj.min(axis=0)).min())
+
+
+def _footprint_inside(inner_lo, inner_hi, outer_lo, outer_hi) -> bool:
+    return bool(np.all(inner_lo[:2] >= outer_lo[:2] - 1e-9) and np.all(inner_hi[:2] <= outer_hi[:2] + 1e-9))
+
+
+def _separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
+                     jitter_xy: Iterable[float] = (0.0, 0.0)) -> np.ndarray:
+    """xy translation of ``mover`` along the line between the box centres that separates the boxes in x or y.
+
+    The gap left is PENETRATION_FIX_MARGIN_M plus ``jitter_xy`` (both objects' randomization half-ranges, per axis),
+    so the objects stay apart at every reset.
+    """
+    jitter = list(jitter_xy)
+    c_m, c_o = (mover_lo[:2] + mover_hi[:2]) / 2, (other_lo[:2] + other_hi[:2]) / 2
+    u = c_m - c_o
+    n = float(np.linalg.norm(u))
+    if n < 1e-3:  # centres on one vertical line: move towards the table's centre line y = 0
+        u = np.array([0.0, -1.0 if fallback_y > 0 else 1.0])
+    else:
+        u = u / n
+    need = []
+    for i in range(2):
+        if abs(u[i]) < 1e-6:
+            continue
+        overlap = other_hi[i] - mover_lo[i] if u[i] > 0 else mover_hi[i] - other_lo[i]
+        need.append((max(overlap, 0.0) + PENETRATION_FIX_MARGIN_M + jitter[i]) / abs(u[i]))
+    t = min(need) if need else PENETRATION_FIX_MARGIN_M
+    return u * t
+
+
+def _moves(obj: str, dxy: Iterable[float]) -> tuple[Directive, ...]:
+    """move_x / move_y directives for an xy translation, rounded to mm away from zero (components < 0.5 mm dropped)."""
+    out = []
+    for axis, d in zip("xy", dxy):
+        if abs(d) >= 5e-4:
+            out.append(Directive.move(obj, axis, math.copysign(math.ceil(abs(d) * 1000) / 1000, d)))
+    return tuple(out)
+
+
+def _scale_factor(scale: float, target: float) -> float:
+    """Factor (4 decimals) that takes ``scale`` to about ``target``, rounded so the result stays in SCALE_RANGE."""
+    lo, hi = SCALE_RANGE
+    target = min(max(target, lo), hi)
+    f = target / scale
+    f = math.floor(f * 1e4) / 1e4 if f < 1 else math.ceil(f * 1e4) / 1e4
+    while scale * f > hi:
+        f -= 1e-4
+    while scale * f < lo:
+        f += 1e-4
+    return round(f, 4)
+
+
+# ----------------------------------------------------------------------------------------------- checks
+def _task_objects(spec: TaskSpec) -> set[str]:
+    names = {s.target for s in spec.stages if s.target}
+    for c in spec.success.conditions:
+        names.add(c.object)
+        if c.target and c.target != "goal":
+            names.add(c.target)
+    return names & {o.name for o in spec.objects} or {o.name for o in spec.objects}
+
+
+def _grasped(spec: TaskSpec, name: str) -> bool:
+    if any(s.target == name and _GRASP_WORDS.search(s.instruction) for s in spec.stages):
+        return True
+    return any(c.object == name and c.type in ("lifted", "inside") for c in spec.success.conditions)
+
+
+def _position_fixes(spec: TaskSpec, placed: dict[str, _Placed], meas_reach: dict, meas_table: dict,
+                    violations: list[Violation]) -> None:
+    bx, by = spec.robot.base_pos_m[:2]
+    base = np.array([bx, by])
+    sx, sy = spec.table.size_m
+    checked = _task_objects(spec)
+    for name, p in placed.items():
+        o = p.spec
+        jitter = math.hypot(*o.randomize.xy_m)
+        lo, hi = p.lo[:2], p.hi[:2]
+        gap = np.maximum(np.maximum(lo - base, base - hi), 0.0)
+        near = float(np.linalg.norm(gap))
+        centre = p.centre_xy
+        d_centre = float(np.linalg.norm(centre - base))
+        meas_reach[name] = {"nearest_m": _r(near), "centre_m": _r(d_centre), "randomize_m": _r(jitter),
+                            "checked": name in checked}
+        on_table = abs(centre[0]) <= sx / 2 and abs(centre[1]) <= sy / 2
+        meas_table[name] = {"centre_xy_m": [_r(centre[0]), _r(centre[1])], "on_table": bool(on_table)}
+        too_far = name in checked and near + jitter > REACH_MAX_M
+        too_close = name in checked and d_centre - jitter < REACH_MIN_M
+        if on_table and not too_far and not too_close:
+            continue
+        # one combined target for the footprint centre: on the table, then within reach
+        half = (hi - lo) / 2
+        target = centre.copy()
+        if not on_table:
+            for i, size in enumerate((sx, sy)):
+                room = size / 2 - half[i] - OFF_TABLE_MARGIN_M
+                target[i] = 0.0 if room <= 0 else min(max(target[i], -room), room)
+        rel = target - base
+        dist = float(np.linalg.norm(rel))
+        u = rel / dist if dist > 1e-6 else np.array([1.0, 0.0])
+        t_lo, t_hi = lo + (target - centre), hi + (target - centre)
+        near_t = float(np.linalg.norm(np.maximum(np.maximum(t_lo - base, base - t_hi), 0.0)))
+        if name in checked and near_t + jitter > REACH_MAX_M:
+            target = target - u * (near_t + jitter - (REACH_MAX_M - REACH_MARGIN_M))
+        if name in checked and float(np.linalg.norm(target - base)) - jitter < REACH_MIN_M:
+            target = base + u * (REACH_MIN_M + REACH_MARGIN_M + jitter)
+        fix = _moves(name, target - centre)
+        if not on_table:
+            violations.append(Violation(
+                "off_table", name, f"{name!r} has its footprint centre at ({centre[0]:.3f}, {centre[1]:.3f}) m, "
+                f"outside the {sx} x {sy} m table top (|x| <= {sx / 2}, |y| <= {sy / 2})",
+                measured=float(max(abs(centre[0]) - sx / 2, abs(centre[1]) - sy / 2)), limit=0.0, fix=fix))
+        if too_far:
+            violations.append(Violation(
+                "out_of_reach", name, f"{name!r} is out of reach: its nearest point is {near:.3f} m from the robot "
+                f"base (+{jitter:.3f} m randomization), beyond the {REACH_MAX_M} m the hand reaches",
+                measured=near + jitter, limit=REACH_MAX_M, fix=fix))
+        if too_close:
+            violations.append(Violation(
+                "out_of_reach", name, f"{name!r} is too close to the robot base ({d_centre:.3f} m to its centre, "
+                f"-{jitter:.3f} m randomization); the hand cannot fold back nearer than {REACH_MIN_M} m",
+                measured=d_centre - jitter, limit=REACH_MIN_M, fix=fix))
+
+
+def _support(p: _Placed, placed: dict[str, _Placed]) -> tuple[bool, float]:
+    """(supported, clearance it could rest at): resting on the table or over another object reaching up to it."""
+    bottom = float(p.lo[2])
+    if bottom <= SUPPORT_TOL_M:
+        return True, 0.0
+    c = p.centre_xy
+    rest = 0.0
+    for other in placed.values():
+        if other is p:
+            continue
+        if not (other.lo[0] <= c[0] <= other.hi[0] and other.lo[1] <= c[1] <= other.hi[1]):
+            continue
+        if other.lo[2] - SUPPORT_TOL_M <= bottom <= other.hi[2] + SUPPORT_TOL_M:
+            return True, bottom
+        if other.hi[2] < bottom:  # below it: where it would land
+            land = (float(other.lo[2]) + CONTAINER_FLOOR_M * other.spec.scale if other.is_container
+                    else float(other.hi[2]))
+            rest = max(rest, land)
+    return False, rest
+
+
+def _unsupported(placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> dict[str, tuple]:
+    fixes: dict[str, tuple[Directive, ...]] = {}
+    for name, p in placed.items():
+        ok, rest = _support(p, placed)
+        bottom = float(p.lo[2])
+        meas[name] = {"clearance_m": _r(bottom), "supported": ok}
+        if ok:
+            continue
+        drop = bottom - rest
+        fix = (Directive.move(name, "z", -math.floor(drop * 1000) / 1000),) if drop >= 1e-3 else ()
+        fixes[name] = fix
+        where = "the table" if rest == 0.0 else f"what is below it (top at {rest:.3f} m)"
+        violations.append(Violation(
+            "unsupported", name, f"{name!r} floats {bottom:.3f} m above the table with nothing under it; it would "
+            f"fall {drop:.3f} m onto {where}", measured=bottom, limit=SUPPORT_TOL_M, fix=fix))
+    return fixes
+
+
+def _overlaps(placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+    names = list(placed)
+    meas["_method"] = "catalog bounding boxes placed by the spec"
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            pa, pb = placed[a], placed[b]
+            depth = float(np.min(np.minimum(pa.hi, pb.hi) - np.maximum(pa.lo, pb.lo)))
+            if depth <= PENETRATION_TOL_M:
+                continue
+            inside = [(x, y) for x, y in ((pa, pb), (pb, pa))
+                      if y.is_container and _footprint_inside(x.lo, x.hi, y.lo, y.hi) and x.lo[2] > SUPPORT_TOL_M]
+            if inside:
+                meas.setdefault(inside[0][0].spec.name, {})["inside_container"] = inside[0][1].spec.name
+                continue
+            mover, other = _pick_mover(pa, pb)
+            fix = _moves(mover.spec.name, _separating_move(mover.lo, mover.hi, other.lo, other.hi,
+                                                           float(other.centre_xy[1]), _jitter(pa, pb)))
+            meas.setdefault(a, {})[b] = _r(depth)
+            violations.append(Violation(
+                "penetration", mover.spec.name, f"{a!r} and {b!r} overlap by {depth:.3f} m (bounding boxes as placed)",
+                measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=other.spec.name))
+
+
+def _jitter(*placed: _Placed) -> np.ndarray:
+    """Sum of the objects' xy randomization half-ranges, per axis."""
+    return np.sum([p.spec.randomize.xy_m for p in placed], axis=0)
+
+
+def _pick_mover(pa: _Placed, pb: _Placed) -> tuple[_Placed, _Placed]:
+    """(the one to move, the other): a movable one before a fixed one, then the smaller footprint."""
+    key = [(p.spec.fixed, p.area) for p in (pa, pb)]
+    return (pa, pb) if key[0] <= key[1] else (pb, pa)
+
+
+def _scale_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+    rlo, rhi = REALISTIC_SCALE_RANGE
+    for name, p in placed.items():
+        o, rec = p.spec, p.record
+        width = _min_width_xy(p.corners)
+        size = max(rec.size_m) * o.scale
+        grasped = _grasped(spec, name) and "graspable" in rec.tags and not rec.articulated
+        meas[name] = {"scale": o.scale, "min_width_m": _r(width), "max_extent_m": _r(size), "grasped": grasped}
+        if grasped and width > GRASP_MAX_WIDTH_M:
+            f = _scale_factor(o.scale, o.scale * GRASP_MAX_WIDTH_M * GRASP_FIX_FILL / width)
+            enough = width * f <= GRASP_MAX_WIDTH_M
+            violations.append(Violation(
+                "scale", name, f"{name!r} is too big for the ShadowHand to grasp: {width:.3f} m wide at scale "
+                f"{o.scale:g} (at most {GRASP_MAX_WIDTH_M} m)" + ("" if enough else
+                f"; even the smallest scale {SCALE_RANGE[0]} leaves it {width * f:.3f} m wide, use another asset"),
+                measured=width, limit=GRASP_MAX_WIDTH_M, fix=(Directive.scale(name, f),) if f != 1 else ()))
+        elif grasped and size < GRASP_MIN_SIZE_M:
+            f = _scale_factor(o.scale, o.scale * GRASP_MIN_SIZE_M / GRASP_FIX_FILL / size)
+            violations.append(Violation(
+                "scale", name, f"{name!r} is too small to grasp: {size:.3f} m at scale {o.scale:g} (at least "
+                f"{GRASP_MIN_SIZE_M} m)", measured=size, limit=GRASP_MIN_SIZE_M,
+                fix=(Directive.scale(name, f),) if f != 1 else ()))
+        if not rlo <= o.scale <= rhi:
+            f = _scale_factor(o.scale, min(max(o.scale, rlo), rhi))
+            violations.append(Violation(
+                "scale", name, f"{name!r} at scale {o.scale:g} is {size:.2f} m across: far from the real size of a "
+                f"{rec.category} (realistic scales {rlo}-{rhi})", measured=o.scale,
+                limit=rlo if o.scale < rlo else rhi, fix=(Directive.scale(name, f),), severity="warning"))
+
+
+def _intent(text: str) -> str | None:
+    for m in _INTENT.finditer(text):
+        after = {w.lower() for w in re.findall(r"\w+", m.group("after"))}
+        if after & _HAND_WORDS:
+            continue
+        return "open" if m.group("verb").lower().startswith("open") else "close"
+    return None
+
+
+def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+    for name, p in placed.items():
+        rec = p.record
+        if not rec.articulated or not rec.joints:
+            continue
+        intent, source = None, None
+        for s in spec.stages:
+            if s.target == name:
+                intent = _intent(s.instruction)
+                if intent:
+                    source = f"stage {s.name!r} ({s.instruction!r})"
+                    break
+        conds = [c for c in spec.success.conditions if c.object == name and c.type == "joint_open"]
+        if intent is None and conds:
+            intent, source = "open", "the joint_open success condition"
+        joint_name = next((c.joint for c in conds if c.joint), None)
+        try:
+            joint = rec.joint(joint_name) if joint_name else rec.joints[0]
+        except KeyError:
+            joint = rec.joints[0]
+        q = p.spec.joint_state.get(joint.name, joint.closed_qpos)
+        span = joint.open_qpos - joint.closed_qpos
+        frac = (q - joint.closed_qpos) / span if span else 0.0
+        meas[name] = {"joint": joint.name, "qpos": _r(q), "open_fraction": _r(frac), "intent": intent}
+        if intent == "open" and frac >= JOINT_OPEN_FRACTION:
+            violations.append(Violation(
+                "joint_state", name, f"{name!r} starts {frac:.0%} open ({joint.name} = {q:g}) but {source} "
+                f"asks to open it", measured=frac, limit=JOINT_OPEN_FRACTION,
+                joint_fix={"object": name, "joint": joint.name, "value": joint.closed_qpos}))
+        elif intent == "close" and frac < JOINT_OPEN_FRACTION:
+            violations.append(Violation(
+                "joint_state", name, f"{name!r} starts closed ({frac:.0%} open, {joint.name} = {q:g}) but {source} "
+                f"asks to close it", measured=frac, limit=JOINT_OPEN_FRACTION,
+                joint_fix={"object": name, "joint": joint.name, "value": joint.open_qpos}))
+
+
+def _static(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dict[str, dict], dict[str, _Placed], dict]:
+    placed = {o.name: _place(o) for o in spec.objects}
+    violations: list[Violation] = []
+    meas: dict[str, dict] = {c: {} for c in CHECKS}
+    if overlap:
+        _overlaps(placed, meas["penetration"], violations)
+    unsupported = _unsupported(placed, meas["unsupported"], violations)
+    _position_fixes(spec, placed, meas["out_of_reach"], meas["off_table"], violations)
+    _scale_checks(spec, placed, meas["scale"], violations)
+    _joint_checks(spec, placed, meas["joint_state"], violations)
+    return violations, meas, placed, unsupported
+
+
+def check_scene_static(spec: TaskSpec) -> PhysicalReport:
+    """The checks that need no simulator (module docstring): a quick pre-screen of a scene."""
+    t0 = time.perf_counter()
+    violations, meas, _, _ = _static(spec, overlap=True)
+    meas["floating"]["_method"] = "not measured (needs the simulator)"
+    report = PhysicalReport(spec.name, "static", _ordered(violations), meas, time.perf_counter() - t0)
+    log.info("static physical check of %s: %d violations", spec.name, len(report.violations))
+    return report
+
+
+def check_raw_scales(raw: Mapping) -> list[Violation]:
+    """Scale violations of a raw task mapping (a scale outside SCALE_RANGE keeps it from parsing)."""
+    lo, hi = SCALE_RANGE
+    out = []
+    for i, o in enumerate(raw.get("objects") or []):
+        if not isinstance(o, Mapping) or "scale" not in o:
+            continue
+        name = str(o.get("name", f"objects[{i}]"))
+        s = o["scale"]
+        if isinstance(s, bool) or not isinstance(s, (int, float)) or not math.isfinite(s):
+            out.append(Violation("scale", name, f"{name!r} has scale {s!r}; it must be a number in {lo}-{hi}"))
+            continue
+        if lo <= s <= hi:
+            continue
+        fix = (Directive.scale(name, _scale_factor(s, min(max(s, lo), hi))),) if s > 0 else ()
+        out.append(Violation("scale", name, f"{name!r} has scale {s:g}, outside the allowed range {lo}-{hi}",
+                             measured=float(s), limit=lo if s < lo else hi, fix=fix))
+    return out
+
+
+def apply_joint_fix(spec: TaskSpec, fixes: Mapping | Iterable[Mapping]) -> TaskSpec:
+    """A new TaskSpec with each ``{"object", "joint", "value"}`` written into that object's ``joint_state``.
+
+    DirectiveError for an unknown object or joint, or a value outside the joint's limits.
+    """
+    fixes = [fixes] if isinstance(fixes, Mapping) else list(fixes)
+    raw = spec_to_dict(spec)
+    by_name = {o["name"]: o for o in raw["objects"]}
+    for fx in fixes:
+        name, joint, value = fx.get("object"), fx.get("joint"), fx.get("value")
+        if name not in by_name:
+            raise DirectiveError(f"joint fix {dict(fx)} names object {name!r}, which is not in the scene; "
+                                 f"objects: {', '.join(by_name)}")
+        rec = get_asset(by_name[name]["asset"])
+        joints = [j.name for j in rec.joints]
+        if joint not in joints:
+            raise DirectiveError(f"joint fix {dict(fx)}: {name!r} (asset {rec.id!r}) has no joint {joint!r}; "
+                                 f"joints: {', '.join(joints) or 'none'}")
+        jlo, jhi = rec.joint(joint).limits
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not jlo <= value <= jhi:
+            raise DirectiveError(f"joint fix {dict(fx)}: value {value!r} is outside {joint}'s limits [{jlo}, {jhi}]")
+        by_name[name]["joint_state"] = {**by_name[name]["joint_state"], joint: float(value)}
+    return parse_task_spec(raw, source=f"<{spec.name} after {len(fixes)} joint fixes>")
+
+
+def _ordered(violations: list[Violation]) -> list[Violation]:
+    return sorted(violations, key=lambda v: (CHECKS.index(v.check), v.severity != "error"))
+
+
+# ------------------------------------------------------------------------------------------- simulator
+def _without_randomization(spec: TaskSpec) -> TaskSpec:
+    objects = tuple(dataclasses.replace(o, randomize=RandomizeSpec()) for o in spec.objects)
+    return dataclasses.replace(spec, objects=objects)
+
+
+def _entity_ids(entity) -> list[int]:
+    from mani_skill.utils.structs import Articulation
+
+    if isinstance(entity, Articulation):
+        return [link._objs[0].entity.per_scene_id for link in entity.get_links()]
+    return [obj.per_scene_id for obj in entity._objs]
+
+
+def _contact_penetrations(env, placed: dict[str, _Placed], boxes: dict[str, tuple], start: dict[str, np.ndarray],
+                          meas: dict) -> list[Violation]:
+    """Penetrations in PhysX's contact list (one per object pair; one per object for the table and the robot)."""
+    from gendex_envs.assets.bounds import body_points
+
+    owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in _entity_ids(entity)}
+    robot_links = {link._objs[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
+    table_id = env.table._objs[0].per_scene_id
+    pairs: dict[tuple[str, str], float] = {}  # (object, object) sorted, or (object, "table")
+    robot: dict[str, dict[str, float]] = {}  # object -> robot link -> depth
+    for c in env.scene.px.get_contacts():
+        ids = [b.entity.per_scene_id for b in c.bodies]
+        a, b = (owner.get(i) for i in ids)
+        if a == b:  # inside one articulation, or neither is an object
+            continue
+        if a is None:  # keep the object first
+            a, b, ids = b, a, ids[::-1]
+        depth = -min(p.separation for p in c.points)
+        if b is None and ids[1] in robot_links:
+            links = robot.setdefault(a, {})
+            name = robot_links[ids[1]].name
+            links[name] = max(links.get(name, 0.0), depth)
+            continue
+        if b is None and ids[1] != table_id:
+            continue  # the ground, the goal site
+        key = (a, "table") if b is None else tuple(sorted((a, b)))
+        pairs[key] = max(pairs.get(key, 0.0), depth)
+    meas["_method"] = "PhysX contact separations after one physics step from the reset state"
+    violations: list[Violation] = []
+    for (a, b), depth in sorted(pairs.items()):
+        meas.setdefault(a, {})[b] = _r(depth)
+        if depth <= PENETRATION_TOL_M:
+            continue
+        if b == "table":
+            violations.append(Violation(
+                "penetration", a, f"{a!r} sinks {depth:.3f} m into the table at reset", measured=depth,
+                limit=PENETRATION_TOL_M, fix=(Directive.move(a, "z", math.ceil((depth + 0.002) * 1000) / 1000),),
+                other="table"))
+            continue
+        pm, po = _pick_mover(placed[a], placed[b])
+        (mlo, mhi), (olo, ohi) = boxes[pm.spec.name], boxes[po.spec.name]
+        fix = _moves(pm.spec.name, _separating_move(mlo, mhi, olo, ohi, float((olo[1] + ohi[1]) / 2),
+                                                    _jitter(pm, po)))
+        violations.append(Violation(
+            "penetration", pm.spec.name, f"{a!r} and {b!r} interpenetrate by {depth:.3f} m at reset",
+            measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=po.spec.name))
+    for a, links in sorted(robot.items()):
+        meas.setdefault(a, {}).update({f"robot:{k}": _r(v) for k, v in links.items()})
+        deep = {k: v for k, v in links.items() if v > PENETRATION_TOL_M}
+        if not deep:
+            continue
+        # one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the
+        # object's top (moving away from one finger would push it into the next)
+        lo, hi = boxes[a]
+        pts = [body_points(link._objs[0].entity_pose, link._objs[0].collision_shapes) for link in robot_links.values()]
+        low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
+        obstacle = np.concatenate(low)
+        fix = _moves(a, _separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), float(start[a][1]),
+                                         _jitter(placed[a])))
+        worst = max(deep, key=deep.get)
+        violations.append(Violation(
+            "penetration", a, f"{a!r} and the robot interpenetrate at reset, by {deep[worst]:.3f} m at its "
+            f"{worst} ({len(deep)} link{'s' if len(deep) > 1 else ''}: {', '.join(sorted(deep))}); the robot stands "
+            "at its initial keyframe",
+            measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}"))
+    return violations
+
+
+def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, _Placed],
+                unsupported_fix: dict[str, tuple], off_table: set[str], meas: dict) -> list[Violation]:
+    from gendex_envs.assets.bounds import entity_aabb
+    from gendex_envs.task_env import TaskEnv
+
+    env = TaskEnv(task_spec=_without_randomization(spec), render_backend="none", control_mode="pd_joint_delta_pos")
+    try:
+        env.reset(seed=seed)
+        start = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
+        boxes = {n: entity_aabb(e) for n, e in env.objects.items()}
+
+        env.scene.step()  # one physics step: PhysX lists the contacts of the reset state
+        violations = _contact_penetrations(env, placed, boxes, start, meas["penetration"])
+
+        zero = np.zeros(env.action_space.shape, dtype=np.float32)
+        for _ in range(max(settle_steps - 1, 0)):
+            env.step(zero)
+        before = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
+        env.step(zero)
+        dt = 1.0 / env.control_freq
+        flo = meas["floating"]
+        flo["_method"] = (f"pose change over {settle_steps} control steps ({settle_steps * dt:.2f} s), "
+                          "robot holding still")
+        for name, entity in env.objects.items():
+            end = entity.pose.p[0].numpy()
+            drop = float(start[name][2] - end[2])
+            speed = float(np.linalg.norm(end - before[name]) / dt)
+            flo[name] = {"drop_m": _r(drop), "speed_mps": _r(speed),
+                         "moved_m": _r(float(np.linalg.norm(end - start[name])))}
+            if spec.object(name).fixed or name in off_table:
+                continue
+            if drop > FALL_TOL_M:
+                fix = unsupported_fix.get(name) or (Directive.move(name, "z", -math.floor((drop - 0.002) * 1000)
+                                                                   / 1000),)
+                violations.append(Violation(
+                    "floating", name, f"{name!r} fell {drop:.3f} m while the scene settled: it was placed above "
+                    f"what supports it", measured=drop, limit=FALL_TOL_M, fix=fix))
+            elif speed > MOVING_TOL_MPS:
+                violations.append(Violation(
+                    "floating", name, f"{name!r} still moves at {speed:.3f} m/s after the scene settled for "
+                    f"{settle_steps * dt:.2f} s: it does not rest stably", measured=speed, limit=MOVING_TOL_MPS))
+        return violations
+    finally:
+        env.close()
+
+
+def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STEPS) -> PhysicalReport:
+    """All checks, penetration and floating measured in the simulator (module docstring)."""
+    if settle_steps < 1:
+        raise ValueError(f"settle_steps={settle_steps} must be >= 1")
+    t0 = time.perf_counter()
+    violations, meas, placed, unsupported_fix = _static(spec, overlap=False)
+    off = {v.object for v in violations if v.check == "off_table"}
+    violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
+    report = PhysicalReport(spec.name, "sim", _ordered(violations), meas, time.perf_counter() - t0)
+    log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
+    return report

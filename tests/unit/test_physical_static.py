@@ -1,0 +1,241 @@
+"""The critic's simulator-free physical checks (generator.critic.physical.check_scene_static) and their fixes."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import pytest
+
+from gendex_envs.registry import REPO_TASKS_DIR
+from gendex_envs.spec import (
+    SCALE_RANGE,
+    TaskSpec,
+    load_task_spec,
+    parse_task_spec,
+    spec_to_dict,
+)
+from generator.critic.directives import Directive, apply_directives
+from generator.critic.physical import (
+    GRASP_MAX_WIDTH_M,
+    REACH_MAX_M,
+    REACH_MIN_M,
+    apply_joint_fix,
+    check_raw_scales,
+    check_scene_static,
+)
+from generator.errors import DirectiveError
+
+SEEDS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
+
+
+def seed(name: str) -> TaskSpec:
+    return load_task_spec(REPO_TASKS_DIR / name / "v0" / "task.yaml")
+
+
+def edited(name: str, **changes) -> TaskSpec:
+    """Seed task ``name`` with per-object field changes: edited('X', apple={'pos_m': [...]})."""
+    raw = spec_to_dict(seed(name))
+    for obj in raw["objects"]:
+        obj.update(changes.get(obj["name"], {}))
+    return parse_task_spec(raw)
+
+
+def checks(report) -> list[tuple[str, str | None]]:
+    return [(v.check, v.object) for v in report.violations]
+
+
+@pytest.mark.parametrize("name", SEEDS)
+def test_seed_tasks_pass(name):
+    report = check_scene_static(seed(name))
+    assert report.violations == [], report.summary()
+    assert report.ok and report.mode == "static"
+    assert report.summary() == "no physical problems found"
+    json.dumps(report.to_dict())  # JSON-able
+
+
+def test_seed_objects_are_within_the_reach_limit_with_margin_to_spare():
+    for name in SEEDS:
+        meas = check_scene_static(seed(name)).measurements["out_of_reach"]
+        for obj, m in meas.items():
+            assert REACH_MIN_M < m["centre_m"] and m["nearest_m"] + m["randomize_m"] <= REACH_MAX_M, (name, obj, m)
+
+
+def test_far_object_is_off_table_and_out_of_reach_with_one_shared_fix():
+    spec = edited("PutAppleBowl", apple={"pos_m": [2.0, 0.12, 0.0]})
+    report = check_scene_static(spec)
+    assert sorted(checks(report)) == [("off_table", "apple"), ("out_of_reach", "apple")]
+    off, far = report.by_check("off_table")[0], report.by_check("out_of_reach")[0]
+    assert far.measured > REACH_MAX_M and far.limit == REACH_MAX_M and off.measured == pytest.approx(1.2)
+    assert off.fix == far.fix and len(report.directives()) == len(off.fix) >= 1
+    fixed = apply_directives(spec, report.directives())
+    assert check_scene_static(fixed).violations == []
+    assert json.loads(report.to_json())["violations"][0]["fix"] == [str(d) for d in off.fix]
+
+
+def test_object_at_the_robot_base_is_too_close():
+    spec = edited("PickUpBottle", bottle={"pos_m": [-0.7, 0.0, 0.0]})
+    (v,) = check_scene_static(spec).violations
+    assert (v.check, v.limit) == ("out_of_reach", REACH_MIN_M) and "too close" in v.message
+    assert check_scene_static(apply_directives(spec, v.fix)).violations == []
+
+
+def test_untargeted_distractor_far_away_is_not_a_reach_problem():
+    raw = spec_to_dict(seed("PickUpBottle"))
+    raw["objects"].append({"name": "decor", "asset": "plate", "pos_m": [0.7, 0.5, 0.0]})
+    report = check_scene_static(parse_task_spec(raw))
+    assert report.violations == [], report.summary()
+    assert report.measurements["out_of_reach"]["decor"]["checked"] is False
+
+
+def test_floating_object_is_unsupported_and_move_z_fixes_it():
+    spec = edited("PickUpBottle", bottle={"pos_m": [0.18, -0.16, 0.3]})
+    (v,) = check_scene_static(spec).violations
+    assert (v.check, v.object, v.measured) == ("unsupported", "bottle", pytest.approx(0.3))
+    assert v.fix == (Directive.move("bottle", "z", -0.3),)
+    assert check_scene_static(apply_directives(spec, v.fix)).violations == []
+
+
+def test_stacked_and_contained_objects_are_supported():
+    raw = spec_to_dict(seed("PickUpBottle"))
+    raw["objects"] += [{"name": "base_block", "asset": "block_large", "pos_m": [0.1, 0.2, 0.0]},
+                       {"name": "top_block", "asset": "block_small", "pos_m": [0.1, 0.2, 0.06]}]
+    assert check_scene_static(parse_task_spec(raw)).violations == []
+    in_bowl = edited("PutAppleBowl", apple={"pos_m": [0.12, -0.16, 0.01]})
+    assert check_scene_static(in_bowl).violations == []
+
+
+def test_object_high_above_a_container_is_lowered_into_it():
+    spec = edited("PutAppleBowl", apple={"pos_m": [0.12, -0.16, 0.2]})
+    (v,) = check_scene_static(spec).violations
+    assert v.check == "unsupported"
+    fixed = apply_directives(spec, v.fix)
+    assert 0.005 <= fixed.object("apple").pos_m[2] <= 0.02  # rests on the bowl's floor, not on the table
+    assert check_scene_static(fixed).violations == []
+
+
+def test_overlapping_objects_penetrate_and_the_fix_separates_them():
+    spec = edited("PutAppleBowl", apple={"pos_m": [0.12, -0.10, 0.0]})
+    (v,) = check_scene_static(spec).violations
+    assert (v.check, v.object, v.other) == ("penetration", "apple", "bowl")
+    assert "bounding boxes" in v.message
+    assert check_scene_static(apply_directives(spec, v.fix)).violations == []
+    # apple sunk into the bowl's floor at its centre: moved out sideways, towards the table's centre line
+    centre = edited("PutAppleBowl", apple={"pos_m": [0.12, -0.16, 0.0]})
+    (v,) = check_scene_static(centre).violations
+    assert v.check == "penetration" and v.fix[0].op == "move_y" and v.fix[0].value > 0
+    assert check_scene_static(apply_directives(centre, v.fix)).violations == []
+
+
+def test_penetration_fix_moves_the_movable_smaller_object_clear_of_randomization():
+    raw = spec_to_dict(seed("PutAppleBowl"))
+    raw["objects"] = [raw["objects"][1],
+                      {"name": "block", "asset": "block_large", "pos_m": [0.14, -0.14, 0.0],
+                       "randomize": {"xy_m": [0.02, 0.02]}}]
+    raw["stages"] = raw["stages"][2:3]
+    raw["success"]["conditions"] = [{"type": "inside", "object": "block", "target": "bowl"}]
+    spec = parse_task_spec(raw)
+    (v,) = check_scene_static(spec).violations
+    assert v.object == "block"  # the block's footprint is smaller than the bowl's
+    fixed = apply_directives(spec, v.fix)
+    bowl, block = fixed.object("bowl"), fixed.object("block")
+    gap = max(abs(bowl.pos_m[0] - block.pos_m[0]), abs(bowl.pos_m[1] - block.pos_m[1])) - 0.075 - 0.03
+    assert gap >= 0.01 + 0.03 + 0.02 - 1e-6  # margin + both objects' randomization half-ranges
+
+
+def test_raw_scales_out_of_range_get_a_factor_back_into_range():
+    raw = spec_to_dict(seed("PutAppleBowl"))
+    raw["objects"][0]["scale"] = 3.0
+    raw["objects"][1]["scale"] = 0.1
+    big, small = check_raw_scales(raw)
+    assert (big.check, big.object, big.measured, big.limit) == ("scale", "apple", 3.0, SCALE_RANGE[1])
+    assert (small.object, small.limit) == ("bowl", SCALE_RANGE[0])
+    spec = apply_directives(raw, [*big.fix, *small.fix])
+    assert SCALE_RANGE[0] <= spec.object("bowl").scale <= SCALE_RANGE[1]
+    assert spec.object("apple").scale == pytest.approx(2.0, abs=1e-3)
+    assert check_raw_scales(spec_to_dict(seed("PutAppleBowl"))) == []
+    raw["objects"][0]["scale"] = "big"
+    (bad, _) = check_raw_scales(raw)
+    assert bad.fix == () and "'big'" in bad.message
+
+
+def test_grasped_object_too_wide_for_the_hand():
+    spec = edited("PickUpBottle", bottle={"asset": "softball", "scale": 1.5})  # 14.4 cm ball
+    report = check_scene_static(spec)
+    (v,) = report.violations
+    assert v.check == "scale" and v.measured == pytest.approx(0.144, abs=1e-3) and v.limit == GRASP_MAX_WIDTH_M
+    fixed = apply_directives(spec, report.directives())
+    assert check_scene_static(fixed).violations == []
+    assert fixed.object("bottle").scale * 0.096 <= GRASP_MAX_WIDTH_M
+    # the bowl in PutAppleBowl is wider, but only carried to, not grasped
+    assert check_scene_static(edited("PutAppleBowl", bowl={"scale": 1.0})).violations == []
+
+
+def test_grasped_object_too_small_and_absurd_scales():
+    tiny = edited("PickUpBottle", bottle={"asset": "dice", "scale": 0.5})
+    report = check_scene_static(tiny)
+    assert ("scale", "bottle") in checks(report) and not report.ok
+    assert check_scene_static(apply_directives(tiny, report.directives())).ok
+    big_bowl = check_scene_static(edited("PutAppleBowl", bowl={"scale": 1.8}))
+    (w,) = big_bowl.violations
+    assert w.severity == "warning" and w.check == "scale" and big_bowl.ok
+    assert big_bowl.directives() == [] and big_bowl.directives(include_warnings=True) == list(w.fix)
+
+
+def _cabinet(door: float, first_instruction: str | None = None) -> TaskSpec:
+    raw = spec_to_dict(seed("OpenCabinet"))
+    raw["objects"][0]["joint_state"] = {"door_hinge": door}
+    if first_instruction is not None:
+        raw["stages"][0]["instruction"] = first_instruction
+    return parse_task_spec(raw)
+
+
+def test_cabinet_starting_open_for_an_open_stage():
+    spec = _cabinet(1.2, "Open the door.")
+    report = check_scene_static(spec)
+    (v,) = report.violations
+    assert (v.check, v.object, v.fix) == ("joint_state", "cabinet", ())
+    assert v.measured == pytest.approx(1.2 / 1.4) and "'Open the door.'" in v.message
+    assert report.joint_fixes() == [{"object": "cabinet", "joint": "door_hinge", "value": 0.0}]
+    fixed = apply_joint_fix(spec, report.joint_fixes())
+    assert fixed.object("cabinet").joint_state == {"door_hinge": 0.0}
+    assert check_scene_static(fixed).violations == []
+
+
+def test_hand_words_are_not_intents_and_conditions_are_the_fallback():
+    # the seed's first stage says "Move the open hand ...": not about the door; the pull stage ("... is open") is
+    spec = _cabinet(1.0)
+    (v,) = check_scene_static(spec).violations
+    assert "pull_door" in v.message
+    raw = spec_to_dict(spec)
+    for s in raw["stages"]:
+        s["instruction"] = "Move the open hand to the handle."
+    (v,) = check_scene_static(parse_task_spec(raw)).violations
+    assert "joint_open success condition" in v.message
+    assert check_scene_static(_cabinet(0.5)).violations == []  # 36 % open: still to be opened
+
+
+def test_close_stage_with_the_door_already_closed():
+    spec = _cabinet(0.0, "Close the cabinet door.")
+    (v,) = check_scene_static(spec).violations
+    assert v.check == "joint_state" and v.joint_fix == {"object": "cabinet", "joint": "door_hinge", "value": 1.4}
+    assert apply_joint_fix(spec, v.joint_fix).object("cabinet").joint_state["door_hinge"] == 1.4
+
+
+def test_apply_joint_fix_rejects_bad_fixes():
+    spec = seed("OpenCabinet")
+    with pytest.raises(DirectiveError, match="'drawer'"):
+        apply_joint_fix(spec, {"object": "drawer", "joint": "door_hinge", "value": 0.0})
+    with pytest.raises(DirectiveError, match="no joint 'lid'"):
+        apply_joint_fix(spec, {"object": "cabinet", "joint": "lid", "value": 0.0})
+    with pytest.raises(DirectiveError, match="outside"):
+        apply_joint_fix(spec, {"object": "cabinet", "joint": "door_hinge", "value": 3.0})
+    with pytest.raises(DirectiveError, match="no joint"):
+        apply_joint_fix(seed("PickUpBottle"), {"object": "bottle", "joint": "x", "value": 0.0})
+
+
+def test_report_does_not_modify_the_spec():
+    spec = edited("PutAppleBowl", apple={"pos_m": [2.0, 0.12, 0.3]})
+    before = copy.deepcopy(spec_to_dict(spec))
+    check_scene_static(spec)
+    assert spec_to_dict(spec) == before
