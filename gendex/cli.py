@@ -210,6 +210,8 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              seed: int = typer.Option(0, "--seed", help="Seed of the offline author and of scene resets."),
              out: Path = typer.Option(Path("generated_tasks"), "--out", help="Task root to commit into."),
              model: str = typer.Option(None, "--model", help="Model id for the anthropic backend."),
+             candidates: int = typer.Option(3, "--candidates", min=1, help="Scene candidates per task; the best "
+                                                                           "one is refined."),
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a transcript.jsonl (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
@@ -257,7 +259,8 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 rows.append(summary)
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
-            run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress)
+            run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
+                         candidates=candidates)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")

@@ -28,14 +28,12 @@ from generator.stages.plan import plan_stages
 from generator.stages.propose import propose
 from generator.stages.refine import refine
 from generator.stages.reward import write_rewards
-from generator.stages.scene import write_scene
+from generator.stages.scene import N_CANDIDATES, write_scene
 
 log = logging.getLogger(__name__)
 
 MAX_TASK_ATTEMPTS = 3
 """Proposals tried per task before giving up on it (a scene that cannot be refined clean starts over)."""
-BLOCKING_CHECKS = ("penetration", "floating", "off_table", "out_of_reach", "scale")
-"""Violations that keep a task from being committed when refinement cannot remove them."""
 
 
 def generator_version() -> str:
@@ -50,6 +48,8 @@ class TaskSummary:
     """One generated task, for the CLI's per-task summary."""
 
     committed: CommittedTask
+    candidate_violations: tuple[float, ...]
+    """Static-check violations of each scene candidate (the best one is refined)."""
     violations_before: int
     violations_after: int
     refine_rounds: int
@@ -84,7 +84,8 @@ def _existing_names(root: Path) -> tuple[str, ...]:
 
 
 def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, index: int, seed: int,
-                  instruction: str | None, command: str, existing: tuple[str, ...] = ()) -> TaskSummary:
+                  instruction: str | None, command: str, existing: tuple[str, ...] = (),
+                  candidates: int = N_CANDIDATES) -> TaskSummary:
     """Generate, validate and commit one task. ``backend_factory(transcript_path)`` gives the (recording) backend."""
     t0 = time.perf_counter()
     staged = new_staging(root)
@@ -95,13 +96,12 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
             proposal, rejected = propose(backend, index=index + 1000 * attempt, existing=existing,
                                          instruction=instruction)
             reasons += rejected
-            spec, candidates = write_scene(backend, proposal, index=index + 1000 * attempt)
+            spec, scenes = write_scene(backend, proposal, index=index + 1000 * attempt, n_candidates=candidates)
             before = render_spec(spec, seed=seed)
             refined, refine_log = refine(backend, spec, seed=seed)
-            remaining = [v for r in refine_log.rounds[-1:] for v in r.violations] if refine_log.violations_after else []
-            blocking = [v for v in remaining if v.split(":", 1)[0] in BLOCKING_CHECKS]
-            if refine_log.violations_after and (blocking or not remaining):
-                reasons.append(f"{proposal.name}: {refine_log.violations_after} violation(s) left after refinement")
+            if refine_log.remaining:
+                reasons.append(f"{proposal.name}: {len(refine_log.remaining)} violation(s) left after refinement "
+                               f"({'; '.join(refine_log.remaining[:3])})")
                 log.info("task %d attempt %d: %s; proposing again", index, attempt + 1, reasons[-1])
                 existing = (*existing, proposal.name)
                 continue
@@ -117,7 +117,7 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
         rewards = write_rewards(backend, planned, proposal, staged)
         _write(staged / "proposal.json", to_json(proposal))
         _write(staged / "scene_candidates.json",
-               json.dumps([dataclasses.asdict(c) for c in candidates], indent=2) + "\n")
+               json.dumps([dataclasses.asdict(c) for c in scenes], indent=2) + "\n")
         _write(staged / "critique.json", to_json(refine_log))
         _write(staged / "reward_attempts.json", json.dumps(
             {"attempts": [dataclasses.asdict(a) for a in rewards.attempts], "probes": rewards.reports},
@@ -132,7 +132,7 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
                               instruction=instruction, command=command)
         _write(staged / "generation.json", to_json(info))
         committed = commit_task(root, proposal.name, staged)
-        return TaskSummary(committed, refine_log.violations_before, refine_log.violations_after,
+        return TaskSummary(committed, tuple(c.score for c in scenes), refine_log.violations_before, refine_log.violations_after,
                            len(refine_log.rounds), time.perf_counter() - t0)
     finally:
         if staged.exists():
@@ -140,8 +140,8 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
 
 
 def generate(backend_factory: Callable[[Path], Backend], root: Path, *, n: int = 1, seed: int = 0,
-             instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None
-             ) -> list[TaskSummary]:
+             instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None,
+             candidates: int = N_CANDIDATES) -> list[TaskSummary]:
     """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again."""
     root.mkdir(parents=True, exist_ok=True)
     clean_staging(root)
@@ -149,7 +149,7 @@ def generate(backend_factory: Callable[[Path], Backend], root: Path, *, n: int =
     existing = _existing_names(root)
     for i in range(n):
         summary = generate_task(backend_factory, root, index=i, seed=seed, instruction=instruction,
-                                command=command, existing=existing)
+                                command=command, existing=existing, candidates=candidates)
         existing = (*existing, summary.committed.name)
         out.append(summary)
         if progress is not None:

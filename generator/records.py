@@ -72,6 +72,8 @@ class RefineLog:
     rounds: tuple[CritiqueRound, ...]
     violations_before: int
     violations_after: int
+    remaining: tuple[str, ...] = ()
+    """Error violations still measured after the last round."""
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ validators as a model's:
     keyword matching of the instruction's verb (grab / put / open / ...) and nouns against catalog ids,
     categories and tags; an object the catalog lacks is replaced by the closest id (string similarity).
 ``scene``
-    a naive layout sampler: objects at random spots of the table's near half, scale 1. It checks nothing on
+    a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1. It checks nothing on
     purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
 ``plan``
     one stage per proposal step (approach / move -> motion planning; finger and contact work -> RL).
@@ -272,10 +272,11 @@ class OfflineBackend:
         objects = []
         for o in proposal["objects"]:
             a = assets[o["asset"]]
+            # anywhere on the table top in front of the robot; reach, overlaps and support are the critic's job
             if o["role"] == "articulated":
-                x, y = rng.uniform(0.35, 0.75), rng.uniform(-0.35, 0.35)
+                x, y = rng.uniform(0.3, 0.75), rng.uniform(-0.45, 0.45)
             else:
-                x, y = rng.uniform(-0.2, 0.45), rng.uniform(-0.4, 0.4)
+                x, y = rng.uniform(-0.35, 0.7), rng.uniform(-0.55, 0.55)
             entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
             if o["role"] == "articulated":
                 j = a["joints"][0]

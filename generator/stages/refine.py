@@ -39,30 +39,54 @@ def _vision_directives(backend: Backend, spec: TaskSpec, findings: str) -> tuple
         return answer, [], [str(exc)]
 
 
+def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpec, list[str], list[str]]:
+    """Apply the measured fixes, then the critic's directives, one at a time; returns (spec, applied, rejected)."""
+    from generator.critic.directives import apply_directives  # noqa: PLC0415
+    from generator.critic.physical import apply_joint_fix  # noqa: PLC0415
+
+    applied: list[str] = []
+    rejected: list[str] = []
+    directives = report.directives()
+    directives += [d for d in model_directives if d not in directives]
+    for d in directives:
+        try:
+            spec = apply_directives(spec, [d])
+            applied.append(str(d))
+        except DirectiveError as exc:
+            rejected.append(f"{d}: {exc}")
+    for fix in report.joint_fixes():
+        try:
+            spec = apply_joint_fix(spec, fix)
+            applied.append(f"Joint_State: {fix['object']} - {fix['joint']} {fix['value']}")
+        except DirectiveError as exc:
+            rejected.append(f"joint fix {fix}: {exc}")
+    return spec, applied, rejected
+
+
 def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS, seed: int = 0) -> tuple[TaskSpec, RefineLog]:
     """Refine ``spec``; returns the refined spec and the log (violations before and after, every round)."""
-    from generator.critic.physical import apply_fixes, check_scene  # noqa: PLC0415
+    from generator.critic.physical import check_scene  # noqa: PLC0415
 
     rounds: list[CritiqueRound] = []
     before: int | None = None
     for r in range(max_rounds + 1):
         report = check_scene(spec, seed=seed)
-        violations = list(report.violations)
+        errors = report.errors
         if before is None:
-            before = len(violations)
+            before = len(errors)
         if r == max_rounds:
             break
         analysis, model_directives, rejected = "", [], []
         if backend.sees_images:
-            findings = "\n".join(f"- {v}" for v in violations) or "- no violations measured"
-            analysis, model_directives, rejected = _vision_directives(backend, spec, findings)
-        if not violations and not model_directives:
+            analysis, model_directives, rejected = _vision_directives(backend, spec, report.summary())
+        if not errors and not model_directives:
             break
-        new_spec, applied, failed = apply_fixes(spec, violations, model_directives)
-        rounds.append(CritiqueRound(round=r, violations=tuple(str(v) for v in violations), analysis=analysis,
-                                    directives=tuple(applied), rejected=tuple(rejected + failed)))
-        log.info("refine round %d: %d violation(s), %d directive(s) applied", r, len(violations), len(applied))
+        new_spec, applied, failed = apply_fixes(spec, report, model_directives)
+        rounds.append(CritiqueRound(round=r, violations=tuple(f"{v.check}: {v.message}" for v in report.violations),
+                                    analysis=analysis, directives=tuple(applied), rejected=tuple(rejected + failed)))
+        log.info("refine round %d: %d violation(s), %d directive(s) applied", r, len(errors), len(applied))
         if not applied:
             break
         spec = new_spec
-    return spec, RefineLog(rounds=tuple(rounds), violations_before=before or 0, violations_after=len(violations))
+    return spec, RefineLog(rounds=tuple(rounds), violations_before=before or 0, violations_after=len(errors),
+                           remaining=tuple(f"{v.check}: {v.message}" for v in errors))

@@ -81,7 +81,7 @@ def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:
     from generator.critic.physical import check_scene_static  # noqa: PLC0415
 
     report = check_scene_static(spec)
-    return float(len(report.violations)), tuple(str(v) for v in report.violations)
+    return float(len(report.errors)), tuple(f"{v.check}: {v.message}" for v in report.errors)
 
 
 def write_scene(backend: Backend, proposal: Proposal, *, index: int = 0, n_candidates: int = N_CANDIDATES,

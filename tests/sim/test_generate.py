@@ -1,0 +1,190 @@
+"""The generator pipeline end to end: offline generation, replay, human-guided tasks, and adversarial answers."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import gymnasium as gym
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from gendex_envs.registry import register_tasks
+from generator.backends.base import ModelResponse
+from generator.backends.offline import OfflineBackend
+from generator.backends.transcript import RecordingBackend, ReplayBackend
+from generator.errors import RetriesExhaustedError
+from generator.pipeline import generate
+from generator.stages.commit import REQUIRED_FILES, STAGING
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _offline(seed: int = 0):
+    return lambda path: RecordingBackend(OfflineBackend(seed=seed), path)
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _task_folders(root: Path) -> list[Path]:
+    return sorted(p for p in root.glob("*/v*") if p.is_dir())
+
+
+@pytest.fixture(scope="module")
+def offline_run(tmp_path_factory):
+    root = tmp_path_factory.mktemp("gen")
+    summaries = generate(_offline(0), root, n=1, seed=0, command="test")
+    return root, summaries
+
+
+def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
+    root, summaries = offline_run
+    [folder] = _task_folders(root)
+    assert folder == summaries[0].committed.path
+    for f in REQUIRED_FILES:
+        assert (folder / f).is_file(), f
+    for stage in ("before", "after"):
+        for view in ("left_overhead", "right_overhead", "top_down"):
+            assert (folder / "renders" / f"{stage}_{view}.png").read_bytes()[:4] == b"\x89PNG"
+    info = json.loads((folder / "generation.json").read_text())
+    assert info["backend"] == "offline" and info["is_language_model"] is False and info["seed"] == 0
+    assert not list((root / STAGING).iterdir())  # nothing left half-written
+    env_id = summaries[0].committed.env_id
+    assert env_id in register_tasks([root], override=True)
+    env = gym.make(env_id)
+    try:
+        check_env(env, skip_render_check=True)
+    finally:
+        env.close()
+
+
+def test_replayed_transcript_reproduces_the_task_files(offline_run, tmp_path):
+    root, summaries = offline_run
+    src = summaries[0].committed.path
+    replay = generate(lambda path: _copy_then_replay(src / "transcript.jsonl", path), tmp_path, n=1, seed=0,
+                      command="test")
+    assert _tree(replay[0].committed.path) == _tree(src)
+
+
+def _copy_then_replay(transcript: Path, dest: Path):
+    dest.write_bytes(transcript.read_bytes())
+    return ReplayBackend(transcript)
+
+
+def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path):
+    [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction="grab the apple", command="test")
+    spec = json.loads((s.committed.path / "proposal.json").read_text())
+    assert [o["asset"] for o in spec["objects"]] == ["apple"]
+    assert any(st["action"] == "grasp" for st in spec["steps"])
+    assert spec["success"]["type"] == "lifted"
+    text = (s.committed.path / "task.yaml").read_text()
+    assert "asset: apple" in text and "control_joint: hand" in text
+
+
+# ---------------------------------------------------------------- adversarial answers (nothing is committed)
+class Scripted:
+    """A fake language model answering each stage from a list or a function; falls back to the offline author."""
+
+    name = "scripted"
+    model = "scripted-1"
+    sees_images = False
+    is_language_model = True
+
+    def __init__(self, **answers):
+        self.answers = answers
+        self.offline = OfflineBackend(seed=0)
+        self.seen: list[str] = []
+
+    def complete(self, request):
+        self.seen.append(request.stage)
+        a = self.answers.get(request.stage)
+        if a is None:
+            return self.offline.complete(request)
+        text = a(request) if callable(a) else a
+        return ModelResponse(text=text, backend=self.name, model=self.model)
+
+
+_APPLE = ('```json\n{"name": "LiftTheApple", "description": "Lift the apple.", '
+          '"objects": [{"name": "apple", "asset": "%s", "role": "graspable"}], '
+          '"steps": [{"action": "approach", "target": "apple", "control_joint": "arm", "instruction": "Reach."}, '
+          '{"action": "grasp", "target": "apple", "control_joint": "hand", "instruction": "Grasp."}], '
+          '"success": {"type": "lifted", "object": "apple", "target": null, "min_height_m": 0.1}, '
+          '"success_text": "The apple is lifted."}\n```')
+
+
+def _assert_nothing_committed(root: Path) -> None:
+    assert _task_folders(root) == []
+    assert not (root / STAGING).exists() or not list((root / STAGING).iterdir())
+
+
+def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(tmp_path):
+    b = Scripted(propose=_APPLE % "golden_apple_9000")
+    with pytest.raises(RetriesExhaustedError, match="golden_apple_9000.*not in the catalog"):
+        generate(lambda p: b, tmp_path, n=1, command="test")
+    assert b.seen == ["propose"] * 3  # bounded retries
+    _assert_nothing_committed(tmp_path)
+
+
+def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
+    b = Scripted(propose=_APPLE % "apple", scene="```yaml\nname: LiftTheApple\nobjects: [\n  - {name: apple\n```")
+    with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
+        generate(lambda p: b, tmp_path, n=1, command="test")
+    _assert_nothing_committed(tmp_path)
+
+
+def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path):
+    bad = ("```python\nimport os\n\ndef evaluate(env):\n    os.remove('x')\n\n"
+           "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
+    b = Scripted(propose=_APPLE % "apple", reward=bad)
+    with pytest.raises(RetriesExhaustedError, match="os"):
+        generate(lambda p: b, tmp_path, n=1, command="test")
+    _assert_nothing_committed(tmp_path)
+
+
+def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path):
+    nan = ("```python\nimport torch\n\ndef evaluate(env):\n    z = torch.zeros(env.num_envs, dtype=torch.bool, "
+           "device=env.device)\n    return {'success': z, 'fail': z}\n\n"
+           "def compute_dense_reward(env, obs, action, info):\n"
+           "    return torch.full((env.num_envs,), float('nan'), device=env.device)\n```")
+    offline = OfflineBackend(seed=0)
+    calls = []
+
+    def reward(request):
+        calls.append(request.prompt)
+        if len(calls) == 1:
+            return nan
+        return offline.complete(request).text
+
+    b = Scripted(propose=_APPLE % "apple", reward=reward)
+    [s] = generate(lambda p: b, tmp_path, n=1, command="test")
+    attempts = json.loads((s.committed.path / "reward_attempts.json").read_text())["attempts"]
+    assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
+    assert "rejected" in calls[-1] or any("nan" in c.lower() for c in calls[1:])
+
+
+def test_killed_run_leaves_no_partial_task_folder(tmp_path):
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen([sys.executable, "-m", "gendex.cli", "generate", "--backend", "offline", "--n", "3",
+                             "--out", str(tmp_path)], env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and not list(tmp_path.glob(f"{STAGING}/*/task.yaml")):
+            time.sleep(0.2)
+        assert list(tmp_path.glob(f"{STAGING}/*/task.yaml")), "the run never reached the reward stage"
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    for folder in _task_folders(tmp_path):  # tasks committed before the kill are complete
+        assert all((folder / f).is_file() for f in REQUIRED_FILES), folder
+    names = {p.name for p in tmp_path.iterdir()} - {STAGING}
+    assert all(list((tmp_path / n).glob("v*/task.yaml")) for n in names)
+    assert register_tasks([tmp_path], override=True) == [f"GenDex/{f.parent.name}-{f.name}"
+                                                         for f in _task_folders(tmp_path)]
