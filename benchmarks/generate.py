@@ -19,7 +19,6 @@ import time
 from pathlib import Path
 
 from generator.backends.offline import OfflineBackend
-from generator.backends.transcript import RecordingBackend
 from generator.pipeline import generate
 
 TARGET_S = 60.0
@@ -35,7 +34,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="gendex-genbench-") as tmp:
         root = Path(tmp)
         t0 = time.perf_counter()
-        factory = lambda path: RecordingBackend(OfflineBackend(seed=args.seed), path)  # noqa: E731
+        factory = lambda: OfflineBackend(seed=args.seed)  # noqa: E731
         warm = generate(factory, root, n=1, seed=args.seed, command="benchmark warm-up")
         print(f"warm-up task {warm[0].committed.env_id}: {time.perf_counter() - t0:.1f} s")
         times = []

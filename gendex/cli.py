@@ -223,7 +223,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
 
     from gendex_envs.errors import GenDexError  # noqa: PLC0415
     from generator.backends.registry import BACKEND_NAMES, default_backend_name, make_backend  # noqa: PLC0415
-    from generator.backends.transcript import RecordingBackend, ReplayBackend  # noqa: PLC0415
+    from generator.backends.transcript import ReplayBackend  # noqa: PLC0415
     from generator.pipeline import generate as run_generate  # noqa: PLC0415
 
     name = backend or default_backend_name()
@@ -242,14 +242,10 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                     "pass --backend anthropic for Claude.", fg=typer.colors.YELLOW, err=True)
     pending = list(files)
 
-    def factory(path: Path):
+    def factory():
         if name == "replay":
-            import shutil  # noqa: PLC0415
-
-            src = pending.pop(0)
-            shutil.copyfile(src, path)  # the replayed task keeps the transcript it was made from
-            return ReplayBackend(src)
-        return RecordingBackend(make_backend(name, seed=seed, model=model), path)
+            return ReplayBackend(pending.pop(0))
+        return make_backend(name, seed=seed, model=model)
 
     command = "gendex generate " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     rows = []

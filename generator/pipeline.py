@@ -20,6 +20,7 @@ from pathlib import Path
 
 from gendex_envs.spec import dump_task_spec
 from generator.backends.base import Backend
+from generator.backends.transcript import RecordingBackend
 from generator.errors import GeneratorError
 from generator.records import GenerationInfo, to_json
 from generator.render import render_spec
@@ -83,14 +84,15 @@ def _existing_names(root: Path) -> tuple[str, ...]:
     return tuple(sorted(names))
 
 
-def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, index: int, seed: int,
+def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: int, seed: int,
                   instruction: str | None, command: str, existing: tuple[str, ...] = (),
                   candidates: int = N_CANDIDATES) -> TaskSummary:
-    """Generate, validate and commit one task. ``backend_factory(transcript_path)`` gives the (recording) backend."""
+    """Generate, validate and commit one task with a fresh ``backend_factory()``, recording every exchange."""
     t0 = time.perf_counter()
     staged = new_staging(root)
     try:
-        backend = backend_factory(staged / "transcript.jsonl")
+        source = backend_factory()
+        backend = RecordingBackend(source, staged / "transcript.jsonl")
         reasons: list[str] = []
         for attempt in range(MAX_TASK_ATTEMPTS):
             proposal, rejected = propose(backend, index=index + 1000 * attempt, existing=existing,
@@ -131,6 +133,8 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
                               is_language_model=backend.is_language_model, seed=seed, index=index,
                               instruction=instruction, command=command)
         _write(staged / "generation.json", to_json(info))
+        if hasattr(source, "assert_consumed"):
+            source.assert_consumed()  # a replay must use every recorded exchange
         committed = commit_task(root, proposal.name, staged)
         return TaskSummary(committed, tuple(c.score for c in scenes), refine_log.violations_before, refine_log.violations_after,
                            len(refine_log.rounds), time.perf_counter() - t0)
@@ -139,7 +143,7 @@ def generate_task(backend_factory: Callable[[Path], Backend], root: Path, *, ind
             shutil.rmtree(staged, ignore_errors=True)
 
 
-def generate(backend_factory: Callable[[Path], Backend], root: Path, *, n: int = 1, seed: int = 0,
+def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, seed: int = 0,
              instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None,
              candidates: int = N_CANDIDATES) -> list[TaskSummary]:
     """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again."""

@@ -48,6 +48,11 @@ _VERBS = {
 _OPENABLE_LINKS = ("door", "lid", "drawer")
 
 
+def _w(name: str) -> str:
+    """An object name as a word in a sentence (``tuna_can`` -> ``tuna can``)."""
+    return name.replace("_", " ")
+
+
 def _fence(lang: str, body: str) -> str:
     return f"```{lang}\n{body.rstrip()}\n```\n"
 
@@ -134,50 +139,50 @@ class OfflineBackend:
     def _lift_task(a: dict) -> dict:
         n = a["category"]
         return {
-            "name": _camel("lift", a["id"]), "description": f"Grasp the {n} and lift it off the table.",
+            "name": _camel("lift", a["id"]), "description": f"Grasp the {_w(n)} and lift it off the table.",
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [
-                {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {n}."},
-                {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {n}."},
-                {"action": "lift", "target": n, "control_joint": "lift_inspire", "instruction": f"Lift the {n} 10 cm."},
+                {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {_w(n)}."},
+                {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {_w(n)}."},
+                {"action": "lift", "target": n, "control_joint": "lift_inspire", "instruction": f"Lift the {_w(n)} 10 cm."},
             ],
             "success": {"type": "lifted", "object": n, "target": None, "min_height_m": 0.1, "min_fraction": None,
                         "max_dist_m": None},
-            "success_text": f"The {n} is held at least 10 cm above where it started.",
+            "success_text": f"The {_w(n)} is held at least 10 cm above where it started.",
         }
 
     @staticmethod
     def _carry_steps(n: str, t: str, where: str) -> list[dict]:
         return [
-            {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {n}."},
-            {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {n}."},
-            {"action": "move", "target": t, "control_joint": "arm", "instruction": f"Carry the {n} {where} the {t}."},
-            {"action": "release", "target": n, "control_joint": "hand", "instruction": f"Open the hand to let go of the {n}."},
+            {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {_w(n)}."},
+            {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {_w(n)}."},
+            {"action": "move", "target": t, "control_joint": "arm", "instruction": f"Carry the {_w(n)} {where} the {_w(t)}."},
+            {"action": "release", "target": n, "control_joint": "hand", "instruction": f"Open the hand to let go of the {_w(n)}."},
         ]
 
     def _put_task(self, a: dict, b: dict) -> dict:
         n, t = a["category"], b["category"]
         t = t if t != n else t + "_2"
         return {
-            "name": _camel("put", a["id"], "in", b["id"]), "description": f"Put the {n} into the {t}.",
+            "name": _camel("put", a["id"], "in", b["id"]), "description": f"Put the {_w(n)} into the {_w(t)}.",
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "container"}],
             "steps": self._carry_steps(n, t, "above"),
             "success": {"type": "inside", "object": n, "target": t, "min_height_m": None, "min_fraction": None,
                         "max_dist_m": None},
-            "success_text": f"The {n} rests inside the {t}.",
+            "success_text": f"The {_w(n)} rests inside the {_w(t)}.",
         }
 
     def _plate_task(self, a: dict, b: dict) -> dict:
         n, t = a["category"], b["category"]
         return {
-            "name": _camel("set", a["id"], "on", b["id"]), "description": f"Set the {n} down on the {t}.",
+            "name": _camel("set", a["id"], "on", b["id"]), "description": f"Set the {_w(n)} down on the {_w(t)}.",
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "support"}],
             "steps": self._carry_steps(n, t, "over"),
             "success": {"type": "near", "object": n, "target": t, "min_height_m": None, "min_fraction": None,
                         "max_dist_m": round(0.4 * _min_xy(b), 3)},
-            "success_text": f"The {n} lies on the {t}.",
+            "success_text": f"The {_w(n)} lies on the {_w(t)}.",
         }
 
     @staticmethod
@@ -185,7 +190,7 @@ class OfflineBackend:
         n = a["category"]
         part = a["joints"][0]["handle_link"].split("_")[0]
         return {
-            "name": _camel("open", a["id"]), "description": f"Open the {n}'s {part} by its handle.",
+            "name": _camel("open", a["id"]), "description": f"Open the {_w(n)}'s {part} by its handle.",
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": [
                 {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {part} handle."},

@@ -91,7 +91,7 @@ def write_rewards(backend: Backend, spec: TaskSpec, proposal: Proposal, task_dir
 
     ``task_dir`` must already hold ``task.yaml``; validated modules are left in it.
     """
-    from generator.stages.validate import check_reward_source, probe_modules  # noqa: PLC0415
+    from generator.stages.validate import check_reward_source, validate_task  # noqa: PLC0415
 
     targets: list[tuple[str, int | None]] = [(f"{STAGE_DIR}/{s.name}.py", i) for i, s in enumerate(spec.stages)
                                              if s.method == "RL"]
@@ -119,14 +119,18 @@ def write_rewards(backend: Backend, spec: TaskSpec, proposal: Proposal, task_dir
             modules[rel] = source
             written.append(rel)
         if written:
-            outcome = probe_modules(task_dir, [task_dir / r for r in written], steps=probe_steps, timeout_s=timeout_s)
-            for rel in written:
-                problem, report = outcome[task_dir / rel]
-                if problem is None:
-                    attempts.append(RewardAttempt(rel, attempt, True, "passed static checks and the simulator probe"))
-                    reports.append({"module": rel, **report})
+            report = validate_task(task_dir, [task_dir / r for r in written], steps=probe_steps, timeout_s=timeout_s)
+            for rel, outcome in zip(written, report.modules, strict=True):
+                if outcome.ok:
+                    attempts.append(RewardAttempt(rel, attempt, True, "passed the static checks and the simulator probe"))
+                    p = outcome.probe
+                    reports.append({"module": rel, "steps": p.steps, "reward_min": round(p.reward_min, 4),
+                                    "reward_max": round(p.reward_max, 4), "reward_mean": round(p.reward_mean, 4),
+                                    "success_rate": p.success_rate, "fail_rate": p.fail_rate,
+                                    "obs_extra": p.obs_extra, "warnings": p.warnings})
                     pending.pop(rel)
                 else:
+                    problem = f"{outcome.error_type}: {outcome.error}"
                     attempts.append(RewardAttempt(rel, attempt, False, problem))
                     pending[rel] = (modules.pop(rel), problem)
                     (task_dir / rel).unlink()

@@ -17,7 +17,7 @@ from gymnasium.utils.env_checker import check_env
 from gendex_envs.registry import register_tasks
 from generator.backends.base import ModelResponse
 from generator.backends.offline import OfflineBackend
-from generator.backends.transcript import RecordingBackend, ReplayBackend
+from generator.backends.transcript import ReplayBackend
 from generator.errors import RetriesExhaustedError
 from generator.pipeline import generate
 from generator.stages.commit import REQUIRED_FILES, STAGING
@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _offline(seed: int = 0):
-    return lambda path: RecordingBackend(OfflineBackend(seed=seed), path)
+    return lambda: OfflineBackend(seed=seed)
 
 
 def _tree(folder: Path) -> dict[str, bytes]:
@@ -68,14 +68,8 @@ def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
 def test_replayed_transcript_reproduces_the_task_files(offline_run, tmp_path):
     root, summaries = offline_run
     src = summaries[0].committed.path
-    replay = generate(lambda path: _copy_then_replay(src / "transcript.jsonl", path), tmp_path, n=1, seed=0,
-                      command="test")
+    replay = generate(lambda: ReplayBackend(src / "transcript.jsonl"), tmp_path, n=1, seed=0, command="test")
     assert _tree(replay[0].committed.path) == _tree(src)
-
-
-def _copy_then_replay(transcript: Path, dest: Path):
-    dest.write_bytes(transcript.read_bytes())
-    return ReplayBackend(transcript)
 
 
 def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path):
@@ -127,7 +121,7 @@ def _assert_nothing_committed(root: Path) -> None:
 def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(tmp_path):
     b = Scripted(propose=_APPLE % "golden_apple_9000")
     with pytest.raises(RetriesExhaustedError, match="golden_apple_9000.*not in the catalog"):
-        generate(lambda p: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test")
     assert b.seen == ["propose"] * 3  # bounded retries
     _assert_nothing_committed(tmp_path)
 
@@ -135,7 +129,7 @@ def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(t
 def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
     b = Scripted(propose=_APPLE % "apple", scene="```yaml\nname: LiftTheApple\nobjects: [\n  - {name: apple\n```")
     with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
-        generate(lambda p: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test")
     _assert_nothing_committed(tmp_path)
 
 
@@ -144,7 +138,7 @@ def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path)
            "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
     b = Scripted(propose=_APPLE % "apple", reward=bad)
     with pytest.raises(RetriesExhaustedError, match="os"):
-        generate(lambda p: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test")
     _assert_nothing_committed(tmp_path)
 
 
@@ -163,7 +157,7 @@ def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path
         return offline.complete(request).text
 
     b = Scripted(propose=_APPLE % "apple", reward=reward)
-    [s] = generate(lambda p: b, tmp_path, n=1, command="test")
+    [s] = generate(lambda: b, tmp_path, n=1, command="test")
     attempts = json.loads((s.committed.path / "reward_attempts.json").read_text())["attempts"]
     assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
     assert "rejected" in calls[-1] or any("nan" in c.lower() for c in calls[1:])
