@@ -127,9 +127,13 @@ class StageExecutor:
         return q
 
     def _obj_geometry(self, name: str) -> tuple[np.ndarray, float, float, float]:
-        """(centre xy, bottom z, height, radius) of object ``name`` from its world bounding box now."""
+        """(centre xy, bottom z, height, radius) of object ``name``: extents from its world bounding box now, radius
+        from its own (local) box, since the world box of a yawed cylinder is up to √2 too wide."""
         lo, hi = self._world_aabb(name)
-        return (lo[:2] + hi[:2]) / 2, float(lo[2]), float(hi[2] - lo[2]), float(np.max(hi[:2] - lo[:2]) / 2)
+        e = self._env._records[name].entry
+        size = (np.asarray(e.bbox_max_m) - np.asarray(e.bbox_min_m)) * self._env.task_spec.object(name).scale
+        radius = float(np.max(size[:2]) / 2)
+        return (lo[:2] + hi[:2]) / 2, float(lo[2]), float(hi[2] - lo[2]), radius
 
     def _world_aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         u = self._env
