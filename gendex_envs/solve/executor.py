@@ -236,9 +236,9 @@ class StageExecutor:
         base = self.ik.base.p
         prefer = float(np.arctan2(center[1] - base[1], center[0] - base[0]))  # fingers pointing away from the base
         q0 = self._target()
-        open_q = self._with_hand(q0, OPEN_HAND)
         chosen: tuple[GraspPlan, np.ndarray, np.ndarray] | None = None
         for plan in grasp_candidates(center, bottom, height, radius, prefer_yaw_rad=prefer):
+            open_q = self._with_hand(q0, plan.open_hand)
             q_pre = self.ik.solve(plan.pregrasp, open_q, restarts=20, valid=self.collision.is_free)
             if q_pre is None:
                 continue
@@ -251,7 +251,7 @@ class StageExecutor:
             raise ExecutionError(f"no reachable collision-free grasp of {name!r}")
         plan, q_pre, _ = chosen
         self._plan = plan
-        yield from self._move_arm(q_pre, hand=open_q)
+        yield from self._move_arm(q_pre, hand=self._with_hand(q0, plan.open_hand))
         yield from self._cartesian(plan.palm.p - plan.pregrasp.p, self.config.descend_m_per_step)
         for _ in range(self.config.settle_steps):
             yield self._emit(self._target())
