@@ -127,9 +127,13 @@ class StageExecutor:
         return q
 
     def _obj_geometry(self, name: str) -> tuple[np.ndarray, float, float, float]:
-        """(centre xy, bottom z, height, radius) of object ``name`` from its world bounding box now."""
+        """(centre xy, bottom z, height, radius) of object ``name``: extents from its world bounding box now, radius
+        from its own (local) box, since the world box of a yawed cylinder is up to √2 too wide."""
         lo, hi = self._world_aabb(name)
-        return (lo[:2] + hi[:2]) / 2, float(lo[2]), float(hi[2] - lo[2]), float(np.max(hi[:2] - lo[:2]) / 2)
+        e = self._env._records[name].entry
+        size = (np.asarray(e.bbox_max_m) - np.asarray(e.bbox_min_m)) * self._env.task_spec.object(name).scale
+        radius = float(np.max(size[:2]) / 2)
+        return (lo[:2] + hi[:2]) / 2, float(lo[2]), float(hi[2] - lo[2]), radius
 
     def _world_aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         u = self._env
@@ -232,9 +236,9 @@ class StageExecutor:
         base = self.ik.base.p
         prefer = float(np.arctan2(center[1] - base[1], center[0] - base[0]))  # fingers pointing away from the base
         q0 = self._target()
-        open_q = self._with_hand(q0, OPEN_HAND)
         chosen: tuple[GraspPlan, np.ndarray, np.ndarray] | None = None
         for plan in grasp_candidates(center, bottom, height, radius, prefer_yaw_rad=prefer):
+            open_q = self._with_hand(q0, plan.open_hand)
             q_pre = self.ik.solve(plan.pregrasp, open_q, restarts=20, valid=self.collision.is_free)
             if q_pre is None:
                 continue
@@ -247,7 +251,7 @@ class StageExecutor:
             raise ExecutionError(f"no reachable collision-free grasp of {name!r}")
         plan, q_pre, _ = chosen
         self._plan = plan
-        yield from self._move_arm(q_pre, hand=open_q)
+        yield from self._move_arm(q_pre, hand=self._with_hand(q0, plan.open_hand))
         yield from self._cartesian(plan.palm.p - plan.pregrasp.p, self.config.descend_m_per_step)
         for _ in range(self.config.settle_steps):
             yield self._emit(self._target())

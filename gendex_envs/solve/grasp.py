@@ -6,8 +6,10 @@ with a 0.03 m object, a palm 5 mm off loses it. Two families cover the catalog's
 - ``top`` — palm facing the table over a compact object (height ≤ :data:`TOP_GRASP_MAX_HEIGHT_M`), the object's
   centre :data:`TOP_ALONG_M` along the palm from the wrist, palm touching its top; the fingers curl down over the
   far side and the thumb comes under from the side.
-- ``side`` — palm facing a tall object's axis from the side at :data:`SIDE_HEIGHT_FRACTION` of its height, fingers
-  horizontal and wrapping around it, the thumb closing from below (thumb side down keeps the object upright).
+- ``side`` — palm facing a tall object's axis from the side at :data:`SIDE_HEIGHT_FRACTION` of its height (thumb side
+  down), fingers horizontal, the axis :data:`SIDE_ALONG_M` along the palm. The hand slides in along its fingers
+  with the thumb already pre-shaped (:data:`SIDE_THUMB_PRE`) behind the object's wrist-side far quadrant; the
+  fingers then curl over the far side and pull the object onto the thumb, which presses back toward the palm.
 
 Candidates differ by the approach heading (yaw about the vertical); :func:`grasp_candidates` returns them all,
 nearest-heading-first for a given preference, and the executor keeps the first one the arm can reach without
@@ -28,9 +30,16 @@ PALM_THICKNESS_M = 0.011
 TOP_ALONG_M = 0.075
 """Top grasp: object centre distance from the palm origin along the fingers (tuned: 0.065–0.075 lift 8/8)."""
 TOP_GRASP_MAX_HEIGHT_M = 0.13
-SIDE_ALONG_M = 0.07
-SIDE_GAP_M = 0.008
+SIDE_ALONG_M = 0.09
+"""Side grasp: object axis distance from the palm origin along the fingers (knuckles at 0.095). Tuned on the 66 mm
+bottle (10 seeds, lift then 2 s hold): 0.08–0.10 all held; at 0.07 / 0.06 the thumb had lost contact after the
+hold in 1 / 3 seeds. Further out the bottle tilts more while closing (≈ 30° at 0.10 against ≈ 22° at 0.08)."""
+SIDE_GAP_M = 0.010
+"""Side grasp: gap between the palm skin and the object (0.006–0.016 all lift)."""
 SIDE_HEIGHT_FRACTION = 0.55
+SIDE_MIN_HEIGHT_M = 0.10
+"""Lowest side-grasp palm height above the object's bottom: with the thumb side down the pre-shaped thumb reaches
+0.09 m below the palm origin."""
 GUARD_RAD = 0.2
 """Guarded closing: finger targets stay within this of the measured joint angles (squeeze ≈ 15 N·m/rad × 0.2)."""
 
@@ -44,6 +53,15 @@ FINGERS_CLOSED = {j: 1.3 for j in FINGER_FLEX_JOINTS}
 """Closing target of the fingers (beyond contact for every catalog object: the guard stops them)."""
 THUMB_OPPOSED = {"THJ4": 0.0, "THJ3": 1.2, "THJ2": 0.0, "THJ1": -0.5, "THJ0": -1.0}
 """Thumb closing target: its tip reaches under the palm's centre (found by forward kinematics, 8/8 in sweeps)."""
+SIDE_THUMB_PRE = {"THJ4": -0.5, "THJ3": 1.0, "THJ2": 0.0, "THJ1": -0.25, "THJ0": -1.0}
+"""Side grasp, before closing: the thumb pad sits 10 mm off a 33 mm-radius object's surface at its far, wrist-side
+quadrant (palm frame y −0.072, z 0.048; found by forward kinematics), and no thumb link lies in the object's band
+beyond its axis, so the hand can slide in along its fingers without touching it."""
+SIDE_THUMB_CLOSED = {"THJ4": 0.0, "THJ3": 0.7, "THJ2": 0.0, "THJ1": -0.25, "THJ0": -1.0}
+"""Side grasp thumb target: from :data:`SIDE_THUMB_PRE`, raising THJ4 and lowering THJ3 both move the pad toward the
+object's axis (≈ +0.04 and +0.06 m/rad), pressing it toward the palm and the fingers."""
+SIDE_OPEN_HAND = {j: 0.0 for j in FINGER_FLEX_JOINTS} | SIDE_THUMB_PRE
+"""Side pre-grasp hand: fingers straight (they slide along the object's near side), thumb pre-shaped behind it."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +77,8 @@ class GraspPlan:
     approach_m: float = 0.10
     fingers: dict[str, float] = field(default_factory=lambda: dict(FINGERS_CLOSED))
     thumb: dict[str, float] = field(default_factory=lambda: dict(THUMB_OPPOSED))
+    open_hand: dict[str, float] = field(default_factory=lambda: dict(OPEN_HAND))
+    """Hand joints while the arm moves to the pre-grasp pose and approaches."""
 
     @property
     def pregrasp(self) -> sapien.Pose:
@@ -105,12 +125,12 @@ def grasp_candidates(center_xy: np.ndarray, bottom_z: float, height_m: float, ra
             palm = top - TOP_ALONG_M * f + PALM_THICKNESS_M * up
             out.append(GraspPlan("top", _pose(palm_rotation(f, -up), palm), approach=-up))
         else:
-            # palm faces the axis along n (horizontal, perpendicular to the fingers), thumb side down
+            # palm faces the axis along n (horizontal, perpendicular to the fingers): this side puts the thumb down
             n_ = np.array([np.sin(yaw), -np.cos(yaw), 0.0])
-            axis = np.array([center_xy[0], center_xy[1], bottom_z + SIDE_HEIGHT_FRACTION * height_m])
+            z = bottom_z + max(SIDE_HEIGHT_FRACTION * height_m, SIDE_MIN_HEIGHT_M)
+            axis = np.array([center_xy[0], center_xy[1], z])
             palm = axis - SIDE_ALONG_M * f - (radius_m + SIDE_GAP_M + PALM_THICKNESS_M) * n_
             rot = palm_rotation(f, n_)
-            if rot[2, 0] > 0:  # thumb side (+x of the palm) must point down
-                continue
-            out.append(GraspPlan("side", _pose(rot, palm), approach=n_))
+            out.append(GraspPlan("side", _pose(rot, palm), approach=f, thumb=dict(SIDE_THUMB_CLOSED),
+                                 open_hand=dict(SIDE_OPEN_HAND)))
     return out

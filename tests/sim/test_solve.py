@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import gendex_envs  # noqa: F401
+from gendex_envs.solve import grasp
 from gendex_envs.solve.collision import ArmCollisionModel, Box
 from gendex_envs.solve.executor import ExecutionError, StageExecutor
 from gendex_envs.solve.grasp import grasp_candidates
@@ -21,8 +22,18 @@ def apple_env():
     env.close()
 
 
-def _run_stages(env, seed, executor, stop_after=None):
-    """Run the executor; with ``stop_after`` stop once that many stages have started and finished."""
+@pytest.fixture(scope="module")
+def bottle_env():
+    env = gym.make("GenDex/PickUpBottle-v0", control_mode="pd_joint_pos", control_joint="both")
+    yield env
+    env.close()
+
+
+def _run_stages(env, seed, executor, stop_after=None, stop_when_done=True):
+    """Run the executor; with ``stop_after`` stop once that many stages have started and finished.
+
+    ``stop_when_done=False`` keeps stepping past the episode's success (a lift task succeeds mid-lift).
+    """
     obs, _ = env.reset(seed=seed)
     executor.reset(env, obs)
     info = {}
@@ -33,7 +44,7 @@ def _run_stages(env, seed, executor, stop_after=None):
         if action is None:
             break
         obs, _, terminated, truncated, info = env.step(action)
-        if terminated or truncated:
+        if stop_when_done and (terminated or truncated):
             break
     return info
 
@@ -84,6 +95,16 @@ def test_grasp_candidates_follow_the_object_geometry():
     tall = grasp_candidates(np.array([0.1, 0.0]), 0.0, 0.22, 0.033)
     short = grasp_candidates(np.array([0.1, 0.0]), 0.0, 0.07, 0.038)
     assert {g.kind for g in tall} == {"side"} and {g.kind for g in short} == {"top"}
+    for g in tall:
+        rot = g.palm.to_transformation_matrix()[:3, :3]
+        fingers, thumb, facing = rot[:, 2], rot[:, 0], -rot[:, 1]
+        assert thumb[2] == pytest.approx(-1.0)  # thumb side down, fingers horizontal
+        assert np.allclose(g.approach, fingers, atol=1e-6)  # slides in along the fingers, the thumb pre-shaped behind the axis
+        assert g.open_hand == grasp.SIDE_OPEN_HAND and g.thumb == grasp.SIDE_THUMB_CLOSED
+        axis = np.array([0.1, 0.0, g.palm.p[2]])
+        assert g.palm.p[2] == pytest.approx(0.55 * 0.22, abs=1e-6)
+        assert np.dot(axis - g.palm.p, fingers) == pytest.approx(grasp.SIDE_ALONG_M, abs=1e-6)
+        assert np.dot(axis - g.palm.p, facing) == pytest.approx(0.011 + grasp.SIDE_GAP_M + 0.033, abs=1e-6)
     for g in short:
         # palm skin touching the top, object centre under the palm, approach straight down
         assert g.palm.p[2] == pytest.approx(0.07 + 0.011)
@@ -102,6 +123,28 @@ def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed)
         apple_env.step(hold)
     assert float(env.obj_height("apple")[0]) >= 0.10
     assert bool(env.agent.is_grasping(env.obj("apple"))[0])
+
+
+@pytest.mark.parametrize("seed", [0, 7])
+def test_synthesized_grasp_lifts_the_bottle_10cm_and_holds_it_2s(bottle_env, seed):
+    env = bottle_env.unwrapped
+    executor = StageExecutor()
+    # approach_bottle + grasp_bottle (closing and lifting 0.15 m); the task's own success would stop it mid-lift
+    _run_stages(bottle_env, seed, executor, stop_after=2, stop_when_done=False)
+    assert [log.primitive for log in executor.logs[:2]] == ["approach", "grasp"]
+    assert executor._plan.kind == "side"
+    hold = env.agent.controller._target_qpos[0, executor._free].numpy()
+    for _ in range(2 * CONTROL_HZ):
+        bottle_env.step(hold)
+    assert float(env.obj_height("bottle")[0]) >= 0.10
+    assert bool(env.agent.is_grasping(env.obj("bottle"))[0])
+    _, x, y, _ = env.obj("bottle").pose.q[0].numpy()
+    assert np.degrees(np.arccos(1 - 2 * (x * x + y * y))) < 40  # held near upright, not dangling from one finger
+
+
+def test_stage_executor_solves_pick_up_bottle(bottle_env):
+    wins = [bool(_run_stages(bottle_env, seed, StageExecutor()).get("success", False)) for seed in range(300, 303)]
+    assert all(wins)
 
 
 def test_stage_executor_solves_put_apple_bowl(apple_env):
