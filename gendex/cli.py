@@ -136,11 +136,11 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
     """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
-    import gendex_envs  # noqa: F401, PLC0415
     from tqdm import tqdm  # noqa: PLC0415
 
-    from gendex_envs.data.collector import (SOLVER_CONTROL_MODES, SOLVERS, CollectConfig,  # noqa: PLC0415
-                                            collect as run_collect)
+    import gendex_envs  # noqa: F401, PLC0415
+    from gendex_envs.data.collector import SOLVER_CONTROL_MODES, SOLVERS, CollectConfig  # noqa: PLC0415
+    from gendex_envs.data.collector import collect as run_collect
     from gendex_envs.errors import GenDexError, suggest  # noqa: PLC0415
     from gendex_envs.registry import task_entry  # noqa: PLC0415
     from gendex_envs.spec import load_task_spec  # noqa: PLC0415
@@ -215,7 +215,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a transcript.jsonl (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
-    """Generate new tasks: propose -> scene -> render -> critique/refine -> plan -> reward code -> validate -> commit."""
+    """Generate new tasks: propose, scene, render, critique/refine, plan, reward code, validate, commit."""
     import shlex  # noqa: PLC0415
     import sys  # noqa: PLC0415
 
@@ -261,8 +261,9 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")
     for s in rows:
+        dropped = f" ({s.proposals_tried - 1} earlier proposal(s) dropped)" if s.proposals_tried > 1 else ""
         typer.echo(f"  {s.committed.env_id}: {s.violations_before} -> {s.violations_after} violations in "
-                   f"{s.refine_rounds} round(s), {s.seconds:.1f} s; folder {s.committed.path}")
+                   f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.path}")
 
 
 @app.command()
@@ -270,10 +271,13 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),
          seed: int = typer.Option(0, help="Seed of resets and random actions."),
          collect_n: int = typer.Option(3, "--collect", min=0,
-                                       help="Successful PutAppleBowl episodes to collect into a LeRobot dataset.")
+                                       help="Successful PutAppleBowl episodes to collect into a LeRobot dataset."),
+         generate_n: int = typer.Option(1, "--generate", min=0,
+                                        help="New tasks to generate with the offline author into OUT/generated_tasks.")
          ) -> None:
-    """The main job on embedded defaults: build every task, render its views, roll out random actions, then collect
-    a few successful PutAppleBowl episodes with the stage executor into a LeRobot v3.0 dataset."""
+    """The main job on embedded defaults: build every task, render its views, roll out random actions, generate a new
+    task with the offline author, then collect a few successful PutAppleBowl episodes with the stage executor into a
+    LeRobot v3.0 dataset."""
     import gymnasium as gym  # noqa: PLC0415
     import numpy as np  # noqa: PLC0415
     from tqdm import tqdm  # noqa: PLC0415
@@ -303,12 +307,27 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
                    f"mean reward {mean_r:.3f}")
         for name, path in paths.items():
             typer.echo(f"      {name:15s} {path}")
+    if generate_n:
+        _demo_generate(out / "generated_tasks", generate_n, seed)
     if collect_n:
         _demo_collect(out / "PutAppleBowl_dataset", collect_n, seed)
 
 
+def _demo_generate(out: Path, n: int, seed: int) -> None:
+    from generator.backends.offline import OfflineBackend  # noqa: PLC0415
+    from generator.pipeline import generate as run_generate  # noqa: PLC0415
+
+    typer.echo(f"\nGenerating {n} new task(s) with the offline author (a seeded task grammar, not a language model)")
+    rows = run_generate(lambda: OfflineBackend(seed=seed), out, n=n, seed=seed,
+                        command=f"gendex generate --backend offline --n {n} --seed {seed} --out {out}")
+    for s in rows:
+        typer.echo(f"  {s.committed.env_id}: violations {s.violations_before} -> {s.violations_after}, "
+                   f"{s.seconds:.1f} s; folder {s.committed.path} (renders in renders/)")
+
+
 def _demo_collect(out: Path, n: int, seed: int) -> None:
-    from gendex_envs.data.collector import SOLVERS, CollectConfig, collect as run_collect  # noqa: PLC0415
+    from gendex_envs.data.collector import SOLVERS, CollectConfig  # noqa: PLC0415
+    from gendex_envs.data.collector import collect as run_collect
     from gendex_envs.registry import task_entry  # noqa: PLC0415
     from gendex_envs.spec import load_task_spec  # noqa: PLC0415
 

@@ -88,7 +88,8 @@ def compute_dense_reward(env, obs, action, info):
 
 
 def _get_obs_extra(env, info):
-    return {{"palm_to_handle": env.handle_pos({obj!r}) - env.palm_pose.p, "open_fraction": info["open_fraction"][:, None]}}
+    return {{"palm_to_handle": env.handle_pos({obj!r}) - env.palm_pose.p,
+            "open_fraction": info["open_fraction"][:, None]}}
 '''
         return src
     held = _HELD.format(obj=obj)

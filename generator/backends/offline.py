@@ -12,8 +12,8 @@ validators as a model's:
     keyword matching of the instruction's verb (grab / put / open / ...) and nouns against catalog ids,
     categories and tags; an object the catalog lacks is replaced by the closest id (string similarity).
 ``scene``
-    a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1. It checks nothing on
-    purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
+    a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1. It checks
+    nothing on purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
 ``plan``
     one stage per proposal step (approach / move -> motion planning; finger and contact work -> RL).
 ``reward``
@@ -51,6 +51,10 @@ _OPENABLE_LINKS = ("door", "lid", "drawer")
 def _w(name: str) -> str:
     """An object name as a word in a sentence (``tuna_can`` -> ``tuna can``)."""
     return name.replace("_", " ")
+
+
+def _step(action: str, target: str, control_joint: str, instruction: str) -> dict:
+    return {"action": action, "target": target, "control_joint": control_joint, "instruction": instruction}
 
 
 def _fence(lang: str, body: str) -> str:
@@ -142,9 +146,9 @@ class OfflineBackend:
             "name": _camel("lift", a["id"]), "description": f"Grasp the {_w(n)} and lift it off the table.",
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [
-                {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {_w(n)}."},
-                {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {_w(n)}."},
-                {"action": "lift", "target": n, "control_joint": "lift_inspire", "instruction": f"Lift the {_w(n)} 10 cm."},
+                _step("approach", n, "arm", f"Bring the open hand to the {_w(n)}."),
+                _step("grasp", n, "hand", f"Close the fingers around the {_w(n)}."),
+                _step("lift", n, "lift_inspire", f"Lift the {_w(n)} 10 cm."),
             ],
             "success": {"type": "lifted", "object": n, "target": None, "min_height_m": 0.1, "min_fraction": None,
                         "max_dist_m": None},
@@ -154,10 +158,10 @@ class OfflineBackend:
     @staticmethod
     def _carry_steps(n: str, t: str, where: str) -> list[dict]:
         return [
-            {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {_w(n)}."},
-            {"action": "grasp", "target": n, "control_joint": "hand", "instruction": f"Close the fingers around the {_w(n)}."},
-            {"action": "move", "target": t, "control_joint": "arm", "instruction": f"Carry the {_w(n)} {where} the {_w(t)}."},
-            {"action": "release", "target": n, "control_joint": "hand", "instruction": f"Open the hand to let go of the {_w(n)}."},
+            _step("approach", n, "arm", f"Bring the open hand to the {_w(n)}."),
+            _step("grasp", n, "hand", f"Close the fingers around the {_w(n)}."),
+            _step("move", t, "arm", f"Carry the {_w(n)} {where} the {_w(t)}."),
+            _step("release", n, "hand", f"Open the hand to let go of the {_w(n)}."),
         ]
 
     def _put_task(self, a: dict, b: dict) -> dict:
@@ -193,9 +197,9 @@ class OfflineBackend:
             "name": _camel("open", a["id"]), "description": f"Open the {_w(n)}'s {part} by its handle.",
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": [
-                {"action": "approach", "target": n, "control_joint": "arm", "instruction": f"Bring the open hand to the {part} handle."},
-                {"action": "grasp", "target": n, "control_joint": "hand", "instruction": "Hook the fingers around the handle."},
-                {"action": "pull", "target": n, "control_joint": "both", "instruction": f"Pull the {part} open along its path."},
+                _step("approach", n, "arm", f"Bring the open hand to the {part} handle."),
+                _step("grasp", n, "hand", "Hook the fingers around the handle."),
+                _step("pull", n, "both", f"Pull the {part} open along its path."),
             ],
             "success": {"type": "joint_open", "object": n, "target": None, "min_height_m": None, "min_fraction": 0.8,
                         "max_dist_m": None},
@@ -294,8 +298,8 @@ class OfflineBackend:
         stages = []
         for i, s in enumerate(proposal["steps"]):
             method = "motion_planning" if s["action"] in ("approach", "move") else "RL"
-            stages.append({"name": f"{s['action']}_{s['target']}" if i == 0 or s["action"] != proposal["steps"][i - 1]["action"]
-                           else f"{s['action']}_{s['target']}_{i}",
+            repeated = i > 0 and s["action"] == proposal["steps"][i - 1]["action"]
+            stages.append({"name": f"{s['action']}_{s['target']}" + (f"_{i}" if repeated else ""),
                            "instruction": s["instruction"], "method": method,
                            "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
                            "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})

@@ -57,7 +57,9 @@ class RecordingBackend:
         if self.path.exists() and self.path.stat().st_size > 0 and not overwrite:
             raise BackendError(f"transcript {self.path} already exists; remove it, record to another path, "
                                "or pass overwrite=True")
-        header = {"format": FORMAT, "version": VERSION, "backend": getattr(inner, "recorded_backend", inner.name), "model": inner.model,
+        header = {"format": FORMAT, "version": VERSION,
+                  "backend": getattr(inner, "recorded_backend", inner.name),  # recording a replay: the original's
+                  "model": inner.model,
                   "sees_images": bool(inner.sees_images), "is_language_model": bool(inner.is_language_model)}
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)

@@ -63,7 +63,8 @@ def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpe
     return spec, applied, rejected
 
 
-def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS, seed: int = 0) -> tuple[TaskSpec, RefineLog]:
+def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS,
+           seed: int = 0) -> tuple[TaskSpec, RefineLog]:
     """Refine ``spec``; returns the refined spec and the log (violations before and after, every round)."""
     from generator.critic.physical import check_scene  # noqa: PLC0415
 

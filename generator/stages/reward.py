@@ -122,7 +122,7 @@ def write_rewards(backend: Backend, spec: TaskSpec, proposal: Proposal, task_dir
             report = validate_task(task_dir, [task_dir / r for r in written], steps=probe_steps, timeout_s=timeout_s)
             for rel, outcome in zip(written, report.modules, strict=True):
                 if outcome.ok:
-                    attempts.append(RewardAttempt(rel, attempt, True, "passed the static checks and the simulator probe"))
+                    attempts.append(RewardAttempt(rel, attempt, True, "passed the static checks and the probe"))
                     p = outcome.probe
                     reports.append({"module": rel, "steps": p.steps, "reward_min": round(p.reward_min, 4),
                                     "reward_max": round(p.reward_max, 4), "reward_mean": round(p.reward_mean, 4),

@@ -182,3 +182,24 @@ def test_killed_run_leaves_no_partial_task_folder(tmp_path):
     assert all(list((tmp_path / n).glob("v*/task.yaml")) for n in names)
     assert register_tasks([tmp_path], override=True) == [f"GenDex/{f.parent.name}-{f.name}"
                                                          for f in _task_folders(tmp_path)]
+
+
+@pytest.mark.slow
+def test_five_offline_tasks_are_distinct_reproducible_and_pass_check_env(tmp_path):
+    runs = []
+    for k in range(2):
+        root = tmp_path / f"run{k}"
+        runs.append((root, generate(_offline(0), root, n=5, seed=0, command="test")))
+    (root_a, a), (root_b, b) = runs
+    assert len({s.committed.name for s in a}) == 5
+    assert [s.committed.name for s in a] == [s.committed.name for s in b]
+    for sa, sb in zip(a, b, strict=True):
+        assert _tree(sa.committed.path) == _tree(sb.committed.path), sa.committed.name
+    ids = register_tasks([root_a], override=True)
+    assert sorted(ids) == sorted(s.committed.env_id for s in a)
+    for env_id in ids:
+        env = gym.make(env_id)
+        try:
+            check_env(env, skip_render_check=True)
+        finally:
+            env.close()
