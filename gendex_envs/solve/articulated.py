@@ -59,6 +59,8 @@ BAR_ALONG_M = 0.125
 phalanges, so closing wraps the middle and distal phalanges behind it)."""
 PRE_M = 0.08
 """Pre-pose: the grasp pose moved this far out from the door along its normal."""
+INSERT_CHECKS = 4
+"""IK checks along the straight move from the pre-pose in to the grasp."""
 GOAL_MARGIN = 0.12
 """The pull's goal: this fraction of the opening beyond the success condition's fraction."""
 TILTS_RAD = (0.0, 0.25, 0.5)
@@ -159,6 +161,10 @@ class HookGrasp:
     wrist: dict[str, float] = field(default_factory=dict)
     """Hand wrist joint targets held during the grasp (extension lets the forearm come from the front)."""
 
+    def __str__(self) -> str:
+        side = "hinge" if self.to_hinge else "free edge"
+        return f"hook grasp (fingers towards the {side}, tilt {self.tilt_rad:.2f} rad, wrist {self.wrist})"
+
     def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
         """World palm pose at door angle ``q``, ``out_m`` further out along the door's normal."""
         m = joint.link_at(q) @ self.offset
@@ -209,7 +215,9 @@ def opening_goal(env: TaskEnv, name: str) -> float:
 
 # ------------------------------------------------------------------------------------------------------ primitives
 @dataclass
-class PullConfig:
+class HandleConfig:
+    """Speeds and checks of the articulated primitives (control steps at 20 Hz)."""
+
     rate_rad: float = 0.04
     """Door angle the palm target advances per control step (0.8 rad/s: the door never outruns the hand)."""
     lead_rad: float = 0.1
@@ -226,9 +234,9 @@ class PullConfig:
 class HandlePrimitives:
     """The articulated primitives of one :class:`StageExecutor` (they share its IK, planner and control helpers)."""
 
-    def __init__(self, ex: StageExecutor, config: PullConfig | None = None):
+    def __init__(self, ex: StageExecutor, config: HandleConfig | None = None):
         self.ex = ex
-        self.config = config or PullConfig()
+        self.config = config or HandleConfig()
         self.grasp: HookGrasp | None = None
         self.hooked = False
         self.target: str | None = None
@@ -287,17 +295,16 @@ class HandlePrimitives:
             ex.collision.set_obstacles(self._boxes(name, moving=False))
             q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20, valid=ex.collision.is_free)
             if q_pre is None:
-                log.debug("hook grasp (to_hinge=%s): pre-pose unreachable", grasp.to_hinge)
+                log.debug("%s: pre-pose unreachable", grasp)
                 continue
-            steps = 4
-            q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / steps)) for k in range(1, steps + 1)],
-                               q_pre)
+            n = INSERT_CHECKS
+            q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)], q_pre)
             if q_in is None:
-                log.debug("hook grasp (to_hinge=%s): no straight motion in", grasp.to_hinge)
+                log.debug("%s: no straight motion in", grasp)
                 continue
             ex.collision.set_obstacles(self._boxes(name, moving=True))
             if self._chain(self._arc(grasp, joint, goal), q_in) is None:
-                log.debug("hook grasp (to_hinge=%s): arm cannot follow the arc", grasp.to_hinge)
+                log.debug("%s: arm cannot follow the arc", grasp)
                 continue
             chosen = (grasp, q_pre, q0)
             break
@@ -305,8 +312,7 @@ class HandlePrimitives:
             raise ExecutionError(f"no hook grasp of {name!r}'s handle that the arm can reach and pull along the "
                                  f"door's arc")
         grasp, q_pre, q0 = chosen
-        log.info("hook grasp of %r: fingers towards the %s, tilt %.2f rad, wrist %s", name,
-                 "hinge" if grasp.to_hinge else "free edge", grasp.tilt_rad, grasp.wrist)
+        log.info("%r: %s", name, grasp)
         self.grasp, self.target, self.hooked = grasp, name, False
         ex.collision.set_obstacles(self._boxes(name, moving=False))
         yield from ex._move_arm(q_pre, hand=q0)
@@ -360,5 +366,5 @@ class HandlePrimitives:
                              f"{c.max_steps} pull steps")
 
 
-__all__ = ["HOOK_CLOSED", "HOOK_OPEN", "PRIMITIVES", "HandlePrimitives", "HookGrasp", "JointFrame", "handle_local",
-           "hook_grasps", "opening_goal", "read_joint"]
+__all__ = ["HOOK_CLOSED", "HOOK_OPEN", "PRIMITIVES", "HandleConfig", "HandlePrimitives", "HookGrasp", "JointFrame",
+           "handle_local", "hook_grasps", "opening_goal", "read_joint"]

@@ -9,7 +9,12 @@ import yaml
 import gendex_envs  # noqa: F401
 from gendex_envs.registry import REPO_TASKS_DIR
 from gendex_envs.solve import articulated
-from gendex_envs.solve.articulated import PALM_STANDOFF_M, handle_local, hook_grasps, opening_goal, read_joint
+from gendex_envs.solve.articulated import (
+    handle_local,
+    hook_grasps,
+    opening_goal,
+    read_joint,
+)
 from gendex_envs.solve.executor import ExecutionError, StageExecutor
 
 
@@ -72,7 +77,7 @@ def test_hook_grasp_puts_the_bar_under_the_fingers(cabinet_env):
         m = palm.to_transformation_matrix()
         in_palm = m[:3, :3].T @ (bar - m[:3, 3])
         # the bar crosses the fingers BAR_ALONG_M from the palm origin, PALM_STANDOFF_M in front of the palm
-        assert in_palm == pytest.approx([0.0, -PALM_STANDOFF_M, articulated.BAR_ALONG_M], abs=1e-5)
+        assert in_palm == pytest.approx([0.0, -articulated.PALM_STANDOFF_M, articulated.BAR_ALONG_M], abs=1e-5)
         assert abs(np.dot(m[:3, 0], joint.axis)) == pytest.approx(1.0, abs=1e-6)  # thumb side along the bar
         if g.tilt_rad == 0.0:
             assert np.dot(-m[:3, 1], front) == pytest.approx(-1.0, abs=1e-6)  # palm faces the door
@@ -82,7 +87,7 @@ def test_hook_grasp_puts_the_bar_under_the_fingers(cabinet_env):
     q = opening_goal(env, "cabinet")
     m = grasps[0].palm_at(joint, q).to_transformation_matrix()
     assert m[:3, :3].T @ (joint.point_at(local, q) - m[:3, 3]) == pytest.approx(
-        [0.0, -PALM_STANDOFF_M, articulated.BAR_ALONG_M], abs=1e-5)
+        [0.0, -articulated.PALM_STANDOFF_M, articulated.BAR_ALONG_M], abs=1e-5)
 
 
 def test_stage_executor_opens_the_cabinet_door(cabinet_env):
