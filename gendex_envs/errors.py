@@ -37,6 +37,10 @@ class ControlModeError(GenDexError, ValueError):
     """An unknown control_joint mode or controller name."""
 
 
+class ExecutionError(GenDexError):
+    """A scripted solver's primitive could not run (no reachable grasp, no plan, unsupported stage)."""
+
+
 def suggest(name: str, options: Iterable[str], n: int = 3) -> str:
     """Return ' Did you mean: a, b?' for close matches of ``name`` among ``options`` (or '')."""
     matches = difflib.get_close_matches(str(name), [str(o) for o in options], n=n, cutoff=0.5)

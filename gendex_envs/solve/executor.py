@@ -16,6 +16,10 @@ RL                     hand holds the target                        ``release`` 
                                                                     somewhere, else ``lift`` to the success height
 =====================  ===========================================  ==============================================
 
+A stage whose target is articulated (a door, a lid) runs :mod:`gendex_envs.solve.articulated` instead:
+``approach_handle`` (motion planning), ``hook`` (RL, hand) and ``pull`` (RL with the arm; it hooks first if no stage
+did).
+
 RL stages are meant to run a trained policy from the task folder (``policies/<stage>.zip``, issue 6); until
 policies can run, the scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
 absolute joint targets for the ``pd_joint_pos`` / ``both`` action space, one control step at a time, and re-reads
@@ -33,17 +37,15 @@ import gymnasium as gym
 import numpy as np
 import sapien
 
-from gendex_envs.errors import GenDexError
+from gendex_envs.errors import ExecutionError
+from gendex_envs.solve.articulated import PRIMITIVES as ARTICULATED_PRIMITIVES
+from gendex_envs.solve.articulated import HandlePrimitives
 from gendex_envs.solve.collision import ArmCollisionModel, Box
 from gendex_envs.solve.grasp import GUARD_RAD, OPEN_HAND, GraspPlan, grasp_candidates
 from gendex_envs.solve.ik import ArmIK
 from gendex_envs.solve.planner import ArmPlanner, PlanningError
 
 log = logging.getLogger(__name__)
-
-
-class ExecutionError(GenDexError):
-    """A stage's primitive could not run (no reachable grasp, no plan, unsupported stage)."""
 
 
 @dataclass
@@ -95,6 +97,7 @@ class StageExecutor:
         self.carried = False
         self.logs: list[StageLog] = []
         self._plan: GraspPlan | None = None
+        self._articulated = HandlePrimitives(self)
         self._actions = self._episode()
 
     def act(self, env: gym.Env, obs) -> np.ndarray | None:
@@ -201,7 +204,10 @@ class StageExecutor:
                          f"scripted primitive {prim!r}" if policy else f"no trained policy; scripted primitive {prim!r}")
             else:
                 log.info("stage %r (motion planning): primitive %r", stage.name, prim)
-            yield from getattr(self, "_" + prim)(stage)
+            if prim in ARTICULATED_PRIMITIVES:
+                yield from self._articulated.run(prim, stage)
+            else:
+                yield from getattr(self, "_" + prim)(stage)
         # hold the last targets until the task reports success (or the episode ends)
         self.logs.append(StageLog("settle", "hold", "scripted"))
         for _ in range(spec.success.hold_steps + 10):
@@ -216,10 +222,8 @@ class StageExecutor:
         target = stage.target
         if target is None:
             raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it")
-        articulated = target in self._env.articulations
-        if articulated:
-            raise ExecutionError(f"stage {stage.name!r}: articulated targets ({target!r}) have no scripted "
-                                 f"primitive yet")
+        if target in self._env.articulations:
+            return self._articulated.choose(stage)  # approach_handle / hook / pull (solve/articulated.py)
         if stage.method == "motion_planning":
             if self.held is None:
                 return "approach"

@@ -153,12 +153,22 @@ def test_stage_executor_solves_put_apple_bowl(apple_env):
 
 
 def test_stage_executor_refuses_a_stage_it_cannot_script():
-    env = gym.make("GenDex/OpenCabinet-v0", control_mode="pd_joint_pos", control_joint="both")
+    """A stage without a target object has no primitive: the attempt ends with the named error."""
+    import yaml
+
+    from gendex_envs.registry import REPO_TASKS_DIR
+    from gendex_envs.spec import parse_task_spec
+    from gendex_envs.task_env import TaskEnv
+
+    raw = yaml.safe_load((REPO_TASKS_DIR / "PutAppleBowl" / "v0" / "task.yaml").read_text())
+    del raw["stages"][0]["target"]
+    env = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_pos", control_joint="both",
+                  render_backend="none")
     try:
         obs, _ = env.reset(seed=0)
         executor = StageExecutor()
         executor.reset(env, obs)
-        with pytest.raises(ExecutionError, match="articulated"):
+        with pytest.raises(ExecutionError, match="no target object"):
             executor.act(env, obs)
     finally:
         env.close()
