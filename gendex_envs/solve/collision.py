@@ -4,6 +4,9 @@ The simulator knows the exact geometry, but a planner asks thousands of "is this
 it gets a model that costs one forward-kinematics pass: every UR10e capsule of :data:`UR10E_LINKS` (and the Shadow
 forearm housing) is covered by spheres; a configuration is free when every sphere stays ``margin_m`` above the table
 top and outside every obstacle box. Fingers and palm are left out on purpose: they are meant to touch things.
+
+A held object is attached (:meth:`ArmCollisionModel.attach`) as spheres fixed in the palm frame, so a carry is
+planned with the object moving with the hand: it must clear the table, the other objects and the container's rim.
 """
 
 from __future__ import annotations
@@ -43,6 +46,22 @@ class ArmCollisionModel:
                 centres = np.asarray(p0, float) + t * (np.asarray(p1, float) - np.asarray(p0, float))
                 self._spheres.append((link.name, centres, np.full(len(centres), r)))
         self._housing = t
+        self._attached: tuple[np.ndarray, np.ndarray] | None = None  # palm-frame centres [k, 3], radii [k]
+        self._palm = ik.link_names.index("palm")
+
+    def attach(self, world_centres: np.ndarray, radii: np.ndarray, q: np.ndarray) -> None:
+        """Fix spheres (world centres at joint vector ``q``) to the palm: they move with the hand from now on."""
+        palm = self.ik.fk(q).to_transformation_matrix()
+        inv = np.linalg.inv(palm)
+        local = np.asarray(world_centres, float) @ inv[:3, :3].T + inv[:3, 3]
+        self._attached = (local, np.asarray(radii, float))
+
+    def detach(self) -> None:
+        self._attached = None
+
+    @property
+    def attached(self) -> bool:
+        return self._attached is not None
 
     def set_obstacles(self, boxes: list[Box]) -> None:
         self.boxes = list(boxes)
@@ -61,6 +80,10 @@ class ArmCollisionModel:
         b = (base @ ik.model.get_link_pose(ik.link_names.index("wrist")).to_transformation_matrix())[:3, 3]
         centres.append(a + self._housing * (b - a))
         radii.append(np.full(len(self._housing), HOUSING_RADIUS_M))
+        if self._attached is not None:
+            m = base @ ik.model.get_link_pose(self._palm).to_transformation_matrix()
+            centres.append(self._attached[0] @ m[:3, :3].T + m[:3, 3])
+            radii.append(self._attached[1])
         return np.concatenate(centres), np.concatenate(radii)
 
     def clearance(self, q: np.ndarray) -> float:

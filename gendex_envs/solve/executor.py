@@ -297,14 +297,31 @@ class StageExecutor:
         obj_p = (held_lo + held_hi) / 2
         goal_center = np.array([t_center[0], t_center[1], t_hi[2] + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
         offset = goal_center - obj_p
-        palm = self.ik.fk(self._target())
+        q_now = self._target()
+        palm = self.ik.fk(q_now)
         goal = sapien.Pose(palm.p + offset, palm.q)
-        self._obstacles(exclude=(held, target))
-        q_goal = self.ik.solve(goal, self._target(), restarts=20, valid=self.collision.is_free)
-        if q_goal is None:
-            raise ExecutionError(f"no reachable pose holding {held!r} above {target!r}")
-        yield from self._move_arm(q_goal)
+        # the held object moves with the palm: plan with it attached, against every other object (the target too)
+        self._obstacles(exclude=(held,))
+        self.collision.attach(*self._object_spheres(held_lo, held_hi), q_now)
+        try:
+            q_goal = self.ik.solve(goal, q_now, restarts=20, valid=self.collision.is_free)
+            if q_goal is None:
+                raise ExecutionError(f"no reachable collision-free pose holding {held!r} above {target!r}")
+            yield from self._move_arm(q_goal)
+        finally:
+            self.collision.detach()
         self.carried = True
+
+    @staticmethod
+    def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+        """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii."""
+        size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
+        r = float(min(size[:2]) / 2)
+        n = max(1, int(np.ceil(size[2] / (2 * r))))
+        z = np.linspace(lo[2] + shrink_m + r, hi[2] - shrink_m - r, n) if n > 1 else np.array([(lo[2] + hi[2]) / 2])
+        centre = (lo + hi) / 2
+        pts = np.stack([np.full(n, centre[0]), np.full(n, centre[1]), z], axis=1)
+        return pts, np.full(n, float(np.linalg.norm(size[:2]) / 2))
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         t = self._with_hand(self._target(), OPEN_HAND | {j: 0.0 for j in ("THJ3", "THJ1", "THJ0")})

@@ -65,6 +65,26 @@ def test_collision_model_separates_rest_from_table_contact(apple_env):
     assert not model.is_free(q)
 
 
+def test_attached_object_moves_with_the_palm_in_the_collision_model(apple_env):
+    env = apple_env.unwrapped
+    apple_env.reset(seed=0)
+    ik = ArmIK(env.agent)
+    model = ArmCollisionModel(ik)
+    q = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
+    palm = ik.fk(q).p
+    held = palm - np.array([0.0, 0.0, 0.12])  # an object hanging 12 cm below the palm
+    box = Box(held - np.array([0.1, 0.1, 0.03]), held + np.array([0.1, 0.1, -0.02]), "rim")  # just under it
+    model.set_obstacles([box])
+    assert model.is_free(q)  # the arm alone clears the box
+    model.attach(held[None], np.array([0.04]), q)
+    assert not model.is_free(q)  # the held object does not
+    raised = q.copy()
+    raised[ik.arm[1]] -= 0.15  # shoulder up: palm and object rise together
+    assert ik.fk(raised).p[2] > palm[2] + 0.05 and model.is_free(raised)
+    model.detach()
+    assert model.is_free(q)
+
+
 def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
     env = apple_env.unwrapped
     apple_env.reset(seed=0)
