@@ -203,3 +203,92 @@ def test_five_offline_tasks_are_distinct_reproducible_and_pass_check_env(tmp_pat
             check_env(env, skip_render_check=True)
         finally:
             env.close()
+
+
+# ---------------------------------------------------------------- the anthropic backend through the whole pipeline
+_SCENE = """```yaml
+name: LiftTheApple
+instruction: Lift the apple.
+objects:
+  - {name: apple, asset: apple, pos_m: [0.1, 0.0, 0.0]}
+stages:
+  - {name: approach_apple, instruction: Reach., method: motion_planning, control_joint: arm, target: apple}
+  - {name: grasp_apple, instruction: Grasp., method: RL, control_joint: hand, target: apple}
+success:
+  description: The apple is lifted.
+  conditions: [{type: lifted, object: apple, min_height_m: 0.1}]
+```"""
+_PLAN = """```yaml
+- {name: approach_apple, instruction: Reach the apple., method: motion_planning, control_joint: arm, target: apple}
+- {name: grasp_apple, instruction: Grasp the apple., method: RL, control_joint: hand, horizon: 40, target: apple}
+```"""
+_REWARD = """```python
+import torch
+
+from gendex_envs import reward_terms as rt
+
+REWARD_MAX = 1.0
+
+
+def evaluate(env):
+    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    return {"success": env.spec_success() & ~fail, "fail": fail}
+
+
+def compute_dense_reward(env, obs, action, info):
+    return rt.reach(torch.linalg.norm(env.palm_pose.p - env.obj_pose("apple").p, dim=-1))
+
+
+def _get_obs_extra(env, info):
+    return {"apple": env.obj_pose("apple").p}
+```"""
+
+
+def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_applied(tmp_path, monkeypatch):
+    import httpx2
+
+    from generator.backends.anthropic_backend import AnthropicBackend
+
+    bodies: list[dict] = []
+    analyses = iter(["Scene looks fine but the apple could sit a bit to the left.\nDirectives:\n"
+                     "Position_Action: apple - move_y 0.05", "All good.\nDirectives: none"])
+
+    def api(request):
+        body = json.loads(request.content)
+        bodies.append(body)
+        prompt = body["messages"][0]["content"][-1]["text"]
+        if "Propose ONE" in prompt:
+            text = _APPLE % "apple"
+        elif "Write the scene file" in prompt:
+            text = _SCENE
+        elif "renders of a robot task scene" in prompt:
+            text = next(analyses)
+        elif "Split this task into sub-stages" in prompt:
+            text = _PLAN
+        elif "Write the Python module" in prompt:
+            text = _REWARD
+        else:
+            raise AssertionError(f"unexpected prompt: {prompt[:80]}")
+        return httpx2.Response(200, json={
+            "id": "msg", "type": "message", "role": "assistant", "model": body["model"],
+            "content": [{"type": "text", "text": text}], "stop_reason": "end_turn", "stop_sequence": None,
+            "usage": {"input_tokens": 10, "output_tokens": 10}})
+
+    monkeypatch.setenv("ANTHROPIC_API_KEY", "sk-ant-test")
+    factory = lambda: AnthropicBackend(model="claude-test", http_client=httpx2.Client(  # noqa: E731
+        transport=httpx2.MockTransport(api)), sleep=lambda s: None)
+    [s] = generate(factory, tmp_path, n=1, command="test", candidates=1)
+    folder = s.committed.path
+    vision = [b for b in bodies if any(c["type"] == "image" for c in b["messages"][0]["content"])]
+    assert len(vision) == 2  # one analysis per refinement round, until the critic asked for nothing
+    images = [c for c in vision[0]["messages"][0]["content"] if c["type"] == "image"]
+    assert len(images) == 3 and all(i["source"]["media_type"] == "image/png" for i in images)
+    critique = json.loads((folder / "critique.json").read_text())
+    assert "Position_Action: apple - move_y 0.05" in critique["rounds"][0]["directives"]
+    assert "pos_m: [0.1, 0.05, 0.0]" in (folder / "task.yaml").read_text()
+    info = json.loads((folder / "generation.json").read_text())
+    assert info["backend"] == "anthropic" and info["model"] == "claude-test" and info["is_language_model"]
+    # the recorded transcript replays to the same files without the API
+    again = generate(lambda: ReplayBackend(folder / "transcript.jsonl"), tmp_path / "replay", n=1, command="test",
+                     candidates=1)
+    assert _tree(again[0].committed.path) == _tree(folder)
