@@ -102,7 +102,7 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
             reasons += rejected
             spec, scenes = write_scene(backend, proposal, index=index + 1000 * attempt, n_candidates=candidates)
             before = render_spec(spec, seed=seed)
-            refined, refine_log = refine(backend, spec, seed=seed)
+            refined, refine_log = refine(backend, spec, seed=seed, renders=before)
             if refine_log.remaining:
                 reasons.append(f"{proposal.name}: {len(refine_log.remaining)} violation(s) left after refinement "
                                f"({'; '.join(refine_log.remaining[:3])})")

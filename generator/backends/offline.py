@@ -334,6 +334,3 @@ class OfflineBackend:
             return _fence("python", compose_task_module(ctx["spec"], ctx["roles"]))
         return _fence("python", compose_stage_module(ctx["spec"], ctx["stage"], ctx["roles"]))
 
-
-def known_stage_kinds() -> tuple[str, ...]:
-    return tuple(OfflineBackend._PLAN)

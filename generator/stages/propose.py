@@ -8,7 +8,6 @@ condition is one GenDex can evaluate. A failed check is fed back to the backend,
 from __future__ import annotations
 
 import logging
-import re
 
 from gendex_envs.errors import suggest
 from gendex_envs.spec import CONDITION_TYPES, CONTROL_JOINT_MODES, SNAKE_NAME_RE, TASK_NAME_RE
@@ -119,6 +118,3 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
         return proposal, reasons
     raise RetriesExhaustedError(f"no valid proposal after {max_attempts} attempts; last reason: {reasons[-1]}")
 
-
-def slug(text: str) -> str:
-    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")

@@ -24,10 +24,11 @@ log = logging.getLogger(__name__)
 MAX_ROUNDS = 4
 
 
-def _vision_directives(backend: Backend, spec: TaskSpec, findings: str) -> tuple[str, list, list[str]]:
+def _vision_directives(backend: Backend, spec: TaskSpec, findings: str,
+                       renders: dict[str, bytes] | None = None, seed: int = 0) -> tuple[str, list, list[str]]:
     from generator.critic.directives import parse_directives  # noqa: PLC0415
 
-    renders = render_spec(spec)
+    renders = renders if renders is not None else render_spec(spec, seed=seed)
     images = tuple(ImagePart(v, renders[v]) for v in VIEWS)
     names = [o.name for o in spec.objects]
     answer = ask(backend, "scene_analysis", images=images, context={"spec_yaml": dump_task_spec(spec)},
@@ -63,9 +64,12 @@ def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpe
     return spec, applied, rejected
 
 
-def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS,
-           seed: int = 0) -> tuple[TaskSpec, RefineLog]:
-    """Refine ``spec``; returns the refined spec and the log (violations before and after, every round)."""
+def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS, seed: int = 0,
+           renders: dict[str, bytes] | None = None) -> tuple[TaskSpec, RefineLog]:
+    """Refine ``spec``; returns the refined spec and the log (violations before and after, every round).
+
+    ``renders``: the views of ``spec`` when the caller has them already (the first vision round reuses them).
+    """
     from generator.critic.physical import check_scene  # noqa: PLC0415
 
     rounds: list[CritiqueRound] = []
@@ -79,7 +83,8 @@ def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS,
             break
         analysis, model_directives, rejected = "", [], []
         if backend.sees_images:
-            analysis, model_directives, rejected = _vision_directives(backend, spec, report.summary())
+            analysis, model_directives, rejected = _vision_directives(backend, spec, report.summary(),
+                                                                      renders if r == 0 else None, seed)
         if not errors and not model_directives:
             break
         new_spec, applied, failed = apply_fixes(spec, report, model_directives)

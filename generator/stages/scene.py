@@ -13,10 +13,11 @@ import json
 import logging
 
 from gendex_envs.errors import TaskSpecError
-from gendex_envs.spec import SCALE_RANGE, TableSpec, TaskSpec, dump_task_spec, parse_task_spec
+from gendex_envs.spec import SCALE_RANGE, RobotSpec, TableSpec, TaskSpec, dump_task_spec, parse_task_spec
 from generator.backends.base import Backend
 from generator.backends.offline import HAND_SPAN_M
 from generator.catalog_view import asset_dict, asset_dicts, guidance
+from generator.critic.physical import REACH_MAX_M
 from generator.errors import RetriesExhaustedError, SceneError
 from generator.prompts import PROMPTS_DIR
 from generator.records import Proposal, SceneCandidate
@@ -29,7 +30,6 @@ MAX_ARTICULATED_HEIGHT_M = 0.6
 """Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach."""
 CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
-REACH_M = 1.25
 
 
 def _clamp_scale(s: float) -> float:
@@ -99,7 +99,7 @@ def write_scene(backend: Backend, proposal: Proposal, *, index: int = 0, n_candi
                        "candidate_index": k, "index": index, "attempt": attempt}
             answer = ask(backend, "scene", context=context, feedback=feedback, proposal_json=proposal_json,
                          reference_yaml=reference, asset_guidance=guidance(), table_size_m=list(TableSpec().size_m),
-                         robot_base_m=[-0.8, 0.0, 0.0], reach_m=REACH_M, scale_range=list(SCALE_RANGE),
+                         robot_base_m=list(RobotSpec().base_pos_m), reach_m=REACH_MAX_M, scale_range=list(SCALE_RANGE),
                          candidate_index=k + 1, hand_span_m=HAND_SPAN_M)
             try:
                 spec = adjust_sizes(parse_scene(answer, proposal), proposal)
