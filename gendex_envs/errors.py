@@ -41,6 +41,14 @@ class ExecutionError(GenDexError):
     """A scripted solver's primitive could not run (no reachable grasp, no plan, unsupported stage)."""
 
 
+class StageError(GenDexError, ValueError):
+    """A task stage does not exist, or a stage env lacks what it needs (start states, a policy)."""
+
+
+class PolicyError(GenDexError, ValueError):
+    """A trained policy does not fit the stage it is used for (observation or action size, control mode)."""
+
+
 def suggest(name: str, options: Iterable[str], n: int = 3) -> str:
     """Return ' Did you mean: a, b?' for close matches of ``name`` among ``options`` (or '')."""
     matches = difflib.get_close_matches(str(name), [str(o) for o in options], n=n, cutoff=0.5)

@@ -125,7 +125,10 @@ def make_task_env(task_dir: str, num_envs: int = 1, max_episode_steps: int | Non
         # without CUDA, render on the Vulkan CPU device directly (ManiSkill would warn, then do the same)
         kwargs["render_backend"] = "gpu" if torch.cuda.is_available() else "cpu"
     env = TaskEnv(task_dir=task_dir, num_envs=num_envs, **kwargs)
-    steps = env.task_spec.max_episode_steps if max_episode_steps is None else max_episode_steps
+    if max_episode_steps is not None:
+        steps = max_episode_steps
+    else:  # a stage env lasts the stage's horizon
+        steps = env.stage_spec.horizon if env.stage_spec is not None else env.task_spec.max_episode_steps
     if steps < 1:
         raise TaskSpecError(f"max_episode_steps={steps} must be >= 1")
     wrapped: gym.Env = TimeLimitWrapper(env, max_episode_steps=steps)

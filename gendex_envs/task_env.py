@@ -15,7 +15,8 @@ Members that reward code may use (all batched over ``num_envs``, tensors on ``en
 * ``env.handle_link(name)``, ``env.handle_pos(name)`` [N, 3] — the link and world grip point of an articulated
   object's handle; ``env.joint_qpos(name)`` [N], ``env.open_qpos(name)``, ``env.closed_qpos(name)`` (floats),
   ``env.joint_open_fraction(name)`` [N].
-* ``env.goal_pos`` [N, 3] (when the task has a goal), ``env.init_obj_pos(name)`` [N, 3] (pose at reset).
+* ``env.goal_pos`` [N, 3] (when the task has a goal), ``env.init_obj_pos(name)`` [N, 3] and
+  ``env.init_obj_quat(name)`` [N, 4] (pose at the start of the task episode).
 * ``env.task_spec`` — the loaded :class:`~gendex_envs.spec.TaskSpec` (``env.spec`` is Gymnasium's EnvSpec).
 * ``env.spec_success()`` [N] bool — the spec's ``success.conditions`` evaluated generically.
 * ``env.table_height`` (0.0: the table top is the plane z = 0).
@@ -40,10 +41,11 @@ from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, asset_ids, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
-from gendex_envs.errors import ControlModeError, RewardModuleError, TaskSpecError, suggest
+from gendex_envs.errors import ControlModeError, RewardModuleError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
 from gendex_envs.reward_module import RewardModule, load_reward_module
-from gendex_envs.spec import ConditionSpec, TaskSpec, load_task_spec
+from gendex_envs.spec import ConditionSpec, StageSpec, TaskSpec, load_task_spec
+from gendex_envs.stage import StartStates, resolve_stage, stage_reward_path, start_states_path
 
 log = logging.getLogger(__name__)
 
@@ -61,14 +63,24 @@ def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
 
 
 class TaskEnv(BaseEnv):
-    """Generic GenDex task: ShadowHand on UR10e at a table, objects and reward from a task folder."""
+    """Generic GenDex task: ShadowHand on UR10e at a table, objects and reward from a task folder.
+
+    Args:
+        task_dir: the task's version folder (``task.yaml``, ``reward.py``); or ``task_spec`` for a spec in memory.
+        control_joint: joint group actions drive (default: the stage's, else the first RL stage's, else ``both``).
+        stage: a sub-stage (name or index) to run on its own: its ``control_joint``, its reward module and start
+            states (see :mod:`gendex_envs.stage`). Stages after the first need start states.
+        start_states: a :class:`~gendex_envs.stage.StartStates` (or its ``.npz`` path) every reset starts from;
+            default for ``stage`` > 0: ``start_states/<stage>.npz`` of the task folder.
+    """
 
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
     agent: UR10eShadowHand
 
     def __init__(self, *args, task_dir: str | None = None, task_spec: TaskSpec | None = None,
-                 control_joint: str | None = None, view_resolution: int = 512, sensor_resolution: int = 128,
-                 **kwargs):
+                 control_joint: str | None = None, stage: str | int | None = None,
+                 start_states: StartStates | str | Path | None = None, view_resolution: int = 512,
+                 sensor_resolution: int = 128, **kwargs):
         if (task_dir is None) == (task_spec is None):
             raise TaskSpecError("TaskEnv needs exactly one of task_dir (a task folder) or task_spec (in memory)")
         self.task_dir = Path(task_dir) if task_dir is not None else None
@@ -79,10 +91,20 @@ class TaskEnv(BaseEnv):
         else:
             reward_path = DEFAULT_REWARD_MODULE
         self.task_spec: TaskSpec = task_spec
+        self.stage_index: int | None = None
+        """Index of the stage this env runs on its own (``stage=``), else None (the whole task)."""
+        self.stage_spec: StageSpec | None = None
+        if stage is not None:
+            self.stage_index, self.stage_spec = resolve_stage(task_spec, stage)
+            if self.task_dir is not None:
+                reward_path = stage_reward_path(self.task_dir, self.stage_spec.name)
         self.reward: RewardModule = load_reward_module(reward_path)
+        self.start_states: StartStates | None = self._load_start_states(start_states)
+        """States every reset starts from (stage envs after the first), else None."""
         if control_joint is None:
             rl = [s for s in self.task_spec.stages if s.method == "RL"]
-            control_joint = rl[0].control_joint if rl else "both"
+            control_joint = (self.stage_spec.control_joint if self.stage_spec is not None
+                             else rl[0].control_joint if rl else "both")
         if control_joint not in CONTROL_JOINT_GROUPS:
             raise ControlModeError(f"control_joint={control_joint!r} is not a mode; allowed: "
                                    f"{sorted(CONTROL_JOINT_GROUPS)}.{suggest(control_joint, CONTROL_JOINT_GROUPS)}")
@@ -103,6 +125,25 @@ class TaskEnv(BaseEnv):
         """Per object: radius (80 % of the half footprint) and height of the space an ``inside`` condition checks."""
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
         super().__init__(*args, **kwargs)
+
+    def _load_start_states(self, given: StartStates | str | Path | None) -> StartStates | None:
+        if given is not None:
+            states = given if isinstance(given, StartStates) else StartStates.load(given)
+        elif self.stage_index and self.task_dir is not None and start_states_path(self.task_dir,
+                                                                                  self.stage_spec.name).is_file():
+            states = StartStates.load(start_states_path(self.task_dir, self.stage_spec.name))
+        elif self.stage_index:
+            where = start_states_path(self.task_dir, self.stage_spec.name) if self.task_dir else "(in-memory spec)"
+            prev = self.task_spec.stages[self.stage_index - 1].name
+            raise StageError(f"stage {self.stage_spec.name!r} starts where stage {prev!r} succeeded, but there are no "
+                             f"start states at {where}; `gendex train` collects them, or pass start_states=")
+        else:
+            return None
+        missing = sorted({o.name for o in self.task_spec.objects} - set(states.obj_reset_pos))
+        if missing:
+            raise StageError(f"start states of stage {states.stage!r} lack objects {missing} of task "
+                             f"{self.task_spec.name!r}")
+        return states
 
     # ------------------------------------------------------------------ configuration
     @property
@@ -182,6 +223,7 @@ class TaskEnv(BaseEnv):
                                          torch.tensor(q, dtype=torch.float32, device=self.device))
         with torch.device(self.device):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
+            self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}
             self._success_streak = torch.zeros(self.num_envs, dtype=torch.long)
             self._streak_counted_at = torch.full((self.num_envs,), -1, dtype=torch.long)
         self.goal_site = None
@@ -237,7 +279,28 @@ class TaskEnv(BaseEnv):
         if seed is None:
             seeds = self.np_random.integers(2**31, size=self.num_envs).tolist()
             seed = seeds[0] if self.num_envs == 1 else seeds
-        return super().reset(seed=seed, options=options)
+        obs, info = super().reset(seed=seed, options=options)
+        if self.start_states is None:
+            return obs, info
+        env_idx = (options or {}).get("env_idx")
+        env_idx = torch.arange(self.num_envs, device=self.device) if env_idx is None else \
+            torch.as_tensor(env_idx, device=self.device)
+        self._apply_start_states(env_idx)
+        info.update(self.get_info())
+        return self.get_obs(info), info
+
+    def _apply_start_states(self, env_idx: torch.Tensor) -> None:
+        """Restore one saved start state (drawn with ``env.np_random``) into each env of ``env_idx``."""
+        s = self.start_states
+        rows = self.np_random.integers(len(s), size=len(env_idx))
+        state = torch.as_tensor(s.state[rows], dtype=torch.float32, device=self.device)
+        self.set_state(state, env_idx)
+        for name in self.objects:
+            self._obj_reset_pos[name][env_idx] = torch.as_tensor(s.obj_reset_pos[name][rows], device=self.device)
+            if name in s.obj_reset_quat:
+                self._obj_reset_quat[name][env_idx] = torch.as_tensor(s.obj_reset_quat[name][rows],
+                                                                      device=self.device)
+        self.agent.contacts.invalidate()
 
     def set_state_dict(self, state: dict, env_idx: torch.Tensor | None = None):
         # ManiSkill restores actors and articulations only; frozen-joint and delta targets live in the controller
@@ -255,6 +318,10 @@ class TaskEnv(BaseEnv):
         tail = state[:, sim_dim:]
         target = self.agent.controller._target_qpos
         if tail.shape[-1] == target.shape[-1]:
+            if env_idx is not None and len(tail) != len(target):
+                full = target.clone()
+                full[env_idx] = tail
+                tail = full
             self.agent.set_controller_state({"target_qpos": tail.clone()})
         elif tail.shape[-1] != 0:
             raise TaskSpecError(f"state has {tail.shape[-1]} values after the simulation state; expected 0 or "
@@ -309,6 +376,7 @@ class TaskEnv(BaseEnv):
                     entity.set_angular_velocity(torch.zeros(b, 3))
             for name, entity in self.objects.items():
                 self._obj_reset_pos[name][env_idx] = entity.pose.p[env_idx]
+                self._obj_reset_quat[name][env_idx] = entity.pose.q[env_idx]
             self._success_streak[env_idx] = 0
             self._streak_counted_at[env_idx] = -1
 
@@ -383,6 +451,10 @@ class TaskEnv(BaseEnv):
     def init_obj_pos(self, name: str) -> torch.Tensor:
         """[N, 3] position of object ``name`` at the last reset."""
         return self._obj_reset_pos[name]
+
+    def init_obj_quat(self, name: str) -> torch.Tensor:
+        """[N, 4] orientation (wxyz) of object ``name`` at the start of the task episode."""
+        return self._obj_reset_quat[name]
 
     def obj_height(self, name: str) -> torch.Tensor:
         """[N] how far object ``name`` has risen above its reset height, metres."""
