@@ -266,6 +266,90 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                    f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.path}")
 
 
+def _task_dir(task_id: str) -> Path:
+    """Task folder of a registered env id (``GenDex/<Name>-v<N>``) or of a folder path holding task.yaml."""
+    import gendex_envs  # noqa: F401, PLC0415  (registers the tasks)
+    from gendex_envs.registry import task_entry  # noqa: PLC0415
+
+    if Path(task_id).is_dir() and (Path(task_id) / "task.yaml").is_file():
+        return Path(task_id)
+    return task_entry(task_id).task_dir
+
+
+@app.command()
+def train(task_id: str = typer.Argument(..., help="e.g. GenDex/PickUpBottle-v0 (or a task folder)."),
+          stage: str = typer.Option(..., "--stage", help="Stage index or name; 'task' trains the whole task as one "
+                                                         "stage with every joint."),
+          steps: int = typer.Option(200_000, "--steps", min=1, help="Env steps of PPO training."),
+          envs: int = typer.Option(None, "--envs", min=1, help="Parallel envs (default: the preset's)."),
+          preset: str = typer.Option("cpu", "--preset", help="cpu (2-core machine) | paper (the seed paper's "
+                                                              "hyperparameters, GPU backend)."),
+          seed: int = typer.Option(0, "--seed"),
+          out: Path = typer.Option(None, "--out", help="Policy folder (default: <task folder>/policies)."),
+          eval_episodes: int = typer.Option(20, "--eval-episodes", min=1)) -> None:
+    """Train PPO on one stage of a task; saves the policy, its curve and evaluation with the task version."""
+    import shlex  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+    from generator.rl.train import train_stage  # noqa: PLC0415
+
+    command = "gendex train " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+    try:
+        r = train_stage(_task_dir(task_id), stage, steps=steps, preset=preset, n_envs=envs, seed=seed,
+                        policy_dir=out, eval_episodes=eval_episodes, command=command)
+    except GenDexError as exc:
+        _die(exc)
+    typer.echo(f"{r.stage}: {r.steps} env steps in {r.wall_s:.0f} s -> {r.policy_path}\n"
+               f"  trained:   success {r.trained.successes}/{r.trained.episodes}, mean return "
+               f"{r.trained.mean_return:.2f}\n"
+               f"  untrained: success {r.untrained.successes}/{r.untrained.episodes}, mean return "
+               f"{r.untrained.mean_return:.2f}")
+
+
+@app.command()
+def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutAppleBowl"], "--tasks",
+                                           help="Task names (latest version) or env ids."),
+           budget: int = typer.Option(100_000, "--budget", min=1, help="PPO env steps per task and variant."),
+           variants: list[str] = typer.Option(None, "--variant", help="Run only these (repeatable): no_subgoals, "
+                                                                      "subgoals, frozen_dofs, mp_rl."),
+           eval_episodes: int = typer.Option(20, "--eval-episodes", min=1),
+           seed: int = typer.Option(0, "--seed"),
+           out: Path = typer.Option(Path("out/ablate"), "--out", help="Run folder (policies, curves, cells)."),
+           results: Path = typer.Option(Path("docs/results.md"), "--results", help="Markdown file for the table."),
+           fresh: bool = typer.Option(False, "--fresh", help="Re-run cells already saved in --out.")) -> None:
+    """The paper's four-variant comparison: success and env steps to 1000 successes per task and variant."""
+    import shlex  # noqa: PLC0415
+    import sys  # noqa: PLC0415
+
+    import gendex_envs  # noqa: F401, PLC0415
+    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+    from gendex_envs.registry import registered_tasks  # noqa: PLC0415
+    from generator.rl.ablate import VARIANTS, run_ablation, write_results  # noqa: PLC0415
+
+    dirs = []
+    latest = {}
+    for e in registered_tasks().values():
+        if e.name not in latest or e.version > latest[e.name].version:
+            latest[e.name] = e
+    try:
+        for t in tasks:
+            dirs.append(latest[t].task_dir if t in latest else _task_dir(t))
+        chosen = tuple(variants) if variants else tuple(VARIANTS)
+        bad = [v for v in chosen if v not in VARIANTS]
+        if bad:
+            raise ValueError(f"unknown variants {bad}; variants: {list(VARIANTS)}")
+        command = "gendex ablate " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+        cells = run_ablation(dirs, budget, out, variants=chosen, seed=seed, eval_episodes=eval_episodes,
+                             resume=not fresh,
+                             progress=lambda c: typer.echo(f"{c.task} {VARIANTS[c.variant]}: {c.successes}/"
+                                                           f"{c.eval_episodes}, {c.train_steps:,} PPO steps"))
+        path = write_results(cells, results, results.parent / "results_ablation.png", command, budget)
+    except (GenDexError, ValueError) as exc:
+        _die(exc)
+    typer.echo(f"wrote {path}")
+
+
 @app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for renders."),
          steps: int = typer.Option(50, help="Control steps of the random rollout per task."),

@@ -42,6 +42,9 @@ class FreezingJointPosController(PDJointPosController):
         self.leader_idx = torch.tensor([names.index(n) for n in self.config.mimic.values()], dtype=torch.long,
                                        device=device)
         self.free_joint_names = tuple(free)
+        qlim = self.articulation.get_qlimits()[0, self.active_joint_indices].to(device)  # [J, 2]
+        self._qlimits = qlim[self.free_idx]
+        """[F, 2] limits of the free joints."""
         self._px_joints = [joint._objs[0] for joint in self.joints]
 
     def set_drive_targets(self, targets: torch.Tensor):
@@ -71,7 +74,9 @@ class FreezingJointPosController(PDJointPosController):
         target = self._target_qpos.clone()  # [N, J]
         if self.config.use_delta:
             base = target if self.config.use_target else self._start_qpos
-            target[:, self.free_idx] = base[:, self.free_idx] + action
+            # clipped to the joint limits: no wind-up past a limit, and the same targets an absolute controller gets
+            lim = self._qlimits
+            target[:, self.free_idx] = torch.clamp(base[:, self.free_idx] + action, lim[:, 0], lim[:, 1])
         else:
             target[:, self.free_idx] = action
         if len(self.follower_idx):

@@ -20,8 +20,9 @@ A stage whose target is articulated (a door, a lid) runs :mod:`gendex_envs.solve
 ``approach_handle`` (motion planning), ``hook`` (RL, hand) and ``pull`` (RL with the arm; it hooks first if no stage
 did).
 
-RL stages are meant to run a trained policy from the task folder (``policies/<stage>.zip``, issue 6); until
-policies can run, the scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
+An RL stage runs its trained policy when the task has one (``policies/<stage>.zip``, written by ``gendex train``;
+see :mod:`gendex_envs.solve.policy`) until the stage's own ``evaluate`` reports success or its horizon ends; without
+a policy the scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
 absolute joint targets for the ``pd_joint_pos`` / ``both`` action space, one control step at a time, and re-reads
 the object poses between primitives (grasps are planned from the actual pose, never from the nominal one).
 """
@@ -44,6 +45,8 @@ from gendex_envs.solve.collision import ArmCollisionModel, Box
 from gendex_envs.solve.grasp import GUARD_RAD, OPEN_HAND, GraspPlan, grasp_candidates
 from gendex_envs.solve.ik import ArmIK
 from gendex_envs.solve.planner import ArmPlanner, PlanningError
+from gendex_envs.solve.policy import StagePolicy
+from gendex_envs.stage import POLICIES_DIR
 
 log = logging.getLogger(__name__)
 
@@ -79,6 +82,16 @@ class StageExecutor:
 
     config: ExecutorConfig = field(default_factory=ExecutorConfig)
     name: str = "stages"
+    policy_dir: Path | None = None
+    """Folder of trained stage policies (default: the task's ``policies/``)."""
+    use_policies: bool = True
+    """Run trained policies for RL stages when present (False: always the scripted primitives)."""
+    policy_stages: str = "rl"
+    """Which stages run a trained policy when one exists: ``rl`` (RL stages; motion-planning stages always plan) or
+    ``all`` (every stage; the ablation's all-RL variants)."""
+    stop_before: int | None = None
+    """Stop (act() returns None) when stage ``stop_before`` would begin: the env then holds the state at the end of
+    stage ``stop_before - 1`` (how start states of a stage are collected)."""
 
     def reset(self, env: gym.Env, obs) -> None:
         u = env.unwrapped
@@ -98,6 +111,11 @@ class StageExecutor:
         self.logs: list[StageLog] = []
         self._plan: GraspPlan | None = None
         self._articulated = HandlePrimitives(self)
+        self.stage_index = -1
+        """Index of the stage being executed (-1 before the first)."""
+        self.finished = False
+        """True once every stage (up to ``stop_before``) ran without an ExecutionError."""
+        self._policies: dict[str, StagePolicy] = getattr(self, "_policies", {})
         self._actions = self._episode()
 
     def act(self, env: gym.Env, obs) -> np.ndarray | None:
@@ -194,29 +212,65 @@ class StageExecutor:
     def _episode(self) -> Iterator[np.ndarray]:
         u = self._env
         spec = u.task_spec
-        for stage in spec.stages:
-            policy = self._policy_path(stage.name)
+        for i, stage in enumerate(spec.stages):
+            if self.stop_before is not None and i >= self.stop_before:
+                self.finished = True
+                return
+            self.stage_index = i
+            learned = stage.method == "RL" or self.policy_stages == "all"
+            policy = self._policy_path(stage.name) if learned and self.use_policies else None
             prim = self._choose(stage)
             self.logs.append(StageLog(stage.name, prim, "scripted" if policy is None else str(policy)))
+            if policy is not None:
+                log.info("stage %r (RL, %s): policy %s", stage.name, stage.control_joint, policy)
+                yield from self._run_policy(stage, policy, prim)
+                continue
             if stage.method == "RL":
-                log.info("stage %r (RL, %s): %s", stage.name, stage.control_joint,
-                         f"policy {policy} found, but running policies lands with `gendex train` (issue 6); "
-                         f"scripted primitive {prim!r}" if policy else f"no trained policy; scripted primitive {prim!r}")
+                log.info("stage %r (RL, %s): no trained policy; scripted primitive %r", stage.name,
+                         stage.control_joint, prim)
             else:
                 log.info("stage %r (motion planning): primitive %r", stage.name, prim)
             if prim in ARTICULATED_PRIMITIVES:
                 yield from self._articulated.run(prim, stage)
             else:
                 yield from getattr(self, "_" + prim)(stage)
+        self.finished = True
         # hold the last targets until the task reports success (or the episode ends)
         self.logs.append(StageLog("settle", "hold", "scripted"))
         for _ in range(spec.success.hold_steps + 10):
             yield self._emit(self._target())
 
     def _policy_path(self, stage: str) -> Path | None:
-        d = self._env.task_dir
-        p = Path(d) / "policies" / f"{stage}.zip" if d else None
+        folder = self.policy_dir if self.policy_dir is not None else \
+            (Path(self._env.task_dir) / POLICIES_DIR if self._env.task_dir else None)
+        p = Path(folder) / f"{stage}.zip" if folder is not None else None
         return p if p is not None and p.exists() else None
+
+    def _run_policy(self, stage, path: Path, prim: str) -> Iterator[np.ndarray]:
+        """Run the stage's trained policy until its ``evaluate`` reports success or its horizon ends; then keep the
+        same bookkeeping the scripted primitive ``prim`` would (what the hand holds, whether a handle is hooked)."""
+        key = str(path)
+        if key not in self._policies:
+            self._policies[key] = StagePolicy.load(self._env.task_dir, stage.name, path)
+        policy = self._policies[key]
+        done = False
+        for _ in range(stage.horizon):
+            target = policy.targets(self._env, policy.act(self._env))[0].cpu().numpy().astype(np.float64)
+            yield self._emit(target)
+            if bool(policy.success(self._env)[0]):
+                done = True
+                break
+        if not done:
+            raise ExecutionError(f"policy of stage {stage.name!r} did not reach the stage's goal in {stage.horizon} "
+                                 "steps")
+        if prim == "grasp":
+            self.held = stage.target
+        elif prim == "carry":
+            self.carried = True
+        elif prim == "release":
+            self.held = None
+        elif prim == "hook":
+            self._articulated.hooked, self._articulated.target = True, stage.target
 
     def _choose(self, stage) -> str:
         target = stage.target

@@ -1,0 +1,80 @@
+"""Environments PPO trains on: one stage (or the whole task) of a GenDex task, as SB3 vector envs.
+
+Training episodes differ from evaluation ones in one way: reaching the stage's goal does not end the episode, so
+the agent keeps earning the success reward until the horizon (ending it would make success worth less than
+hovering next to it); a failure (``evaluate()['fail']``, e.g. the object fell off the table) does end it.
+``info['is_success']`` (success at any step) feeds SB3's ``rollout/success_rate`` curve.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+from gendex_envs.stage import StartStates
+
+TASK_STAGE = "task"
+"""Name of the pseudo-stage that is the whole task (the ablation's "no sub-goals" variant)."""
+
+
+class StageEpisodes(gym.Wrapper):
+    """Numpy stage env for PPO: episodes end on failure or at the horizon, not on success (see the module doc)."""
+
+    def reset(self, **kwargs):
+        self._success = False
+        return self.env.reset(**kwargs)
+
+    def step(self, action):
+        obs, reward, _, truncated, info = self.env.step(action)
+        self._success |= bool(info["success"])
+        terminated = bool(info.get("fail", False))
+        if terminated or truncated:
+            info["is_success"] = self._success
+        return obs, float(reward), terminated, bool(truncated), info
+
+
+def make_stage_env(task_dir: str | Path, stage: str | None, *, control_joint: str | None = None,
+                   start_states: StartStates | None = None, training: bool = True,
+                   max_episode_steps: int | None = None) -> gym.Env:
+    """One numpy env of ``stage`` (None: the whole task) with normalized joint-delta actions and flat state obs."""
+    from mani_skill.utils.wrappers.gymnasium import CPUGymWrapper  # noqa: PLC0415
+
+    from gendex_envs.registry import make_task_env  # noqa: PLC0415
+
+    env = make_task_env(str(task_dir), stage=None if stage in (None, TASK_STAGE) else stage,
+                        start_states=start_states, control_joint=control_joint, control_mode="pd_joint_delta_pos",
+                        obs_mode="state", reward_mode="normalized_dense", gym_api=False,
+                        max_episode_steps=max_episode_steps)
+    env = CPUGymWrapper(env, ignore_terminations=training)
+    return StageEpisodes(env) if training else env
+
+
+def env_factory(task_dir: str | Path, stage: str | None, rank: int, **kwargs) -> Callable[[], gym.Env]:
+    """A picklable constructor for one worker process (one torch thread each: two cores, two workers)."""
+
+    def make() -> gym.Env:
+        import torch  # noqa: PLC0415
+        from stable_baselines3.common.monitor import Monitor  # noqa: PLC0415
+
+        torch.set_num_threads(1)
+        return Monitor(make_stage_env(task_dir, stage, **kwargs), info_keywords=("is_success",))
+
+    make.rank = rank
+    return make
+
+
+def make_vec_env(task_dir: str | Path, stage: str | None, n_envs: int, seed: int, **kwargs):
+    """``n_envs`` stage envs: worker processes when ``n_envs`` > 1, else in this process."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv  # noqa: PLC0415
+
+    fns = [env_factory(task_dir, stage, i, **kwargs) for i in range(n_envs)]
+    venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
+    venv.seed(seed)
+    return venv
+
+
+def obs_dim(env: gym.Env) -> int:
+    return int(np.prod(env.observation_space.shape))

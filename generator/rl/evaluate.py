@@ -1,0 +1,87 @@
+"""Evaluate a stage policy (or a random / zero baseline) on its stage env, and capture the states it succeeds in.
+
+Evaluation episodes end at the stage's first success (that state is where the next stage starts), at a failure, or
+at the horizon. Actions are the policy's deterministic mean.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from gendex_envs.solve.policy import StagePolicy
+from gendex_envs.stage import StartStates
+from generator.rl.envs import make_stage_env
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class EvalResult:
+    episodes: int
+    successes: int
+    fails: int
+    mean_return: float
+    """Mean undiscounted return (normalized dense reward: each step's reward is in [0, 1])."""
+    env_steps: int
+    """Env steps all evaluation episodes took."""
+
+    @property
+    def success_rate(self) -> float:
+        return self.successes / self.episodes if self.episodes else 0.0
+
+    def as_dict(self) -> dict:
+        return asdict(self) | {"success_rate": self.success_rate}
+
+
+def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy | str | None, *, episodes: int = 20,
+                   seed: int = 10_000, control_joint: str | None = None, start_states: StartStates | None = None,
+                   capture: bool = False, max_episode_steps: int | None = None) -> tuple[EvalResult, StartStates | None]:
+    """Run ``episodes`` episodes (seeds ``seed``, ``seed + 1``, ...) of ``policy`` (a StagePolicy, ``"random"`` or
+    ``"zero"``). With ``capture``, return the states at each episode's first success as the next stage's start
+    states (None when no episode succeeded)."""
+    env = make_stage_env(task_dir, stage, control_joint=control_joint, start_states=start_states, training=False,
+                         max_episode_steps=max_episode_steps)
+    u = env.unwrapped
+    rng = np.random.default_rng(seed)
+    successes = fails = steps = 0
+    returns, captured = [], []
+    try:
+        for ep in range(episodes):
+            obs, _ = env.reset(seed=seed + ep)
+            total, done = 0.0, False
+            while not done:
+                if isinstance(policy, StagePolicy):
+                    action = policy.predict(obs)
+                elif policy == "zero":
+                    action = np.zeros(env.action_space.shape, dtype=np.float32)
+                else:
+                    action = rng.uniform(-1.0, 1.0, env.action_space.shape).astype(np.float32)
+                obs, reward, terminated, truncated, info = env.step(action)
+                total += float(reward)
+                steps += 1
+                done = terminated or truncated
+            if bool(info["success"]):
+                successes += 1
+                if capture:
+                    captured.append(_snapshot(u))
+            elif bool(info.get("fail", False)):
+                fails += 1
+            returns.append(total)
+    finally:
+        env.close()
+    result = EvalResult(episodes=episodes, successes=successes, fails=fails, mean_return=float(np.mean(returns)),
+                        env_steps=steps)
+    states = StartStates.concat(captured) if captured else None
+    return result, states
+
+
+def _snapshot(u) -> StartStates:
+    """The env's current state as a one-row StartStates (stage name filled in by the caller's context)."""
+    name = u.stage_spec.name if u.stage_spec is not None else "task"
+    return StartStates(stage=name, source="policy", state=u.get_state().cpu().numpy().astype(np.float32),
+                       obj_reset_pos={n: u.init_obj_pos(n).cpu().numpy() for n in u.objects},
+                       obj_reset_quat={n: u.init_obj_quat(n).cpu().numpy() for n in u.objects})
