@@ -280,7 +280,9 @@ class TaskEnv(BaseEnv):
             seeds = self.np_random.integers(2**31, size=self.num_envs).tolist()
             seed = seeds[0] if self.num_envs == 1 else seeds
         obs, info = super().reset(seed=seed, options=options)
-        if self.start_states is None:
+        # BaseEnv.__init__ resets once before it records the flat-state layout (_init_raw_state) that set_state
+        # needs; that reset only sizes the spaces, so it keeps the task's own initial state
+        if self.start_states is None or not hasattr(self, "_init_raw_state"):
             return obs, info
         env_idx = (options or {}).get("env_idx")
         env_idx = torch.arange(self.num_envs, device=self.device) if env_idx is None else \
@@ -312,9 +314,17 @@ class TaskEnv(BaseEnv):
     def set_state(self, state: torch.Tensor, env_idx: torch.Tensor | None = None):
         """Restore a flat state from :meth:`get_state`, controller targets included (ManiSkill drops them)."""
         state = torch.as_tensor(state, device=self.device)
-        sim_dim = 13 * len(self._init_raw_state["actors"]) + sum(
-            s.shape[-1] for s in self._init_raw_state["articulations"].values())
-        super().set_state(state[:, :sim_dim], env_idx)
+        # ManiSkill's set_state indexes _init_raw_state["actors"], which it leaves out of a scene without dynamic
+        # actors (OpenCabinet: one fixed articulation), so the state dict is rebuilt here with the same layout
+        actors = self._init_raw_state.get("actors", {})
+        arts = self._init_raw_state.get("articulations", {})
+        sim, start = {"actors": {}, "articulations": {}}, 0
+        for name in actors:
+            sim["actors"][name], start = state[:, start:start + 13], start + 13
+        for name, raw in arts.items():
+            sim["articulations"][name], start = state[:, start:start + raw.shape[-1]], start + raw.shape[-1]
+        self.set_state_dict(sim, env_idx)
+        sim_dim = start
         tail = state[:, sim_dim:]
         target = self.agent.controller._target_qpos
         if tail.shape[-1] == target.shape[-1]:
