@@ -27,7 +27,7 @@ from gendex_envs.errors import TaskSpecError, suggest
 log = logging.getLogger(__name__)
 
 RobotUid = Literal["ur10e_shadow"]
-Keyframe = Literal["rest", "pregrasp_open"]
+Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
 ConditionType = Literal["lifted", "inside", "joint_open", "near"]

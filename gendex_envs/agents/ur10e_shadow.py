@@ -113,9 +113,18 @@ _OPEN_HAND = {j: 0.0 for j in HAND_JOINTS}
 _RELAXED_HAND = _OPEN_HAND | {"FFJ2": 0.3, "FFJ1": 0.3, "FFJ0": 0.3, "MFJ2": 0.3, "MFJ1": 0.3, "MFJ0": 0.3,
                               "RFJ2": 0.3, "RFJ1": 0.3, "RFJ0": 0.3, "LFJ2": 0.3, "LFJ1": 0.3, "LFJ0": 0.3,
                               "THJ4": 0.6, "THJ3": 0.3}
+_PALM_UP_ARM = _REST_ARM[:5] + (-3.1416,)
+"""The rest arm with wrist_3 turned half a turn about the forearm axis (IK finds exactly this for the target): palm
+facing straight up 0.30 m above the table at x = 0, fingers pointing away from the base, thumb towards -y. The UR
+links stay where they are at rest, above the hand and clear of the table."""
+_CUPPED_HAND = _OPEN_HAND | {"FFJ2": 0.25, "FFJ1": 0.2, "FFJ0": 0.2, "MFJ2": 0.25, "MFJ1": 0.2, "MFJ0": 0.2,
+                            "RFJ2": 0.25, "RFJ1": 0.2, "RFJ0": 0.2, "LFJ4": 0.3, "LFJ2": 0.25, "LFJ1": 0.2,
+                            "LFJ0": 0.2, "THJ4": 1.0, "THJ3": 0.2}
+"""Fingers a little flexed, little-finger metacarpal cupped and thumb abducted: a shallow bowl a ball rests in."""
 KEYFRAME_QPOS_BY_NAME: dict[str, dict[str, float]] = {
     "rest": dict(zip(ARM_JOINTS, _REST_ARM)) | _RELAXED_HAND,
     "pregrasp_open": dict(zip(ARM_JOINTS, _REST_ARM)) | _OPEN_HAND | {"THJ4": 1.0, "THJ3": 0.2},
+    "palm_up": dict(zip(ARM_JOINTS, _PALM_UP_ARM)) | _CUPPED_HAND,
 }
 
 

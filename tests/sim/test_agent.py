@@ -30,7 +30,7 @@ def test_keyframes_match_robot_dof(make_env):
         assert np.all(keyframe.qpos >= limits[:, 0] - 1e-6) and np.all(keyframe.qpos <= limits[:, 1] + 1e-6), name
 
 
-@pytest.mark.parametrize("keyframe", ["rest", "pregrasp_open"])
+@pytest.mark.parametrize("keyframe", ["rest", "pregrasp_open", "palm_up"])
 def test_hand_holds_keyframe(make_env, keyframe):
     env = make_env(TASK, control_mode="pd_joint_delta_pos")
     agent = env.unwrapped.agent

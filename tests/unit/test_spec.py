@@ -154,7 +154,7 @@ def test_allowed_value_constants() -> None:
     assert CONTROL_JOINT_MODES == ("arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire")
     assert STAGE_METHODS == ("motion_planning", "RL")
     assert CONDITION_TYPES == ("lifted", "inside", "joint_open", "near")
-    assert KEYFRAMES == ("rest", "pregrasp_open")
+    assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
 

@@ -1,0 +1,102 @@
+"""RotateTennisBall: the palm_up keyframe, a stable scene, evaluate()'s rotation/drop logic, random is not enough."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+from gymnasium.utils.env_checker import check_env
+from mani_skill.utils.structs import Pose
+
+from gendex_envs.agents.ur10e_shadow import ARM_JOINTS, KEYFRAME_QPOS_BY_NAME
+from gendex_envs.geometry import quat_mul, quat_rotate, yaw_quat
+from generator.stages.validate import check_reward_source
+
+TASK = "GenDex/RotateTennisBall-v0"
+TASK_DIR = Path(__file__).resolve().parents[2] / "generated_tasks/RotateTennisBall/v0"
+BALL_RADIUS_M = 0.0335 * 0.97
+
+
+def _make(make_env):
+    return make_env(TASK, control_mode="pd_joint_delta_pos", control_joint="hand")
+
+
+def test_reward_module_passes_the_validator():
+    check_reward_source((TASK_DIR / "reward.py").read_text())
+
+
+@pytest.mark.filterwarnings("ignore:.*observation space (minimum|maximum) value is:UserWarning")
+@pytest.mark.filterwarnings("ignore:.*different from the unwrapped version:UserWarning")
+def test_check_env_passes(make_env):
+    check_env(make_env(TASK), skip_render_check=True)
+
+
+def test_palm_up_keyframe_faces_up_and_clears_the_table(make_env):
+    env = _make(make_env)
+    env.reset(seed=0)
+    agent = env.unwrapped.agent
+    palm = agent.palm_link.pose
+    normal = quat_rotate(palm.q, torch.tensor([[0.0, -1.0, 0.0]]))[0]  # -y of the palm frame points out of the palm
+    fingers = quat_rotate(palm.q, torch.tensor([[0.0, 0.0, 1.0]]))[0]
+    assert normal[2].item() > 0.999 and fingers[0].item() > 0.999
+    assert 0.25 <= palm.p[0, 2].item() <= 0.35
+    for link in agent.robot.get_links():  # links (not the base, standing on the table top) clear the table
+        if link.name in ("base_link", "shoulder_link") or not link._objs[0].collision_shapes:
+            continue
+        assert link._objs[0].compute_global_aabb_tight()[0][2] > 0.05, link.name
+    assert set(KEYFRAME_QPOS_BY_NAME["palm_up"]) >= set(ARM_JOINTS)
+
+
+def test_ball_rests_in_the_palm_under_zero_actions(make_env):
+    env = _make(make_env)
+    env.reset(seed=0)
+    zero = np.zeros(env.action_space.shape, dtype=np.float32)
+    for _ in range(100):
+        _, _, terminated, _, info = env.step(zero)
+        assert not terminated
+    assert not info["fail"] and abs(math.degrees(info["rotation"])) < 20.0 and info["palm_dist"] < 0.04
+
+
+def _place_ball(u, yaw_rad: float, shift_m: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> None:
+    """Turn the ball about its own centre by ``yaw_rad`` about world z and shift it."""
+    ball = u.obj("ball")
+    p, q = ball.pose.p, ball.pose.q
+    up = torch.tensor([[0.0, 0.0, BALL_RADIUS_M]])
+    centre = p + quat_rotate(q, up)
+    q_new = quat_mul(yaw_quat(torch.tensor([yaw_rad])), q)
+    p_new = centre - quat_rotate(q_new, up) + torch.tensor([shift_m])
+    ball.set_pose(Pose.create_from_pq(p_new, q_new))
+
+
+def test_evaluate_reports_rotation_success_and_drop(make_env):
+    env = _make(make_env)
+    u = env.unwrapped
+    env.reset(seed=0)
+    info = u.reward.evaluate(u)
+    assert not info["success"].item() and not info["fail"].item()
+    _place_ball(u, math.radians(100.0))
+    info = u.reward.evaluate(u)
+    assert info["success"].item() and not info["fail"].item()
+    assert math.degrees(info["rotation"].item()) == pytest.approx(100.0, abs=1.0)
+    _place_ball(u, math.radians(-200.0))  # back to -100 degrees: the wrong sense is no success
+    assert not u.reward.evaluate(u)["success"].item()
+    env.reset(seed=0)
+    _place_ball(u, math.radians(100.0), shift_m=(0.1, 0.0, 0.0))
+    info = u.reward.evaluate(u)
+    assert info["fail"].item() and not info["success"].item()
+
+
+def test_random_policy_rarely_succeeds(make_env):
+    env = _make(make_env)
+    env.action_space.seed(0)
+    successes = 0
+    for seed in range(5):
+        env.reset(seed=seed)
+        for _ in range(60):
+            _, reward, terminated, truncated, info = env.step(env.action_space.sample())
+            assert np.isfinite(reward)
+            if terminated or truncated:
+                break
+        successes += bool(info["success"])
+    assert successes <= 2
