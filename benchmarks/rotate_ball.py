@@ -56,7 +56,8 @@ def evaluate(env: gym.Env, name: str, n: int, reset, act) -> dict:
                rot_deg=np.mean([math.degrees(r["rotation"]) for r in runs]),
                steps_per_s=sum(r["steps"] for r in runs) / wall)
     print(f"{name:12s} success {res['success']:6.1%}  drop {res['drop']:6.1%}  mean final |rotation| "
-          f"{res['abs_rot_deg']:6.1f} deg (signed {res['rot_deg']:+6.1f})  {res['steps_per_s']:6.0f} steps/s", flush=True)
+          f"{res['abs_rot_deg']:6.1f} deg (signed {res['rot_deg']:+6.1f})  {res['steps_per_s']:6.0f} steps/s",
+          flush=True)
     return res
 
 
@@ -74,11 +75,10 @@ def main(argv: list[str] | None = None) -> list[dict]:
         gait = FingerGaitSolver()
         results.append(evaluate(env, gait.name, args.episodes, gait.reset, gait.act))
         if POLICY.is_file():
-            from stable_baselines3 import PPO  # heavy import, only when there is a policy to run
+            from gendex_envs.solve.policy import StagePolicy  # loads SB3: only when there is a policy to run
 
-            model = PPO.load(str(POLICY), device="cpu")
-            results.append(evaluate(env, "ppo", args.episodes, lambda e, o: None,
-                                    lambda e, o: model.predict(o, deterministic=True)[0]))
+            policy = StagePolicy.load(POLICY.parent.parent, "rotate_ball")  # applies the saved obs normalization
+            results.append(evaluate(env, "ppo", args.episodes, lambda e, o: None, lambda e, o: policy.predict(o)))
         else:
             print(f"ppo          skipped: no trained policy at {POLICY}")
     finally:

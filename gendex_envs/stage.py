@@ -96,7 +96,8 @@ class StartStates:
             raise StageError(f"start states of stage {self.stage!r} must be a non-empty [M, D] array, "
                              f"got shape {self.state.shape}")
         m = len(self.state)
-        for kind, table, width in (("obj_reset_pos", self.obj_reset_pos, 3), ("obj_reset_quat", self.obj_reset_quat, 4)):
+        for kind, table, width in (("obj_reset_pos", self.obj_reset_pos, 3),
+                                   ("obj_reset_quat", self.obj_reset_quat, 4)):
             for name, value in table.items():
                 if value.shape != (m, width):
                     raise StageError(f"start states of stage {self.stage!r}: {kind}[{name!r}] has shape {value.shape}, "

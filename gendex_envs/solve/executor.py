@@ -22,7 +22,8 @@ did).
 
 An RL stage runs its trained policy when the task has one (``policies/<stage>.zip``, written by ``gendex train``;
 see :mod:`gendex_envs.solve.policy`) until the stage's own ``evaluate`` reports success or its horizon ends; without
-a policy the scripted primitive runs and the log says so. The executor is a :class:`gendex_envs.data.collector.Solver`: it emits
+a policy the scripted primitive runs and the log says so. The executor is a
+:class:`gendex_envs.data.collector.Solver`: it emits
 absolute joint targets for the ``pd_joint_pos`` / ``both`` action space, one control step at a time, and re-reads
 the object poses between primitives (grasps are planned from the actual pose, never from the nominal one).
 """

@@ -77,7 +77,8 @@ class StagePolicy:
         module = load_reward_module(stage_reward_path(task_dir, stage))
         norm = meta["obs_norm"]
         return cls(stage=stage, control_joint=meta["control_joint"], module=module, model=model,
-                   obs_mean=np.asarray(norm["mean"], dtype=np.float32), obs_var=np.asarray(norm["var"], dtype=np.float32),
+                   obs_mean=np.asarray(norm["mean"], dtype=np.float32),
+                   obs_var=np.asarray(norm["var"], dtype=np.float32),
                    clip_obs=float(norm["clip"]), meta=meta)
 
     def normalize(self, obs: np.ndarray) -> np.ndarray:

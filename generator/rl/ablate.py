@@ -262,7 +262,8 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
     for ax, title in zip(axes, ("success rate (%)", f"env steps to {n} successes (log; none = never)")):
         ax.set_xticks(range(len(tasks)), tasks)
         ax.set_title(title, fontsize=10)
-    axes[1].set_yscale("log")
+    if any(not math.isinf(c.steps_to(n)) for c in cells):
+        axes[1].set_yscale("log")
     axes[0].set_ylim(0, 105)
     axes[0].legend(fontsize=7, loc="upper right")
     fig.suptitle(f"GenDex ablation, {budget:,} PPO env steps per task and variant (2 CPU cores)", fontsize=10)
@@ -288,9 +289,9 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
     table = "\n".join(lines)
     path.parent.mkdir(parents=True, exist_ok=True)
     rel = plot.relative_to(path.parent) if plot.is_relative_to(path.parent) else plot
-    text = ABLATION_BEGIN + f"\nCommand: `{command}` (budget {budget:,} PPO env steps per task and variant, " \
-                            f"{cells[0].eval_episodes} evaluation episodes per cell).\n\n{table}\n\n![ablation]({rel})\n" \
-        + ABLATION_END
+    text = (ABLATION_BEGIN + f"\nCommand: `{command}` (budget {budget:,} PPO env steps per task and variant, "
+            f"{cells[0].eval_episodes} evaluation episodes per cell).\n\n{table}\n\n![ablation]({rel})\n"
+            + ABLATION_END)
     old = path.read_text() if path.is_file() else "# Results\n\n"
     if ABLATION_BEGIN in old and ABLATION_END in old:
         head, rest = old.split(ABLATION_BEGIN, 1)

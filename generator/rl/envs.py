@@ -78,3 +78,27 @@ def make_vec_env(task_dir: str | Path, stage: str | None, n_envs: int, seed: int
 
 def obs_dim(env: gym.Env) -> int:
     return int(np.prod(env.observation_space.shape))
+
+
+class _FailOnlyTermination(gym.Wrapper):
+    """Batched counterpart of :class:`StageEpisodes` for the GPU backend: only ``fail`` ends an episode."""
+
+    def step(self, action):
+        obs, reward, _, truncated, info = self.env.step(action)
+        return obs, reward, info["fail"].clone(), truncated, info
+
+
+def make_gpu_vec_env(task_dir: str | Path, stage: str | None, n_envs: int, seed: int, *,
+                     control_joint: str | None = None, start_states: StartStates | None = None):
+    """``n_envs`` sub-scenes of one ManiSkill GPU-backend env as an SB3 VecEnv (needs CUDA)."""
+    from mani_skill.vector.wrappers.sb3 import ManiSkillSB3VectorEnv  # noqa: PLC0415
+
+    from gendex_envs.registry import make_task_env  # noqa: PLC0415
+
+    env = make_task_env(str(task_dir), num_envs=n_envs, sim_backend="physx_cuda", gym_api=False,
+                        stage=None if stage in (None, TASK_STAGE) else stage, start_states=start_states,
+                        control_joint=control_joint, control_mode="pd_joint_delta_pos", obs_mode="state",
+                        reward_mode="normalized_dense")
+    venv = ManiSkillSB3VectorEnv(_FailOnlyTermination(env))
+    venv.seed(seed)
+    return venv

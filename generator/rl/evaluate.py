@@ -1,7 +1,9 @@
 """Evaluate a stage policy (or a random / zero baseline) on its stage env, and capture the states it succeeds in.
 
-Evaluation episodes end at the stage's first success (that state is where the next stage starts), at a failure, or
-at the horizon. Actions are the policy's deterministic mean.
+Evaluation episodes run like training ones: to the horizon, or to a failure; the return is summed over the whole
+episode, so returns of a policy that succeeds early and one that never does compare fairly. An episode succeeds when
+the goal holds at any step; its state at that first success is what the next stage starts from, and the steps up to
+it are what collecting that trajectory costs. Actions are the policy's deterministic mean.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ class EvalResult:
     mean_return: float
     """Mean undiscounted return (normalized dense reward: each step's reward is in [0, 1])."""
     env_steps: int
-    """Env steps all evaluation episodes took."""
+    """Env steps of collecting these episodes: up to the first success, else the whole episode."""
 
     @property
     def success_rate(self) -> float:
@@ -39,11 +41,12 @@ class EvalResult:
 
 def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy | str | None, *, episodes: int = 20,
                    seed: int = 10_000, control_joint: str | None = None, start_states: StartStates | None = None,
-                   capture: bool = False, max_episode_steps: int | None = None) -> tuple[EvalResult, StartStates | None]:
+                   capture: bool = False,
+                   max_episode_steps: int | None = None) -> tuple[EvalResult, StartStates | None]:
     """Run ``episodes`` episodes (seeds ``seed``, ``seed + 1``, ...) of ``policy`` (a StagePolicy, ``"random"`` or
     ``"zero"``). With ``capture``, return the states at each episode's first success as the next stage's start
     states (None when no episode succeeded)."""
-    env = make_stage_env(task_dir, stage, control_joint=control_joint, start_states=start_states, training=False,
+    env = make_stage_env(task_dir, stage, control_joint=control_joint, start_states=start_states, training=True,
                          max_episode_steps=max_episode_steps)
     u = env.unwrapped
     rng = np.random.default_rng(seed)
@@ -52,7 +55,7 @@ def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy 
     try:
         for ep in range(episodes):
             obs, _ = env.reset(seed=seed + ep)
-            total, done = 0.0, False
+            total, done, first, t = 0.0, False, None, 0
             while not done:
                 if isinstance(policy, StagePolicy):
                     action = policy.predict(obs)
@@ -62,14 +65,15 @@ def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy 
                     action = rng.uniform(-1.0, 1.0, env.action_space.shape).astype(np.float32)
                 obs, reward, terminated, truncated, info = env.step(action)
                 total += float(reward)
-                steps += 1
+                t += 1
+                if first is None and bool(info["success"]):
+                    first = t
+                    if capture:
+                        captured.append(_snapshot(u))
                 done = terminated or truncated
-            if bool(info["success"]):
-                successes += 1
-                if capture:
-                    captured.append(_snapshot(u))
-            elif bool(info.get("fail", False)):
-                fails += 1
+            steps += t if first is None else first
+            successes += first is not None
+            fails += first is None and bool(info.get("fail", False))
             returns.append(total)
     finally:
         env.close()

@@ -45,7 +45,8 @@ class PPOPreset:
     def with_overrides(self, **changes) -> PPOPreset:
         unknown = sorted(set(changes) - {f.name for f in dataclasses.fields(self)})
         if unknown:
-            raise TrainingError(f"unknown PPO settings {unknown}; allowed: {[f.name for f in dataclasses.fields(self)]}")
+            allowed = [f.name for f in dataclasses.fields(self)]
+            raise TrainingError(f"unknown PPO settings {unknown}; allowed: {allowed}")
         return dataclasses.replace(self, **{k: v for k, v in changes.items() if v is not None})
 
     def ppo_kwargs(self) -> dict:

@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from gendex_envs.reward_module import load_reward_module
 from gendex_envs.solve.policy import POLICY_FORMAT, StagePolicy
 from gendex_envs.spec import load_task_spec
-from gendex_envs.reward_module import load_reward_module
 from gendex_envs.stage import POLICIES_DIR, START_STATES_DIR, StartStates, resolve_stage, stage_reward_path
-from generator.rl.envs import TASK_STAGE, make_vec_env
+from generator.rl.envs import TASK_STAGE, make_gpu_vec_env, make_vec_env
 from generator.rl.evaluate import EvalResult, evaluate_stage
 from generator.rl.presets import PPOPreset, TrainingError, get_preset
 from generator.rl.start_states import collect_executor_states
@@ -101,8 +101,6 @@ def train_stage(task_dir: str | Path, stage: str | int | None, *, steps: int, pr
     if p.gpu_backend and not torch.cuda.is_available():
         raise TrainingError(f"preset {p.name!r} runs {p.n_envs} envs on ManiSkill's GPU backend and needs CUDA; "
                             "on a CPU machine pass --envs (processes) or use --preset cpu")
-    if p.gpu_backend:
-        raise TrainingError("the GPU backend path (ManiSkillSB3VectorEnv) is not wired yet; use --envs on CPU")
     rollout = p.n_steps * p.n_envs
     if steps < rollout:
         raise TrainingError(f"--steps {steps} is less than one PPO rollout ({p.n_steps} steps × {p.n_envs} envs = "
@@ -118,7 +116,8 @@ def train_stage(task_dir: str | Path, stage: str | int | None, *, steps: int, pr
     torch.set_num_threads(1)  # the env workers own the cores (PPO on 2 cores: 4x faster than torch's default)
     env_kw = dict(control_joint=cj, start_states=start_states)
     t0 = time.perf_counter()
-    venv = VecNormalize(make_vec_env(task_dir, name, p.n_envs, seed, **env_kw), gamma=p.gamma, clip_obs=10.0)
+    make = make_gpu_vec_env if p.gpu_backend else make_vec_env
+    venv = VecNormalize(make(task_dir, name, p.n_envs, seed, **env_kw), gamma=p.gamma, clip_obs=10.0)
     try:
         model = PPO("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **p.ppo_kwargs())
         fresh = StagePolicy(stage=name, control_joint=cj, module=load_reward_module(stage_reward_path(task_dir, name)),

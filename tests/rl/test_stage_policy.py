@@ -69,11 +69,12 @@ def test_later_stage_needs_start_states_and_restores_them(tmp_path):
     try:
         u = env.unwrapped
         env.reset(seed=0)
-        assert u.control_joint == "hand" and env.action_space.shape == (18,)
+        assert u.control_joint == "hand" and env.action_space.shape == (20,)  # 2 wrist + 18 fingers (distals follow)
         row = [i for i in range(2) if np.allclose(u.get_state()[0].cpu().numpy(), got.states.state[i], atol=1e-5)]
         assert row, "the reset state is none of the saved start states"
         # obj_height measures from where the bottle stood when the task episode began, not from the restored pose
-        np.testing.assert_allclose(u.init_obj_pos("bottle")[0].cpu().numpy(), got.states.obj_reset_pos["bottle"][row[0]])
+        np.testing.assert_allclose(u.init_obj_pos("bottle")[0].cpu().numpy(),
+                                   got.states.obj_reset_pos["bottle"][row[0]])
         assert abs(float(u.obj_height("bottle")[0])) < 0.02
         assert env.unwrapped.stage_spec.horizon == 40
     finally:
