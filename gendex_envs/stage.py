@@ -10,7 +10,7 @@ the success of the previous stage (:class:`StartStates`). Files of one task vers
         start_states/<stage>.npz        states the stage starts from (stages after the first)
         policies/<stage>.zip            trained PPO policy, used by the stage executor when present
         policies/<stage>.json           what trained it: preset, steps, seed, evaluation, command
-        policies/<stage>/progress.csv   training curve (and eval.csv, checkpoints/)
+        policies/<stage>/progress.csv   training curve (checkpoints/ beside it, not committed)
 """
 
 from __future__ import annotations
