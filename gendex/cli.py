@@ -344,7 +344,7 @@ def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutA
                              resume=not fresh,
                              progress=lambda c: typer.echo(f"{c.task} {VARIANTS[c.variant]}: {c.successes}/"
                                                            f"{c.eval_episodes}, {c.train_steps:,} PPO steps"))
-        path = write_results(cells, results, results.parent / "results_ablation.png", command, budget)
+        path = write_results(cells, results, results.parent / "images" / f"ablation_{budget}.png", command, budget)
     except (GenDexError, ValueError) as exc:
         _die(exc)
     typer.echo(f"wrote {path}")

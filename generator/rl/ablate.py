@@ -289,18 +289,21 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
     table = "\n".join(lines)
     path.parent.mkdir(parents=True, exist_ok=True)
     rel = plot.relative_to(path.parent) if plot.is_relative_to(path.parent) else plot
-    text = (ABLATION_BEGIN + f"\nCommand: `{command}` (budget {budget:,} PPO env steps per task and variant, "
+    begin, end = ablation_markers(budget)
+    text = (begin + f"\nCommand: `{command}` (budget {budget:,} PPO env steps per task and variant, "
             f"{cells[0].eval_episodes} evaluation episodes per cell).\n\n{table}\n\n![ablation]({rel})\n"
-            + ABLATION_END)
+            + end)
     old = path.read_text() if path.is_file() else "# Results\n\n"
-    if ABLATION_BEGIN in old and ABLATION_END in old:
-        head, rest = old.split(ABLATION_BEGIN, 1)
-        new = head + text + rest.split(ABLATION_END, 1)[1]
+    if begin in old and end in old:  # one block per budget, replaced in place
+        head, rest = old.split(begin, 1)
+        new = head + text + rest.split(end, 1)[1]
     else:
         new = old.rstrip("\n") + "\n\n" + text + "\n"
     path.write_text(new)
     return path
 
 
-ABLATION_BEGIN = "<!-- ablation table: written by `gendex ablate` -->"
-ABLATION_END = "<!-- end of ablation table -->"
+def ablation_markers(budget: int) -> tuple[str, str]:
+    """HTML comments around the table of one budget in the results file."""
+    return (f"<!-- ablation table, budget {budget}: written by `gendex ablate` -->",
+            f"<!-- end of ablation table, budget {budget} -->")

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from generator.rl.ablate import ABLATION_BEGIN, ABLATION_END, Cell, StageRecord, _split, load_cell, write_results
+from generator.rl.ablate import Cell, StageRecord, _split, ablation_markers, load_cell, write_results
 from generator.rl.presets import TrainingError
 
 
@@ -33,13 +33,16 @@ def test_results_table_is_written_and_replaced_in_place(tmp_path):
     cells = [_cell("mp_rl", 10), _cell("subgoals", 0)]
     write_results(cells, md, tmp_path / "plot.png", "gendex ablate --budget 20000", 20_000)
     text = md.read_text()
-    assert "intro kept" in text and text.count(ABLATION_BEGIN) == 1 and text.count(ABLATION_END) == 1
+    begin, end = ablation_markers(20_000)
+    assert "intro kept" in text and text.count(begin) == 1 and text.count(end) == 1
     assert "| PickUpBottle | (iv) motion planning + RL | 10/20 (50 %) | 0.17 M |" in text
     assert "| PickUpBottle | (ii) sub-goals | 0/20 (0 %) | — (no success) |" in text
     assert "60 %, 88.6 M" in text and "grasp_bottle: 50 %" in text and "approach_bottle: planner" in text
     assert (tmp_path / "plot.png").stat().st_size > 1000
     write_results(cells[:1], md, tmp_path / "plot.png", "gendex ablate --budget 20000", 20_000)  # rewrite in place
-    assert md.read_text().count(ABLATION_BEGIN) == 1 and "(ii) sub-goals" not in md.read_text()
+    assert md.read_text().count(begin) == 1 and "(ii) sub-goals" not in md.read_text()
+    write_results(cells[:1], md, tmp_path / "plot2.png", "gendex ablate --budget 99000", 99_000)  # another block
+    assert md.read_text().count(begin) == 1 and md.read_text().count(ablation_markers(99_000)[0]) == 1
 
 
 def test_cell_round_trip(tmp_path):
