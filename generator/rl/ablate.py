@@ -51,6 +51,8 @@ PAPER: dict[str, dict[str, str]] = {
 variants appear as bars without values."""
 START_STATES = 64
 CAPTURE_EPISODES = 40
+FLOOR_STEPS = 1e4
+"""Bottom of the plot's log axis."""
 """Evaluation episodes of an all-RL stage whose successes become the next stage's start states."""
 
 
@@ -258,12 +260,15 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
         rate = [100 * by[(t, v)].success_rate if (t, v) in by else 0 for t in tasks]
         steps = [by[(t, v)].steps_to(n) if (t, v) in by else math.inf for t in tasks]
         axes[0].bar(xs, rate, width, label=VARIANTS[v])
-        axes[1].bar(xs, [s if not math.isinf(s) else 0 for s in steps], width, label=VARIANTS[v])
-    for ax, title in zip(axes, ("success rate (%)", f"env steps to {n} successes (log; none = never)")):
+        bars = axes[1].bar(xs, [s if not math.isinf(s) else 0 for s in steps], width, label=VARIANTS[v])
+        for x, s, bar in zip(xs, steps, bars):
+            if math.isinf(s):  # never succeeded: a marker at the axis instead of an invisible bar
+                axes[1].plot(x, FLOOR_STEPS * 1.3, marker="x", color=bar.get_facecolor(), markersize=6)
+    for ax, title in zip(axes, ("success rate (%)", f"env steps to {n} successes (log; × = never succeeded)")):
         ax.set_xticks(range(len(tasks)), tasks)
         ax.set_title(title, fontsize=10)
-    if any(not math.isinf(c.steps_to(n)) for c in cells):
-        axes[1].set_yscale("log")
+    axes[1].set_yscale("log")
+    axes[1].set_ylim(bottom=FLOOR_STEPS)
     axes[0].set_ylim(0, 105)
     axes[0].legend(fontsize=7, loc="upper right")
     fig.suptitle(f"GenDex ablation, {budget:,} PPO env steps per task and variant (2 CPU cores)", fontsize=10)
@@ -281,7 +286,7 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
             if c is None:
                 continue
             stages = ", ".join(f"{s.stage}: " + ("planner" if s.method == "motion_planning" else
-                                                  "—" if s.stage_success is None else f"{100 * s.stage_success:.0f} %")
+                                                  "not reached" if s.stage_success is None else f"{100 * s.stage_success:.0f} %")
                                for s in c.stages)
             lines.append(f"| {t} | {VARIANTS[v]} | {c.successes}/{c.eval_episodes} ({100 * c.success_rate:.0f} %) | "
                          f"{_fmt_steps(c.steps_to(n))} | {c.train_steps:,} | {c.collect_steps:,} | {stages} | "
