@@ -16,6 +16,7 @@ N / success rate × env steps per evaluation episode (the paper's measure, with 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -162,6 +163,8 @@ def run_cell(task_dir: str | Path, variant: str, budget: int, out: Path, *, seed
                                              control_joint=cj, start_states=states, capture=True)
                 rec.collect_steps = res.env_steps
                 cell.collect_steps += res.env_steps
+                if states is not None:  # captured at this stage's success: the next stage's start states
+                    states = dataclasses.replace(states, stage=spec.stages[i + 1].name)
         else:
             cell.successes, cell.eval_steps = evaluate_task(task_dir, pol_dir, eval_episodes, seed=seed + 100_000,
                                                             policy_stages="all" if all_rl else "rl")
@@ -237,6 +240,12 @@ def run_ablation(task_dirs: list[Path], budget: int, out: Path, *, variants: tup
     return cells
 
 
+def _stage_cell(s: StageRecord) -> str:
+    if s.method == "motion_planning":
+        return "planner"
+    return "not reached" if s.stage_success is None else f"{100 * s.stage_success:.0f} %"
+
+
 def _fmt_steps(x: float) -> str:
     if math.isinf(x):
         return "— (no success)"
@@ -285,9 +294,7 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
             c = by.get((t, v))
             if c is None:
                 continue
-            stages = ", ".join(f"{s.stage}: " + ("planner" if s.method == "motion_planning" else
-                                                  "not reached" if s.stage_success is None else f"{100 * s.stage_success:.0f} %")
-                               for s in c.stages)
+            stages = ", ".join(f"{s.stage}: {_stage_cell(s)}" for s in c.stages)
             lines.append(f"| {t} | {VARIANTS[v]} | {c.successes}/{c.eval_episodes} ({100 * c.success_rate:.0f} %) | "
                          f"{_fmt_steps(c.steps_to(n))} | {c.train_steps:,} | {c.collect_steps:,} | {stages} | "
                          f"{PAPER.get(t, {}).get(v, 'bar only')} |")
