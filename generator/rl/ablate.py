@@ -268,14 +268,21 @@ def write_results(cells: list[Cell], path: Path, plot: Path, command: str, budge
         xs = [i + (j - (len(variants) - 1) / 2) * width for i in range(len(tasks))]
         rate = [100 * by[(t, v)].success_rate if (t, v) in by else 0 for t in tasks]
         steps = [by[(t, v)].steps_to(n) if (t, v) in by else math.inf for t in tasks]
-        axes[0].bar(xs, rate, width, label=VARIANTS[v])
-        bars = axes[1].bar(xs, [s if not math.isinf(s) else 0 for s in steps], width, label=VARIANTS[v])
+        color = f"C{list(VARIANTS).index(v)}"  # one colour per variant in every plot
+        axes[0].bar(xs, rate, width, label=VARIANTS[v], color=color)
+        bars = axes[1].bar(xs, [s if not math.isinf(s) else 0 for s in steps], width, label=VARIANTS[v],
+                           color=color)
         for x, s, bar in zip(xs, steps, bars):
             if math.isinf(s):  # never succeeded: a marker at the axis instead of an invisible bar
                 axes[1].plot(x, FLOOR_STEPS * 1.3, marker="x", color=bar.get_facecolor(), markersize=6)
     for ax, title in zip(axes, ("success rate (%)", f"env steps to {n} successes (log; × = never succeeded)")):
         ax.set_xticks(range(len(tasks)), tasks)
         ax.set_title(title, fontsize=10)
+    for i, t in enumerate(tasks):  # the paper's variant (iv), where its text gives numbers
+        if "mp_rl" in PAPER.get(t, {}):
+            rate, steps = PAPER[t]["mp_rl"].replace(" %", "").replace(" M", "").split(", ")
+            axes[0].plot(i, float(rate), marker="*", color="k", markersize=9, label="paper (iv)" if i == 0 else None)
+            axes[1].plot(i, float(steps) * 1e6, marker="*", color="k", markersize=9)
     axes[1].set_yscale("log")
     axes[1].set_ylim(bottom=FLOOR_STEPS)
     axes[0].set_ylim(0, 105)
