@@ -114,6 +114,7 @@ def train_stage(task_dir: str | Path, stage: str | int | None, *, steps: int, pr
                                                        policy_dir, seed)
     else:
         state_steps = 0
+    threads = torch.get_num_threads()
     torch.set_num_threads(1)  # the env workers own the cores (PPO on 2 cores: 4x faster than torch's default)
     env_kw = dict(control_joint=cj, start_states=start_states)
     t0 = time.perf_counter()
@@ -132,6 +133,7 @@ def train_stage(task_dir: str | Path, stage: str | int | None, *, steps: int, pr
         norm = dict(mean=venv.obs_rms.mean.tolist(), var=venv.obs_rms.var.tolist(), clip=venv.clip_obs)
     finally:
         venv.close()
+        torch.set_num_threads(threads)
     trained_steps = int(model.num_timesteps)
     path = policy_dir / f"{name}.zip"
     tmp = policy_dir / f".{name}.partial.zip"
