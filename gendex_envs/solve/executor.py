@@ -347,6 +347,16 @@ class StageExecutor:
         c = self.config
         held, target = self.held, stage.target
         held_lo, held_hi = self._world_aabb(held)
+        if held_lo[2] < self._env.table_height + 0.5 * c.lift_m:
+            # still at the table (a trained grasp policy closes the hand but does not lift, unlike the scripted
+            # grasp): lift straight up first, so the planned carry never drags the object across the table
+            z0 = float(self._env.obj(held).pose.p[0, 2])
+            yield from self._cartesian(np.array([0.0, 0.0, c.lift_m]), c.lift_m_per_step, guard=True)
+            risen = float(self._env.obj(held).pose.p[0, 2]) - z0
+            if risen < 0.5 * c.lift_m:
+                raise ExecutionError(f"{held!r} slipped when lifted for the carry (rose {risen:.3f} m of "
+                                     f"{c.lift_m:.3f} m)")
+            held_lo, held_hi = self._world_aabb(held)
         t_center = self._obj_geometry(target)[0]
         t_hi = self._world_aabb(target)[1]
         obj_p = (held_lo + held_hi) / 2
