@@ -17,13 +17,12 @@ from __future__ import annotations
 
 import json
 import logging
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from gendex_envs.atomic_io import atomic_path
 from gendex_envs.errors import StageError, suggest
 from gendex_envs.spec import StageSpec, TaskSpec
 
@@ -62,16 +61,6 @@ def policy_path(task_dir: str | Path, stage: str) -> Path:
     return Path(task_dir) / POLICIES_DIR / f"{stage}.zip"
 
 
-def policy_meta_path(task_dir: str | Path, stage: str) -> Path:
-    return Path(task_dir) / POLICIES_DIR / f"{stage}.json"
-
-
-def read_policy_meta(task_dir: str | Path, stage: str) -> dict | None:
-    """The JSON record saved beside a stage's policy, or None when the stage has no policy."""
-    path = policy_meta_path(task_dir, stage)
-    return json.loads(path.read_text()) if path.is_file() else None
-
-
 @dataclass(frozen=True)
 class StartStates:
     """States a stage starts from, captured when the previous stage succeeded (one row per captured episode).
@@ -106,6 +95,15 @@ class StartStates:
     def __len__(self) -> int:
         return len(self.state)
 
+    @classmethod
+    def capture(cls, env, stage: str, source: str) -> StartStates:
+        """The current state of ``env`` (a :class:`~gendex_envs.task_env.TaskEnv` or a wrapper of one), one row
+        per sub-scene, as start states of ``stage``."""
+        u = env.unwrapped
+        return cls(stage=stage, source=source, state=u.get_state().cpu().numpy().astype(np.float32),
+                   obj_reset_pos={n: u.init_obj_pos(n).cpu().numpy() for n in u.objects},
+                   obj_reset_quat={n: u.init_obj_quat(n).cpu().numpy() for n in u.objects})
+
     def save(self, path: str | Path) -> Path:
         """Write atomically (temp file in the same folder, then rename)."""
         path = Path(path)
@@ -114,15 +112,8 @@ class StartStates:
             {"stage": self.stage, "source": self.source, "objects": sorted(self.obj_reset_pos)}))}
         arrays.update({f"pos/{k}": v.astype(np.float32) for k, v in self.obj_reset_pos.items()})
         arrays.update({f"quat/{k}": v.astype(np.float32) for k, v in self.obj_reset_quat.items()})
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".npz", dir=path.parent)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                np.savez_compressed(f, **arrays)
-            os.chmod(tmp, 0o644)  # mkstemp creates 0600
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        with atomic_path(path) as tmp, tmp.open("wb") as f:
+            np.savez_compressed(f, **arrays)
         return path
 
     @classmethod

@@ -42,9 +42,8 @@ class FreezingJointPosController(PDJointPosController):
         self.leader_idx = torch.tensor([names.index(n) for n in self.config.mimic.values()], dtype=torch.long,
                                        device=device)
         self.free_joint_names = tuple(free)
-        qlim = self.articulation.get_qlimits()[0, self.active_joint_indices].to(device)  # [J, 2]
-        self._qlimits = qlim[self.free_idx]
-        """[F, 2] limits of the free joints."""
+        self._qlimits = self.articulation.get_qlimits()[0, self.active_joint_indices].to(device)
+        """[J, 2] limits of every driven joint."""
         self._px_joints = [joint._objs[0] for joint in self.joints]
 
     def set_drive_targets(self, targets: torch.Tensor):
@@ -71,21 +70,42 @@ class FreezingJointPosController(PDJointPosController):
         action = self._preprocess_action(action)  # [N, F]
         self._step = 0
         self._start_qpos = self.qpos
-        target = self._target_qpos.clone()  # [N, J]
         if self.config.use_delta:
-            base = target if self.config.use_target else self._start_qpos
-            # clipped to the joint limits: no wind-up past a limit, and the same targets an absolute controller gets
-            lim = self._qlimits
-            target[:, self.free_idx] = torch.clamp(base[:, self.free_idx] + action, lim[:, 0], lim[:, 1])
+            target = self.moved_targets(self.free_idx, action, from_qpos=not self.config.use_target)
         else:
+            target = self._target_qpos.clone()  # [N, J]
             target[:, self.free_idx] = action
-        if len(self.follower_idx):
-            target[:, self.follower_idx] = target[:, self.leader_idx]
+            self._mimic(target)
         self._target_qpos = target
         if self.config.interpolate:
             self._step_size = (self._target_qpos - self._start_qpos) / self._sim_steps
         else:
             self.set_drive_targets(self._target_qpos)
+
+    def joint_indices(self, names: Sequence[str]) -> torch.Tensor:
+        """[K] positions of joints ``names`` in this controller's ``joint_names``."""
+        order = list(self.config.joint_names)
+        unknown = [n for n in names if n not in order]
+        if unknown:
+            raise ControlModeError(f"joints {unknown} are not driven by this controller; known joints: {order}")
+        return torch.tensor([order.index(n) for n in names], dtype=torch.long, device=self.device)
+
+    def moved_targets(self, idx: torch.Tensor, delta: torch.Tensor, from_qpos: bool = False) -> torch.Tensor:
+        """[N, J] targets after moving joints ``idx`` by ``delta`` [N, K] from their current targets (or measured
+        positions), clipped to the joint limits (no wind-up past a limit: the targets an absolute controller would
+        get), followers copying their leaders. The rule of a delta action, for any subset of joints: a stage
+        policy's deltas run through the stage executor's absolute controller with it."""
+        target = self._target_qpos.clone()
+        base = (self.qpos if from_qpos else target)[:, idx]
+        lim = self._qlimits[idx]
+        target[:, idx] = torch.clamp(base + torch.as_tensor(delta, dtype=target.dtype, device=target.device),
+                                     lim[:, 0], lim[:, 1])
+        self._mimic(target)
+        return target
+
+    def _mimic(self, target: torch.Tensor) -> None:
+        if len(self.follower_idx):
+            target[:, self.follower_idx] = target[:, self.leader_idx]
 
     def reset(self):
         super().reset()

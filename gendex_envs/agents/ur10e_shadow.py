@@ -104,6 +104,16 @@ FINGER_GAINS = DriveGains(stiffness=15.0, damping=0.5, force_limit=2.0)
 DELTA_LIMIT_RAD = {"arm": 0.05, "hand": 0.1}
 """Per-control-step bound of ``pd_joint_delta_pos`` actions, for arm and hand joints."""
 
+
+def free_joints(control_joint: str) -> list[str]:
+    """Joints the actions of ``control_joint`` mode drive (its group without the coupled distal joints)."""
+    return [j for j in CONTROL_JOINT_GROUPS[control_joint] if j not in COUPLED_DISTAL]
+
+
+def delta_limits(joints: list[str]) -> list[float]:
+    """Per-control-step bound (rad) of a ``pd_joint_delta_pos`` action on each of ``joints``."""
+    return [DELTA_LIMIT_RAD["arm" if j in ARM_JOINTS else "hand"] for j in joints]
+
 # Keyframes, by joint name (coupled distal joints equal their leader).
 _REST_ARM = (2.683, -1.71, 2.408, -0.699, 1.112, 0.0)
 """Elbow and wrist up, palm facing the table 0.30 m above it 0.80 m in front of the base, fingers pointing away from
@@ -190,16 +200,15 @@ class UR10eShadowHand(BaseAgent):
     @property
     def _controller_configs(self):
         order = [j.name for j in self.robot.get_active_joints()]
-        free = [j for j in CONTROL_JOINT_GROUPS[self.control_joint] if j not in COUPLED_DISTAL]
+        free = free_joints(self.control_joint)
 
         def gains(attr: str) -> list[float]:
             return [getattr(ARM_GAINS if j in ARM_JOINTS else WRIST_GAINS if j in WRIST_JOINTS else FINGER_GAINS,
                             attr) for j in order]
 
-        delta = [DELTA_LIMIT_RAD["arm" if j in ARM_JOINTS else "hand"] for j in order]
         common = dict(joint_names=order, stiffness=gains("stiffness"), damping=gains("damping"),
                       force_limit=gains("force_limit"), free_joint_names=free, mimic=dict(COUPLED_DISTAL))
-        free_delta = [delta[order.index(j)] for j in free]
+        free_delta = delta_limits(free)
         return dict(
             pd_joint_pos=FreezingJointPosControllerConfig(lower=None, upper=None, normalize_action=False, **common),
             pd_joint_delta_pos=FreezingJointPosControllerConfig(

@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -26,6 +24,7 @@ from typing import Protocol
 import gymnasium as gym
 import numpy as np
 
+from gendex_envs.atomic_io import write_json
 from gendex_envs.data.episode import Episode, EpisodeError
 from gendex_envs.data.rollout import EpisodeRecorder, env_info
 from gendex_envs.solve.executor import ExecutionError, make_stage_executor
@@ -125,13 +124,6 @@ class CollectState:
     @property
     def env_steps_per_success(self) -> float:
         return self.env_steps / self.successes if self.successes else float("inf")
-
-
-def _write_json_atomic(path: Path, data: dict) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    with os.fdopen(fd, "w") as f:
-        json.dump(data, f, indent=1)
-    os.replace(tmp, path)
 
 
 def _load_state(cfg: CollectConfig) -> CollectState:
@@ -272,7 +264,7 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
             state.attempts += 1
             state.env_steps += result.steps
             state.seconds += result.seconds
-            _write_json_atomic(cfg.out / STATE_FILE, asdict(state))
+            write_json(cfg.out / STATE_FILE, asdict(state), indent=1)
             if progress is not None:
                 progress(state)
             if state.successes >= cfg.num_success:

@@ -255,10 +255,12 @@ class StageExecutor:
             self._policies[key] = StagePolicy.load(self._env.task_dir, stage.name, path)
         policy = self._policies[key]
         done = False
+        info = policy.module.evaluate(self._env)  # one evaluate per step: it feeds the next observation too
         for _ in range(stage.horizon):
-            target = policy.targets(self._env, policy.act(self._env))[0].cpu().numpy().astype(np.float64)
+            target = policy.targets(self._env, policy.act(self._env, info))[0].cpu().numpy().astype(np.float64)
             yield self._emit(target)
-            if bool(policy.success(self._env)[0]):
+            info = policy.module.evaluate(self._env)
+            if bool(info["success"][0]):
                 done = True
                 break
         if not done:

@@ -13,14 +13,14 @@ from __future__ import annotations
 
 import json
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import torch
 from mani_skill.utils import common
 
-from gendex_envs.agents.ur10e_shadow import ARM_JOINTS, CONTROL_JOINT_GROUPS, COUPLED_DISTAL, DELTA_LIMIT_RAD
+from gendex_envs.agents.ur10e_shadow import delta_limits, free_joints
 from gendex_envs.errors import PolicyError, StageError
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.stage import policy_path, stage_reward_path
@@ -31,10 +31,11 @@ POLICY_FORMAT = 1
 """Version of the ``policies/<stage>.json`` record; bumped when the observation or action layout changes."""
 
 
-def stage_observation(env, module: RewardModule) -> torch.Tensor:
-    """[N, D] the flat ``state`` observation a stage env with reward ``module`` would return for ``env``'s state."""
+def stage_observation(env, module: RewardModule, info: dict | None = None) -> torch.Tensor:
+    """[N, D] the flat ``state`` observation a stage env with reward ``module`` would return for ``env``'s state
+    (``info``: what ``module.evaluate`` returned for this state, if the caller has it already)."""
     u = env.unwrapped
-    info = dict(module.evaluate(u))
+    info = dict(module.evaluate(u) if info is None else info)
     info.setdefault("fail", torch.zeros(u.num_envs, dtype=torch.bool, device=u.device))
     active = u.reward
     u.reward = module  # _get_obs_extra reads the stage module's extras; restored at once
@@ -59,6 +60,8 @@ class StagePolicy:
     obs_var: np.ndarray
     clip_obs: float
     meta: dict
+    _joints: tuple | None = field(default=None, init=False, repr=False)
+    """(controller, joint indices, per-joint delta bounds), computed once per controller."""
 
     @classmethod
     def load(cls, task_dir: str | Path, stage: str, path: str | Path | None = None) -> StagePolicy:
@@ -93,9 +96,10 @@ class StagePolicy:
         action, _ = self.model.predict(self.normalize(np.asarray(obs, dtype=np.float32)), deterministic=deterministic)
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
 
-    def act(self, env, deterministic: bool = True) -> np.ndarray:
-        """[N, F] normalized deltas in [-1, 1] for the stage's free joints."""
-        obs = stage_observation(env, self.module).cpu().numpy()
+    def act(self, env, info: dict | None = None, deterministic: bool = True) -> np.ndarray:
+        """[N, F] normalized deltas in [-1, 1] for the stage's free joints (``info``: the stage module's
+        ``evaluate`` of the current state, when the caller has it)."""
+        obs = stage_observation(env, self.module, info).cpu().numpy()
         return self.predict(obs, deterministic).reshape(env.unwrapped.num_envs, -1)
 
     def targets(self, env, action: np.ndarray) -> torch.Tensor:
@@ -103,26 +107,12 @@ class StagePolicy:
         free joints move by ``action`` × the per-step delta bound from their current target, clipped to the joint
         limits; coupled distal joints copy their leader)."""
         ctrl = env.unwrapped.agent.controller
-        names = list(ctrl.config.joint_names)
-        free = [j for j in CONTROL_JOINT_GROUPS[self.control_joint] if j not in COUPLED_DISTAL]
-        if action.shape[-1] != len(free):
+        if self._joints is None or self._joints[0] is not ctrl:
+            free = free_joints(self.control_joint)
+            self._joints = (ctrl, ctrl.joint_indices(free),
+                            torch.tensor(delta_limits(free), dtype=torch.float32, device=ctrl.device))
+        _, idx, bound = self._joints
+        if action.shape[-1] != len(idx):
             raise PolicyError(f"stage {self.stage!r}: policy gives {action.shape[-1]} actions, control_joint "
-                              f"{self.control_joint!r} has {len(free)} free joints")
-        idx = torch.tensor([names.index(j) for j in free], device=ctrl.device)
-        bound = torch.tensor([DELTA_LIMIT_RAD["arm" if j in ARM_JOINTS else "hand"] for j in free],
-                             dtype=torch.float32, device=ctrl.device)
-        target = ctrl._target_qpos.clone()
-        limits = ctrl.articulation.get_qlimits()[:, ctrl.active_joint_indices]  # [N, J, 2]
-        moved = target[:, idx] + torch.as_tensor(action, device=ctrl.device) * bound
-        target[:, idx] = torch.clamp(moved, limits[:, idx, 0], limits[:, idx, 1])
-        if len(ctrl.follower_idx):
-            target[:, ctrl.follower_idx] = target[:, ctrl.leader_idx]
-        return target
-
-    def success(self, env) -> torch.Tensor:
-        """[N] bool: the stage's own goal holds now."""
-        return self.module.evaluate(env.unwrapped)["success"]
-
-
-def has_policy(task_dir: str | Path | None, stage: str) -> bool:
-    return task_dir is not None and policy_path(task_dir, stage).is_file()
+                              f"{self.control_joint!r} has {len(idx)} free joints")
+        return ctrl.moved_targets(idx, torch.as_tensor(action, device=ctrl.device) * bound)

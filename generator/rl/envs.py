@@ -12,7 +12,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import gymnasium as gym
-import numpy as np
 
 from gendex_envs.stage import StartStates
 
@@ -52,7 +51,7 @@ def make_stage_env(task_dir: str | Path, stage: str | None, *, control_joint: st
     return StageEpisodes(env) if training else env
 
 
-def env_factory(task_dir: str | Path, stage: str | None, rank: int, **kwargs) -> Callable[[], gym.Env]:
+def env_factory(task_dir: str | Path, stage: str | None, **kwargs) -> Callable[[], gym.Env]:
     """A picklable constructor for one worker process (one torch thread each: two cores, two workers)."""
 
     def make() -> gym.Env:
@@ -62,7 +61,6 @@ def env_factory(task_dir: str | Path, stage: str | None, rank: int, **kwargs) ->
         torch.set_num_threads(1)
         return Monitor(make_stage_env(task_dir, stage, **kwargs), info_keywords=("is_success",))
 
-    make.rank = rank
     return make
 
 
@@ -70,14 +68,10 @@ def make_vec_env(task_dir: str | Path, stage: str | None, n_envs: int, seed: int
     """``n_envs`` stage envs: worker processes when ``n_envs`` > 1, else in this process."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv  # noqa: PLC0415
 
-    fns = [env_factory(task_dir, stage, i, **kwargs) for i in range(n_envs)]
+    fns = [env_factory(task_dir, stage, **kwargs) for _ in range(n_envs)]
     venv = SubprocVecEnv(fns) if n_envs > 1 else DummyVecEnv(fns)
     venv.seed(seed)
     return venv
-
-
-def obs_dim(env: gym.Env) -> int:
-    return int(np.prod(env.observation_space.shape))
 
 
 class _FailOnlyTermination(gym.Wrapper):

@@ -68,8 +68,8 @@ def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy 
                 t += 1
                 if first is None and bool(info["success"]):
                     first = t
-                    if capture:
-                        captured.append(_snapshot(u))
+                    if capture:  # relabelled with the next stage by the caller
+                        captured.append(StartStates.capture(u, stage or "task", "policy"))
                 done = terminated or truncated
             steps += t if first is None else first
             successes += first is not None
@@ -81,11 +81,3 @@ def evaluate_stage(task_dir: str | Path, stage: str | None, policy: StagePolicy 
                         env_steps=steps)
     states = StartStates.concat(captured) if captured else None
     return result, states
-
-
-def _snapshot(u) -> StartStates:
-    """The env's current state as a one-row StartStates (stage name filled in by the caller's context)."""
-    name = u.stage_spec.name if u.stage_spec is not None else "task"
-    return StartStates(stage=name, source="policy", state=u.get_state().cpu().numpy().astype(np.float32),
-                       obj_reset_pos={n: u.init_obj_pos(n).cpu().numpy() for n in u.objects},
-                       obj_reset_quat={n: u.init_obj_quat(n).cpu().numpy() for n in u.objects})

@@ -11,7 +11,6 @@ import logging
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 from tqdm import tqdm
 
 from gendex_envs.errors import ExecutionError, StageError
@@ -61,10 +60,7 @@ def collect_executor_states(task_dir: str | Path, stage: str | int, n: int, *, s
                 log.debug("attempt %d: %s", attempts, e)
                 continue
             if ex.finished and bool(judge.evaluate(u)["success"][0]):
-                rows.append(StartStates(stage=spec.name, source="executor",
-                                        state=u.get_state().cpu().numpy().astype(np.float32),
-                                        obj_reset_pos={k: u.init_obj_pos(k).cpu().numpy() for k in u.objects},
-                                        obj_reset_quat={k: u.init_obj_quat(k).cpu().numpy() for k in u.objects}))
+                rows.append(StartStates.capture(u, spec.name, "executor"))
                 bar.update(1)
     finally:
         bar.close()

@@ -14,16 +14,14 @@ Stage K > 0 starts from ``start_states/<stage>.npz`` beside the policy folder, c
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
-import os
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from gendex_envs.atomic_io import atomic_path, write_json
 from gendex_envs.reward_module import load_reward_module
 from gendex_envs.solve.policy import POLICY_FORMAT, StagePolicy
 from gendex_envs.spec import load_task_spec
@@ -49,15 +47,6 @@ class TrainResult:
     wall_s: float
     untrained: EvalResult
     trained: EvalResult
-
-
-def _write_json(path: Path, data: dict) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    with os.fdopen(fd, "w") as f:
-        json.dump(data, f, indent=2, sort_keys=True)
-        f.write("\n")
-    os.chmod(tmp, 0o644)  # mkstemp creates 0600; the record is meant to be read by everyone
-    os.replace(tmp, path)
 
 
 def stage_start_states(task_dir: Path, stage: str, index: int, states_dir: Path, policy_dir: Path | None,
@@ -136,20 +125,19 @@ def train_stage(task_dir: str | Path, stage: str | int | None, *, steps: int, pr
         torch.set_num_threads(threads)
     trained_steps = int(model.num_timesteps)
     path = policy_dir / f"{name}.zip"
-    tmp = policy_dir / f".{name}.partial.zip"
-    model.save(str(tmp))
     meta = dict(format=POLICY_FORMAT, task=spec.name, stage=name, stage_index=index, control_joint=cj,
                 control_mode="pd_joint_delta_pos", preset=dataclasses.asdict(p), steps=trained_steps, seed=seed,
                 obs_norm=norm, obs_dim=len(norm["mean"]), start_states=len(start_states) if start_states else 0,
                 start_state_steps=state_steps, command=command)
-    os.replace(tmp, path)
-    _write_json(path.with_suffix(".json"), meta)
+    with atomic_path(path) as tmp:
+        model.save(str(tmp))
+    write_json(path.with_suffix(".json"), meta, indent=2, sort_keys=True)
     policy = StagePolicy.load(task_dir, name, path)
     trained, _ = evaluate_stage(task_dir, name, policy, episodes=eval_episodes, **env_kw)
     wall = time.perf_counter() - t0
     meta |= dict(evaluation=dict(untrained=untrained.as_dict(), trained=trained.as_dict()),
                  wall_s=round(wall, 1))
-    _write_json(path.with_suffix(".json"), meta)
+    write_json(path.with_suffix(".json"), meta, indent=2, sort_keys=True)
     log.info("%s/%s: %d steps in %.0f s; success %d/%d (untrained: %d/%d), mean return %.2f (untrained: %.2f)",
              spec.name, name, trained_steps, wall, trained.successes, trained.episodes, untrained.successes,
              untrained.episodes, trained.mean_return, untrained.mean_return)

@@ -60,16 +60,16 @@ def test_keeps_only_successes_and_formats_agree(near_task, tmp_path):
 def test_resume_after_kill_between_export_and_commit(near_task, tmp_path, monkeypatch):
     """Killed after the exporters took an episode but before the state commit: resuming does not duplicate it."""
     out = tmp_path / "b"
-    real_write = collector._write_json_atomic
+    real_write = collector.write_json
     calls = {"n": 0}
 
-    def dying_write(path, data):
+    def dying_write(path, data, **kwargs):
         if data["kept_seeds"] and len(data["kept_seeds"]) == 2 and calls["n"] == 0:
             calls["n"] += 1
             raise KeyboardInterrupt("killed")
-        real_write(path, data)
+        real_write(path, data, **kwargs)
 
-    monkeypatch.setattr(collector, "_write_json_atomic", dying_write)
+    monkeypatch.setattr(collector, "write_json", dying_write)
     with pytest.raises(KeyboardInterrupt):
         collect(_cfg(out), lambda: HoldSolver(steps=4))
     assert _counts(out)[0] == 2  # the second success reached the exporters, the state says one
