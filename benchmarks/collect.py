@@ -2,7 +2,7 @@
 
 Per task, in one run:
 
-(a) success rate of ``--episodes`` seeded attempts (seeds ``--seed`` ..), through ``gendex_envs.data.collector``
+(a) success rate of ``--episodes`` seeded attempts (seeds ``--seed`` ..), through ``gendex.data.collector``
     exactly as ``gendex collect`` runs them (one CPU env, ``pd_joint_pos``, successful episodes kept, nothing written
     but the dataset in a scratch folder);
 (b) env steps per successful trajectory (all attempts' steps / successes) and what 1000 successes would cost;
@@ -25,7 +25,8 @@ import time
 from pathlib import Path
 
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
-from gendex_envs.data.collector import SOLVERS, CollectConfig, collect
+from gendex.data.collector import CollectConfig, collect
+from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 
 TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
 
@@ -33,7 +34,7 @@ TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl
 def run(task: str, n: int, seed: int, workers: int, formats: tuple[str, ...] = ("h5",)):
     with tempfile.TemporaryDirectory(prefix="gendex-bench-") as tmp:
         cfg = CollectConfig(task_id=task, num_success=n, out=Path(tmp) / "ds", formats=formats, seed=seed,
-                            max_attempts=n, control_mode="pd_joint_pos")
+                            max_attempts=n, **SOLVER_ENV_KWARGS["stages"])
         t0 = time.perf_counter()
         state = collect(cfg, SOLVERS["stages"], workers=workers)
         return state, time.perf_counter() - t0

@@ -1,7 +1,7 @@
 """How hard is RotateTennisBall? Success, final rotation and drop rate of three policies over seeded episodes.
 
-(a) uniform random actions, (b) the scripted finger gait :class:`gendex_envs.solve.in_hand.FingerGaitSolver`,
-(c) a trained PPO policy, if ``generated_tasks/RotateTennisBall/v0/policies/rotate_ball.zip`` exists.
+(a) uniform random actions, (b) the scripted finger gait :class:`gendex.solve.in_hand.FingerGaitSolver`,
+(c) the task version's trained PPO policy of stage ``rotate_ball``, if it has one.
 Every episode runs the whole horizon (seeds 0..N-1, one CPU env, ``pd_joint_delta_pos``, ``control_joint=hand``);
 success is the task's (a quarter turn counter-clockwise held 5 steps), a drop is the task's ``fail``.
 
@@ -15,16 +15,15 @@ import logging
 import math
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
-from gendex_envs.solve.in_hand import FingerGaitSolver
+from gendex.solve.in_hand import FingerGaitSolver
 
 TASK = "GenDex/RotateTennisBall-v0"
-POLICY = Path(__file__).resolve().parent.parent / "generated_tasks/RotateTennisBall/v0/policies/rotate_ball.zip"
+STAGE = "rotate_ball"
 
 log = logging.getLogger("bench.rotate_ball")
 
@@ -74,13 +73,15 @@ def main(argv: list[str] | None = None) -> list[dict]:
                                 lambda e, o: rng.uniform(-1, 1, e.action_space.shape).astype(np.float32)))
         gait = FingerGaitSolver()
         results.append(evaluate(env, gait.name, args.episodes, gait.reset, gait.act))
-        if POLICY.is_file():
-            from gendex_envs.solve.policy import StagePolicy  # loads SB3: only when there is a policy to run
+        version = env.unwrapped.task
+        files = version.policy(STAGE)
+        if files is not None:
+            from gendex.solve.policy import StagePolicy  # loads SB3: only when there is a policy to run
 
-            policy = StagePolicy.load(POLICY.parent.parent, "rotate_ball")  # applies the saved obs normalization
+            policy = StagePolicy.load(version, files)  # applies the saved obs normalization
             results.append(evaluate(env, "ppo", args.episodes, lambda e, o: None, lambda e, o: policy.predict(o)))
         else:
-            print(f"ppo          skipped: no trained policy at {POLICY}")
+            print(f"ppo          skipped: {version.env_id} has no trained policy of stage {STAGE}")
     finally:
         env.close()
     return results

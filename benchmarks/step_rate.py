@@ -36,6 +36,7 @@ from sapien.wrapper.urdf_loader import URDFLoader
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex_envs.agents.robot_model import robot_urdf_path
 from gendex_envs.assets.catalog import get_asset, lowest_point_z
+from gendex_envs.physx import px_objects
 
 
 # ---------------------------------------------------------------------------------------------- raw SAPIEN scene
@@ -120,13 +121,13 @@ class RawScene:
         builder.initial_pose = sapien.Pose(list(robot.base_pos_m), [math.cos(yaw / 2), 0, 0, math.sin(yaw / 2)])
         self.robot = builder.build(fix_root_link=True)
         # mirror the env's robot: gravity flags and collision groups per link, drive properties per joint
-        src_links = {link.name: link._objs[0] for link in env.agent.robot.get_links()}
+        src_links = {link.name: px_objects(link)[0] for link in env.agent.robot.get_links()}
         for link in self.robot.links:
             src = src_links[link.name]
             link.disable_gravity = src.disable_gravity
             for shape, src_shape in zip(link.collision_shapes, src.collision_shapes, strict=True):
                 shape.set_collision_groups(src_shape.get_collision_groups())
-        src_joints = {j.name: j._objs[0] for j in env.agent.robot.get_active_joints()}
+        src_joints = {j.name: px_objects(j)[0] for j in env.agent.robot.get_active_joints()}
         self.joints = self.robot.active_joints
         for j in self.joints:
             src = src_joints[j.name]
@@ -139,7 +140,7 @@ class RawScene:
         self.delta = np.asarray(ctrl.config.upper, dtype=np.float32)
         self.follower_idx = np.array([names.index(n) for n in ctrl.config.mimic])
         self.leader_idx = np.array([names.index(n) for n in ctrl.config.mimic.values()])
-        env_qpos = dict(zip(src_joints, env.agent.robot.get_qpos()[0].tolist()))  # the env was just reset
+        env_qpos = dict(zip(src_joints, env.agent.robot.get_qpos()[0].tolist(), strict=True))  # the env was just reset
         self.rest = np.array([env_qpos[n] for n in names], dtype=np.float32)
 
         table = spec.table  # static table top (top face at z = 0) and a ground plane under the legs
@@ -168,7 +169,7 @@ class RawScene:
         self.elapsed = 0
         self.robot.qpos, self.robot.qvel = self.rest, np.zeros_like(self.rest)
         self.targets = self.rest.copy()
-        for j, t in zip(self.joints, self.targets):
+        for j, t in zip(self.joints, self.targets, strict=True):
             j.set_drive_target(float(t))
         for entity, pose, qpos in self.objects:
             if qpos is not None:  # articulated object
@@ -187,7 +188,7 @@ class RawScene:
         Returns True when an episode of the env's length is over (the caller resets, like a time limit)."""
         self.targets[self.free_idx] += np.clip(action, -1.0, 1.0) * self.delta
         self.targets[self.follower_idx] = self.targets[self.leader_idx]
-        for j, t in zip(self.joints, self.targets.tolist()):
+        for j, t in zip(self.joints, self.targets.tolist(), strict=True):
             j.set_drive_target(t)
         for _ in range(self.substeps):
             self.px.step()

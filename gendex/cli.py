@@ -1,4 +1,8 @@
-"""``gendex`` command line: thin commands over :mod:`gendex_envs` (and, later, :mod:`generator`)."""
+"""``gendex`` command line: thin commands (parse, call, print) over the runtime (:mod:`gendex_envs`), the
+application packages (:mod:`gendex.solve`, :mod:`gendex.data`, :mod:`gendex.train`) and the generator.
+
+A task argument is a registered id (``GenDex/PutAppleBowl-v0``), an unversioned name (``PutAppleBowl``: its highest
+version, as ``gym.make`` resolves it) or a version folder."""
 
 from __future__ import annotations
 
@@ -28,24 +32,32 @@ def _die(exc: Exception) -> None:
 
 @app.command("list")
 def list_tasks() -> None:
-    """List the registered tasks (Gymnasium IDs), their instruction and stages."""
-    from gendex_envs.registry import registered_tasks  # noqa: PLC0415
-    from gendex_envs.spec import load_task_spec  # noqa: PLC0415
+    """List the registered task versions (Gymnasium IDs): instruction, objects, stages, policies, origin."""
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.registry import registered_tasks
 
     tasks = registered_tasks()
     if not tasks:
         typer.echo("no tasks registered (looked in generated_tasks/ and $GENDEX_TASKS_PATH)")
         return
-    for env_id, entry in sorted(tasks.items()):
-        spec = load_task_spec(entry.task_dir / "task.yaml")
-        stages = " -> ".join(f"{s.name}[{s.method}:{s.control_joint}]" for s in spec.stages)
+    for env_id, version in sorted(tasks.items()):
+        try:
+            spec = version.spec
+        except GenDexError as exc:
+            typer.echo(f"{env_id}\n    INVALID: {exc}")
+            continue
+        stages = " -> ".join(f"{s.name}[{s.skill}, {s.method}:{s.control_joint}]" for s in spec.stages)
         objects = ", ".join(f"{o.name}({o.asset})" for o in spec.objects)
-        typer.echo(f"{env_id}\n    {spec.instruction}\n    objects: {objects}\n    stages:  {stages}\n"
-                   f"    folder:  {entry.task_dir}")
+        policies = ", ".join(version.artifacts.policy_stages()) or "none"
+        origin = version.provenance()
+        made = ("promoted from " + origin["promotion"]["source"] if "promotion" in origin
+                else f"generated ({origin['generation']['backend']})" if "generation" in origin else "hand-written")
+        typer.echo(f"{env_id}\n    {spec.instruction}\n    objects:  {objects}\n    stages:   {stages}\n"
+                   f"    policies: {policies}; {made}\n    folder:   {version.root}")
 
 
 def _save_png(rgb, path: Path) -> Path:
-    from PIL import Image  # noqa: PLC0415
+    from PIL import Image
 
     tmp = path.with_suffix(".tmp.png")
     Image.fromarray(rgb).save(tmp)
@@ -54,12 +66,12 @@ def _save_png(rgb, path: Path) -> Path:
 
 
 def _render_views(env_id: str, out: Path, seed: int, montage: bool = False) -> dict[str, Path]:
-    import gymnasium as gym  # noqa: PLC0415
-    import numpy as np  # noqa: PLC0415
+    import gymnasium as gym
+    import numpy as np
 
-    from gendex_envs.registry import task_entry  # noqa: PLC0415
+    from gendex_envs.registry import resolve_task
 
-    task_entry(env_id)
+    env_id = resolve_task(env_id).env_id
     env = gym.make(env_id, render_mode="rgb_array")
     try:
         env.reset(seed=seed)
@@ -81,8 +93,8 @@ def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"
            seed: int = typer.Option(0, help="Reset seed (object randomization)."),
            montage: bool = typer.Option(False, help="Also write the three views side by side.")) -> None:
     """Render a task's three views (left-overhead, right-overhead, top-down) to PNG."""
-    import gendex_envs  # noqa: F401, PLC0415
-    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+    import gendex_envs  # noqa: F401
+    from gendex_envs.errors import GenDexError
 
     try:
         paths = _render_views(task_id, out, seed, montage)
@@ -96,9 +108,9 @@ def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"
 def assets(as_json: bool = typer.Option(False, "--json", help="Machine-readable catalog."),
            guidance: bool = typer.Option(False, "--guidance", help="The text block proposal prompts consume.")) -> None:
     """List the asset catalog (shipped objects, articulated models and user datasets found on disk)."""
-    import json  # noqa: PLC0415
+    import json
 
-    from gendex_envs.assets.guidance import catalog_json, guidance_text  # noqa: PLC0415
+    from gendex_envs.assets.guidance import catalog_json, guidance_text
 
     if as_json:
         typer.echo(json.dumps(catalog_json(), indent=1))
@@ -119,7 +131,7 @@ def assets(as_json: bool = typer.Option(False, "--json", help="Machine-readable 
 def gallery(out: Path = typer.Option(Path("docs/assets"), "--out", help="Folder for thumbnails and index."),
             size: int = typer.Option(256, help="Thumbnail size in pixels.")) -> None:
     """Render a thumbnail of every asset (on the task table, next to the hand) and write ``<out>.md``."""
-    from gendex.gallery import render_gallery  # noqa: PLC0415
+    from gendex.gallery import render_gallery
 
     index = render_gallery(out, size)
     typer.echo(f"wrote {index}")
@@ -136,25 +148,25 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
     """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
-    from tqdm import tqdm  # noqa: PLC0415
+    from tqdm import tqdm
 
-    import gendex_envs  # noqa: F401, PLC0415
-    from gendex_envs.data.collector import SOLVER_CONTROL_MODES, SOLVERS, CollectConfig  # noqa: PLC0415
-    from gendex_envs.data.collector import collect as run_collect
-    from gendex_envs.errors import GenDexError, suggest  # noqa: PLC0415
-    from gendex_envs.registry import task_entry  # noqa: PLC0415
-    from gendex_envs.spec import load_task_spec  # noqa: PLC0415
+    from gendex.data.collector import CollectConfig
+    from gendex.data.collector import collect as run_collect
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+    from gendex_envs.errors import GenDexError, suggest
+    from gendex_envs.registry import resolve_task
 
     formats = {"lerobot": ("lerobot",), "h5": ("h5",), "both": ("lerobot", "h5")}
     if fmt not in formats:
         _die(ValueError(f"--format {fmt!r} is not one of {sorted(formats)}.{suggest(fmt, formats)}"))
     if solver not in SOLVERS:
         _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
-    cfg = CollectConfig(task_id=task_id, num_success=num_success, out=out, formats=formats[fmt],
-                        cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
-                        control_mode=SOLVER_CONTROL_MODES.get(solver, "pd_joint_pos"))
     try:
-        spec = load_task_spec(task_entry(task_id).task_dir / "task.yaml")
+        version = resolve_task(task_id)
+        cfg = CollectConfig(task_id=version.env_id, num_success=num_success, out=out, formats=formats[fmt],
+                            cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
+                            **SOLVER_ENV_KWARGS[solver])
+        spec = version.spec
         with tqdm(total=num_success, desc="successes", unit="ep") as bar:
             def progress(state):
                 bar.n = state.successes
@@ -170,23 +182,23 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
 
 
 def _write_card(cfg, instruction: str, solver: str, state) -> None:
-    import json  # noqa: PLC0415
+    import json
 
-    from gendex_envs.data.lerobot_v3 import write_dataset_card  # noqa: PLC0415
+    from gendex.data.lerobot_v3 import write_dataset_card
 
     root = cfg.out / "lerobot"
     info = json.loads((root / "meta" / "info.json").read_text())
+    seeds = f"{cfg.seed}..{cfg.seed + state.attempts - 1}"
     write_dataset_card(root, task_id=cfg.task_id, instruction=instruction, robot="ShadowHand on UR10e (30 joints)",
-                       control_mode=cfg.control_mode, n_episodes=info["total_episodes"],
-                       n_frames=info["total_frames"],
-                       how_made=f"gendex collect with solver '{solver}', seeds {cfg.seed}..{cfg.seed + state.attempts - 1}")
+                       env_kwargs=cfg.env_kwargs(), n_episodes=info["total_episodes"], n_frames=info["total_frames"],
+                       how_made=f"gendex collect with solver '{solver}', seeds {seeds}")
 
 
 @app.command()
 def replay(file: Path = typer.Argument(..., help="A trajectories .h5 file written by gendex collect.")) -> None:
     """Re-simulate every episode of an HDF5 trajectory file and confirm its end state and success."""
-    from gendex_envs.data.trajectory_h5 import replay_file  # noqa: PLC0415
-    from gendex_envs.errors import GenDexError  # noqa: PLC0415
+    from gendex.data.trajectory_h5 import replay_file
+    from gendex_envs.errors import GenDexError
 
     try:
         results = replay_file(file)
@@ -201,6 +213,13 @@ def replay(file: Path = typer.Argument(..., help="A trajectories .h5 file writte
     raise typer.Exit(code=1 if bad else 0)
 
 
+def _command(name: str) -> str:
+    import shlex
+    import sys
+
+    return f"gendex {name} " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+
+
 @app.command()
 def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to generate."),
              instruction: str = typer.Option(None, "--instruction", help='Human request, e.g. "grab the apple".'),
@@ -213,26 +232,25 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              candidates: int = typer.Option(3, "--candidates", min=1, help="Scene candidates per task; the best "
                                                                            "one is refined."),
              transcript: list[Path] = typer.Option(None, "--transcript",
-                                                   help="replay: a transcript.jsonl (or a task folder holding "
+                                                   help="replay: a recorded transcript (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
     """Generate new tasks: propose, scene, render, critique/refine, plan, reward code, validate, commit."""
-    import shlex  # noqa: PLC0415
-    import sys  # noqa: PLC0415
+    from tqdm import tqdm
 
-    from tqdm import tqdm  # noqa: PLC0415
-
-    from gendex_envs.errors import GenDexError  # noqa: PLC0415
-    from generator.backends.registry import BACKEND_NAMES, default_backend_name, make_backend  # noqa: PLC0415
-    from generator.backends.transcript import ReplayBackend  # noqa: PLC0415
-    from generator.pipeline import generate as run_generate  # noqa: PLC0415
+    from gendex_envs.errors import GenDexError
+    from generator.backends.registry import BACKEND_NAMES, default_backend_name, make_backend
+    from generator.backends.transcript import ReplayBackend
+    from generator.pipeline import generate as run_generate
 
     name = backend or default_backend_name()
     if name not in BACKEND_NAMES:
         _die(ValueError(f"--backend {name!r} is not one of {list(BACKEND_NAMES)}"))
-    files = [t / "transcript.jsonl" if t.is_dir() else t for t in (transcript or [])]
+    from gendex_envs.task_version import TaskLayout
+
+    files = [TaskLayout(t).transcript if t.is_dir() else t for t in (transcript or [])]
     if name == "replay":
         if not files:
-            _die(ValueError("--backend replay needs --transcript PATH (a transcript.jsonl or a task folder)"))
+            _die(ValueError("--backend replay needs --transcript PATH (a recorded transcript or a task folder)"))
         n = len(files)
     elif files:
         _die(ValueError("--transcript is only used with --backend replay"))
@@ -247,7 +265,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
             return ReplayBackend(pending.pop(0))
         return make_backend(name, seed=seed, model=model)
 
-    command = "gendex generate " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+    command = _command("generate")
     rows = []
     try:
         with tqdm(total=n, desc="tasks", unit="task") as bar:
@@ -263,21 +281,11 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
     for s in rows:
         dropped = f" ({s.proposals_tried - 1} earlier proposal(s) dropped)" if s.proposals_tried > 1 else ""
         typer.echo(f"  {s.committed.env_id}: {s.violations_before} -> {s.violations_after} violations in "
-                   f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.path}")
-
-
-def _task_dir(task_id: str) -> Path:
-    """Task folder of a registered env id (``GenDex/<Name>-v<N>``) or of a folder path holding task.yaml."""
-    import gendex_envs  # noqa: F401, PLC0415  (registers the tasks)
-    from gendex_envs.registry import task_entry  # noqa: PLC0415
-
-    if Path(task_id).is_dir() and (Path(task_id) / "task.yaml").is_file():
-        return Path(task_id)
-    return task_entry(task_id).task_dir
+                   f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.root}")
 
 
 @app.command()
-def train(task_id: str = typer.Argument(..., help="e.g. GenDex/PickUpBottle-v0 (or a task folder)."),
+def train(task_id: str = typer.Argument(..., help="e.g. GenDex/PickUpBottle-v0, PickUpBottle, or a version folder."),
           stage: str = typer.Option(..., "--stage", help="Stage index or name; 'task' trains the whole task as one "
                                                          "stage with every joint."),
           steps: int = typer.Option(200_000, "--steps", min=1, help="Env steps of PPO training."),
@@ -285,26 +293,42 @@ def train(task_id: str = typer.Argument(..., help="e.g. GenDex/PickUpBottle-v0 (
           preset: str = typer.Option("cpu", "--preset", help="cpu (2-core machine) | paper (the seed paper's "
                                                               "hyperparameters, GPU backend)."),
           seed: int = typer.Option(0, "--seed"),
-          out: Path = typer.Option(None, "--out", help="Policy folder (default: <task folder>/policies)."),
+          out: Path = typer.Option(None, "--out", help="Run folder (default: out/train/<Name>-v<N>); train more "
+                                                       "stages into the same folder to chain them."),
           eval_episodes: int = typer.Option(20, "--eval-episodes", min=1)) -> None:
-    """Train PPO on one stage of a task; saves the policy, its curve and evaluation with the task version."""
-    import shlex  # noqa: PLC0415
-    import sys  # noqa: PLC0415
+    """Train PPO on one stage of a task version into a run folder (the version is never changed); publish the
+    result as a new version with ``gendex promote``."""
+    from gendex.train.train import default_run_dir, train_stage
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.registry import resolve_task
 
-    from gendex_envs.errors import GenDexError  # noqa: PLC0415
-    from generator.rl.train import train_stage  # noqa: PLC0415
-
-    command = "gendex train " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     try:
-        r = train_stage(_task_dir(task_id), stage, steps=steps, preset=preset, n_envs=envs, seed=seed,
-                        policy_dir=out, eval_episodes=eval_episodes, command=command)
+        version = resolve_task(task_id)
+        run = out or default_run_dir(version)
+        r = train_stage(version, stage, steps=steps, run_dir=run, preset=preset, n_envs=envs, seed=seed,
+                        eval_episodes=eval_episodes, command=_command("train"))
     except GenDexError as exc:
         _die(exc)
-    typer.echo(f"{r.stage}: {r.steps} env steps in {r.wall_s:.0f} s -> {r.policy_path}\n"
+    typer.echo(f"{r.stage}: {r.steps} env steps in {r.wall_s:.0f} s -> {r.policy.model}\n"
                f"  trained:   success {r.trained.successes}/{r.trained.episodes}, mean return "
                f"{r.trained.mean_return:.2f}\n"
                f"  untrained: success {r.untrained.successes}/{r.untrained.episodes}, mean return "
-               f"{r.untrained.mean_return:.2f}")
+               f"{r.untrained.mean_return:.2f}\n"
+               f"publish it as the next version of {version.env_id} with: gendex promote {run}")
+
+
+@app.command()
+def promote(runs: list[Path] = typer.Argument(..., help="Training run folders (gendex train --out) of one version.")
+            ) -> None:
+    """Publish the runs' task version plus their trained policies and start states as its next version."""
+    from gendex.train.train import promote as run_promote
+    from gendex_envs.errors import GenDexError
+
+    try:
+        new = run_promote(runs, command=_command("promote"))
+    except GenDexError as exc:
+        _die(exc)
+    typer.echo(f"published {new.env_id} ({', '.join(new.artifacts.policy_stages()) or 'no'} policies) in {new.root}")
 
 
 @app.command()
@@ -319,28 +343,18 @@ def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutA
            results: Path = typer.Option(Path("docs/results.md"), "--results", help="Markdown file for the table."),
            fresh: bool = typer.Option(False, "--fresh", help="Re-run cells already saved in --out.")) -> None:
     """The paper's four-variant comparison: success and env steps to 1000 successes per task and variant."""
-    import shlex  # noqa: PLC0415
-    import sys  # noqa: PLC0415
+    from gendex.train.ablate import VARIANTS, run_ablation, write_results
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.registry import resolve_task
 
-    import gendex_envs  # noqa: F401, PLC0415
-    from gendex_envs.errors import GenDexError  # noqa: PLC0415
-    from gendex_envs.registry import registered_tasks  # noqa: PLC0415
-    from generator.rl.ablate import VARIANTS, run_ablation, write_results  # noqa: PLC0415
-
-    dirs = []
-    latest = {}
-    for e in registered_tasks().values():
-        if e.name not in latest or e.version > latest[e.name].version:
-            latest[e.name] = e
     try:
-        for t in tasks:
-            dirs.append(latest[t].task_dir if t in latest else _task_dir(t))
+        versions = [resolve_task(t) for t in tasks]
         chosen = tuple(variants) if variants else tuple(VARIANTS)
         bad = [v for v in chosen if v not in VARIANTS]
         if bad:
             raise ValueError(f"unknown variants {bad}; variants: {list(VARIANTS)}")
-        command = "gendex ablate " + " ".join(shlex.quote(a) for a in sys.argv[2:])
-        cells = run_ablation(dirs, budget, out, variants=chosen, seed=seed, eval_episodes=eval_episodes,
+        command = _command("ablate")
+        cells = run_ablation(versions, budget, out, variants=chosen, seed=seed, eval_episodes=eval_episodes,
                              resume=not fresh,
                              progress=lambda c: typer.echo(f"{c.task} {VARIANTS[c.variant]}: {c.successes}/"
                                                            f"{c.eval_episodes}, {c.train_steps:,} PPO steps"))
@@ -362,11 +376,11 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
     """The main job on embedded defaults: build every task, render its views, roll out random actions, generate a new
     task with the offline author, then collect a few successful PutAppleBowl episodes with the stage executor into a
     LeRobot v3.0 dataset."""
-    import gymnasium as gym  # noqa: PLC0415
-    import numpy as np  # noqa: PLC0415
-    from tqdm import tqdm  # noqa: PLC0415
+    import gymnasium as gym
+    import numpy as np
+    from tqdm import tqdm
 
-    from gendex_envs.registry import registered_tasks  # noqa: PLC0415
+    from gendex_envs.registry import registered_tasks
 
     rows = []
     for env_id in tqdm(sorted(registered_tasks()), desc="tasks", unit="task"):
@@ -398,29 +412,30 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
 
 
 def _demo_generate(out: Path, n: int, seed: int) -> None:
-    from generator.backends.offline import OfflineBackend  # noqa: PLC0415
-    from generator.pipeline import generate as run_generate  # noqa: PLC0415
+    from generator.backends.offline import OfflineBackend
+    from generator.pipeline import generate as run_generate
 
     typer.echo(f"\nGenerating {n} new task(s) with the offline author (a seeded task grammar, not a language model)")
     rows = run_generate(lambda: OfflineBackend(seed=seed), out, n=n, seed=seed,
                         command=f"gendex generate --backend offline --n {n} --seed {seed} --out {out}")
     for s in rows:
         typer.echo(f"  {s.committed.env_id}: violations {s.violations_before} -> {s.violations_after}, "
-                   f"{s.seconds:.1f} s; folder {s.committed.path} (renders in renders/)")
+                   f"{s.seconds:.1f} s; folder {s.committed.root}")
 
 
 def _demo_collect(out: Path, n: int, seed: int) -> None:
-    from gendex_envs.data.collector import SOLVERS, CollectConfig  # noqa: PLC0415
-    from gendex_envs.data.collector import collect as run_collect
-    from gendex_envs.registry import task_entry  # noqa: PLC0415
-    from gendex_envs.spec import load_task_spec  # noqa: PLC0415
+    from gendex.data.collector import CollectConfig
+    from gendex.data.collector import collect as run_collect
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+    from gendex_envs.registry import resolve_task
 
-    task_id = "GenDex/PutAppleBowl-v0"
+    version = resolve_task("GenDex/PutAppleBowl-v0")
+    task_id = version.env_id
     cfg = CollectConfig(task_id=task_id, num_success=n, out=out, formats=("lerobot",), seed=seed,
-                        max_attempts=5 * n, control_mode="pd_joint_pos")
+                        max_attempts=5 * n, **SOLVER_ENV_KWARGS["stages"])
     state = run_collect(cfg, SOLVERS["stages"])
     if state.successes:
-        _write_card(cfg, load_task_spec(task_entry(task_id).task_dir / "task.yaml").instruction, "stages", state)
+        _write_card(cfg, version.spec.instruction, "stages", state)
     typer.echo(f"\nCollected {state.successes}/{state.attempts} successful {task_id} episodes "
                f"({state.env_steps_per_success:.0f} env steps per success) into the LeRobot dataset {out / 'lerobot'}")
     if state.successes < n:

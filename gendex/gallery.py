@@ -30,8 +30,8 @@ def _spec(record: AssetRecord):
         "instruction": f"Look at the {record.category}.",
         "objects": [{"name": "item", "asset": record.id, "pos_m": [x, y, 0.0],
                      "fixed": record.articulated}],
-        "stages": [{"name": "look", "instruction": "Nothing to do.", "method": "RL", "control_joint": "hand",
-                    "target": "item"}],
+        "stages": [{"name": "look", "instruction": "Nothing to do.", "skill": "reach", "method": "RL",
+                    "control_joint": "hand", "target": "item"}],
         "success": {"description": "never", "conditions": [{"type": "lifted", "object": "item",
                                                              "min_height_m": 10.0}]},
     }, source=f"<gallery:{record.id}>")
@@ -39,7 +39,7 @@ def _spec(record: AssetRecord):
 
 def render_thumbnail(record: AssetRecord, size: int = 256) -> np.ndarray:
     """[size, size, 3] uint8 close-up of ``record`` standing on the task table."""
-    from gendex_envs.task_env import TaskEnv  # noqa: PLC0415
+    from gendex_envs.task_env import TaskEnv
 
     extent = max(max(record.size_m), 0.06)
     x, y = _spot(record)

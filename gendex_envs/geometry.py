@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import torch
 
 
@@ -42,3 +44,14 @@ def transform_points(p: torch.Tensor, q_wxyz: torch.Tensor, local: torch.Tensor)
 def xy_distance(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
     """Horizontal distance between positions a, b [N, 3] -> [N], metres."""
     return torch.linalg.norm(a[..., :2] - b[..., :2], dim=-1)
+
+
+def z_twist(q_wxyz: torch.Tensor, q0_wxyz: torch.Tensor) -> torch.Tensor:
+    """[N] signed angle (rad, wrapped to (-pi, pi]) of the twist about world z of the rotation from ``q0`` to ``q``
+    (that is, of ``q * conj(q0)``); positive is counter-clockwise seen from above."""
+    w0, x0, y0, z0 = q0_wxyz[:, 0], -q0_wxyz[:, 1], -q0_wxyz[:, 2], -q0_wxyz[:, 3]
+    w1, x1, y1, z1 = q_wxyz[:, 0], q_wxyz[:, 1], q_wxyz[:, 2], q_wxyz[:, 3]
+    dw = w1 * w0 - x1 * x0 - y1 * y0 - z1 * z0
+    dz = w1 * z0 + x1 * y0 - y1 * x0 + z1 * w0
+    angle = 2.0 * torch.atan2(dz, dw)
+    return torch.remainder(angle + math.pi, 2.0 * math.pi) - math.pi

@@ -1,42 +1,37 @@
-"""Task registry: ``generated_tasks/<Name>/v<N>/`` folders become Gymnasium IDs ``GenDex/<Name>-v<N>``.
+"""Task registry: every task version ``<Name>/v<N>/`` under the task roots is the Gymnasium id ``GenDex/<Name>-v<N>``.
 
-:func:`register_tasks` is called once when :mod:`gendex_envs` is imported. Task folders are searched in the roots
-listed in ``$GENDEX_TASKS_PATH`` (``os.pathsep``-separated) and then in the repository's ``generated_tasks/``.
+:func:`register_tasks` runs once when :mod:`gendex_envs` is imported. Task roots are the folders listed in
+``$GENDEX_TASKS_PATH`` (``os.pathsep``-separated), then the repository's ``generated_tasks/``; the first root that
+has a version wins. Every version is registered, and an unversioned name resolves as Gymnasium resolves it:
+``gym.make("GenDex/PutAppleBowl")`` makes the highest version (with Gymnasium's warning), and
+:func:`resolve_task` does the same for GenDex's own commands.
 
-``gym.make("GenDex/PutAppleBowl-v0")`` with one CPU env returns a standard Gymnasium env (numpy arrays, no batch
-dimension: ManiSkill's ``CPUGymWrapper``). With ``num_envs > 1`` (or the GPU backend) it returns the batched
-ManiSkill env (torch tensors ``[num_envs, ...]``). ``env.unwrapped`` is the :class:`~gendex_envs.task_env.TaskEnv`
-either way.
+Each registered spec carries the task's ``max_episode_steps`` (``gym.spec(id).max_episode_steps``), so Gymnasium
+applies the time limit and ``gym.make(id, max_episode_steps=N)`` changes it. The entry point builds the bare
+:class:`~gendex_envs.task_env.TaskEnv`; :class:`~gendex_envs.wrappers.GymApi` is applied last: the plain numpy
+Gymnasium API for one CPU env, ManiSkill's batched torch API otherwise. ``env.unwrapped`` is the ``TaskEnv`` (a
+ManiSkill env: torch tensors ``[num_envs, ...]`` even for one env). By default actions drive the whole arm and hand
+with absolute joint targets (``control_mode="pd_joint_pos"``, ``control_joint="both"``), which is what
+``gendex collect`` records.
 """
 
 from __future__ import annotations
 
 import logging
 import os
-import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import gymnasium as gym
+from gymnasium.envs.registration import WrapperSpec, find_highest_version, parse_env_id
 
 from gendex_envs.errors import DuplicateTaskError, TaskNotFoundError, TaskSpecError, suggest
+from gendex_envs.task_version import NAMESPACE, TaskVersion, versions_in
 
 log = logging.getLogger(__name__)
 
-NAMESPACE = "GenDex"
 TASKS_PATH_ENV = "GENDEX_TASKS_PATH"
 REPO_TASKS_DIR = Path(__file__).resolve().parent.parent / "generated_tasks"
-_VERSION_DIR = re.compile(r"^v(\d+)$")
-
-
-@dataclass(frozen=True)
-class TaskEntry:
-    """One registered task version."""
-
-    env_id: str
-    name: str
-    version: int
-    task_dir: Path
+GYM_API_WRAPPER = WrapperSpec(name="GymApi", entry_point="gendex_envs.wrappers:GymApi", kwargs={})
 
 
 def task_roots() -> list[Path]:
@@ -47,93 +42,109 @@ def task_roots() -> list[Path]:
     return roots
 
 
-def discover_tasks(roots: list[Path] | None = None) -> dict[str, TaskEntry]:
-    """Find every ``<root>/<Name>/v<N>/task.yaml``; returns env id -> entry (first root wins on duplicates)."""
-    found: dict[str, TaskEntry] = {}
+def discover_tasks(roots: list[Path] | None = None) -> dict[str, TaskVersion]:
+    """Every task version in ``roots`` (default :func:`task_roots`): env id -> version; the first root wins."""
+    found: dict[str, TaskVersion] = {}
     for root in task_roots() if roots is None else roots:
         if not root.is_dir():
             raise TaskNotFoundError(f"task root {root} is not a folder (from ${TASKS_PATH_ENV} or the repository)")
-        for task_yaml in sorted(root.glob("*/v*/task.yaml")):
-            version_dir = task_yaml.parent
-            m = _VERSION_DIR.match(version_dir.name)
-            if m is None:
-                log.warning("ignoring %s: version folders are named v<N>", version_dir)
+        for version in versions_in(root):
+            if version.env_id in found:
+                log.info("%s in %s is shadowed by %s", version.env_id, version.root, found[version.env_id].root)
                 continue
-            name = version_dir.parent.name
-            env_id = f"{NAMESPACE}/{name}-v{int(m.group(1))}"
-            if env_id in found:
-                log.info("%s in %s is shadowed by %s", env_id, version_dir, found[env_id].task_dir)
-                continue
-            found[env_id] = TaskEntry(env_id, name, int(m.group(1)), version_dir)
+            found[version.env_id] = version
     return found
 
 
-_REGISTERED: dict[str, TaskEntry] = {}
+_REGISTERED: dict[str, TaskVersion] = {}
 
 
 def register_tasks(roots: list[Path] | None = None, override: bool = False) -> list[str]:
-    """Register every discovered task with Gymnasium; returns the new IDs.
+    """Register every discovered task version with Gymnasium; returns the new ids.
 
-    Re-registering an ID that points at the same folder is a no-op; a different folder raises
-    :class:`DuplicateTaskError` unless ``override``.
+    Re-registering an id that points at the same folder is a no-op; a different folder raises
+    :class:`DuplicateTaskError` unless ``override``. A version whose spec does not parse is logged and skipped (one
+    broken folder must not hide every other task); making it names the problem.
     """
     new = []
-    for env_id, entry in discover_tasks(roots).items():
+    for env_id, version in discover_tasks(roots).items():
         if env_id in gym.registry:
             previous = _REGISTERED.get(env_id)
-            if previous is not None and previous.task_dir == entry.task_dir:
+            if previous is not None and previous.root == version.root:
                 continue
             if not override:
-                where = previous.task_dir if previous else "another package"
-                raise DuplicateTaskError(f"{env_id} from {entry.task_dir} is already registered by {where}; "
+                where = previous.root if previous else "another package"
+                raise DuplicateTaskError(f"{env_id} from {version.root} is already registered by {where}; "
                                          "pass override=True to replace it")
             del gym.registry[env_id]
-        gym.register(id=env_id, entry_point="gendex_envs.registry:make_task_env",
-                     kwargs={"task_dir": str(entry.task_dir)}, disable_env_checker=True)
-        _REGISTERED[env_id] = entry
+        try:
+            steps = version.load_spec_unchecked().max_episode_steps
+        except TaskSpecError as exc:
+            log.error("not registering %s: %s", env_id, exc)
+            continue
+        gym.register(id=env_id, entry_point="gendex_envs.registry:make_task_env", max_episode_steps=steps,
+                     kwargs={"task": str(version.root)}, disable_env_checker=True,
+                     additional_wrappers=(GYM_API_WRAPPER,))
+        _REGISTERED[env_id] = version
         new.append(env_id)
     return new
 
 
-def registered_tasks() -> dict[str, TaskEntry]:
-    """Env id -> entry of every task registered by GenDex in this process."""
+def unregister_tasks(env_ids: list[str]) -> None:
+    """Remove GenDex task ids from Gymnasium's registry (tasks registered for a while, e.g. a scratch root)."""
+    for env_id in env_ids:
+        if env_id in _REGISTERED:
+            del _REGISTERED[env_id]
+            gym.registry.pop(env_id, None)
+
+
+def registered_tasks() -> dict[str, TaskVersion]:
+    """Env id -> version of every task registered by GenDex in this process."""
     return dict(_REGISTERED)
 
 
-def task_entry(env_id: str) -> TaskEntry:
-    """Look up a registered task by id; :class:`TaskNotFoundError` with suggestions."""
-    try:
-        return _REGISTERED[env_id]
-    except KeyError:
-        raise TaskNotFoundError(f"no GenDex task {env_id!r}.{suggest(env_id, _REGISTERED)} "
-                                f"Registered: {', '.join(sorted(_REGISTERED)) or 'none'}") from None
+def resolve_task(task: str | Path) -> TaskVersion:
+    """The task version named by ``task``: a registered id (``GenDex/PutAppleBowl-v0``), an unversioned name
+    (``GenDex/PutAppleBowl`` or ``PutAppleBowl``: the highest registered version, as ``gym.make`` picks it), or a
+    version folder. :class:`TaskNotFoundError` with suggestions otherwise."""
+    text = str(task)
+    if text in _REGISTERED:
+        return _REGISTERED[text]
+    if Path(text).is_dir():
+        return TaskVersion.at(text)
+    ns, name, version = parse_env_id(text if "/" in text else f"{NAMESPACE}/{text}")
+    if ns == NAMESPACE and version is None:
+        latest = find_highest_version(ns, name)
+        if latest is not None and f"{ns}/{name}-v{latest}" in _REGISTERED:
+            return _REGISTERED[f"{ns}/{name}-v{latest}"]
+    raise TaskNotFoundError(f"no GenDex task {text!r}.{suggest(text, _REGISTERED)} "
+                            f"Registered: {', '.join(sorted(_REGISTERED)) or 'none'}")
 
 
-def make_task_env(task_dir: str, num_envs: int = 1, max_episode_steps: int | None = None,
-                  gym_api: bool | None = None, **kwargs) -> gym.Env:
-    """Build a task env. ``gym_api`` (default: one CPU env) wraps it as a plain numpy Gymnasium env."""
-    from mani_skill.utils.registration import TimeLimitWrapper  # noqa: PLC0415
-    from mani_skill.utils.wrappers.gymnasium import CPUGymWrapper  # noqa: PLC0415
+def make_task_env(task: str | Path | TaskVersion, num_envs: int = 1, **kwargs):
+    """Gymnasium entry point: the bare :class:`~gendex_envs.task_env.TaskEnv` of ``task`` (a version or its folder).
 
-    from gendex_envs.task_env import TaskEnv  # noqa: PLC0415  (heavy: sapien + torch)
+    Without CUDA the renderer runs on the Vulkan CPU device directly (ManiSkill would warn, then do the same)."""
+    from gendex_envs.task_env import TaskEnv
 
-    if not (Path(task_dir) / "task.yaml").is_file():
-        raise TaskNotFoundError(f"{task_dir} holds no task.yaml")
     if "render_backend" not in kwargs:
-        import torch  # noqa: PLC0415
+        import torch
 
-        # without CUDA, render on the Vulkan CPU device directly (ManiSkill would warn, then do the same)
         kwargs["render_backend"] = "gpu" if torch.cuda.is_available() else "cpu"
-    env = TaskEnv(task_dir=task_dir, num_envs=num_envs, **kwargs)
-    if max_episode_steps is not None:
-        steps = max_episode_steps
-    else:  # a stage env lasts the stage's horizon
-        steps = env.stage_spec.horizon if env.stage_spec is not None else env.task_spec.max_episode_steps
-    if steps < 1:
-        raise TaskSpecError(f"max_episode_steps={steps} must be >= 1")
-    wrapped: gym.Env = TimeLimitWrapper(env, max_episode_steps=steps)
-    if gym_api is None:
-        gym_api = num_envs == 1 and not env.gpu_sim_enabled
-    if gym_api:
-        wrapped = CPUGymWrapper(wrapped)
-    return wrapped
+    return TaskEnv(task=task, num_envs=num_envs, **kwargs)
+
+
+def make_env(task: str | Path | TaskVersion, *, max_episode_steps: int | None = None, **kwargs) -> gym.Env:
+    """``gym.make`` for a task version that need not be registered: the same wrappers, the same defaults.
+
+    ``max_episode_steps``: None for the task's own limit, -1 for none."""
+    from gendex_envs.wrappers import GymApi
+
+    version = task if isinstance(task, TaskVersion) else TaskVersion.at(task)
+    env = make_task_env(version, **kwargs)
+    steps = version.spec.max_episode_steps if max_episode_steps is None else max_episode_steps
+    if steps != -1:
+        if steps < 1:
+            raise TaskSpecError(f"max_episode_steps={steps} must be >= 1 (or -1 for no limit)")
+        env = gym.wrappers.TimeLimit(env, steps)
+    return GymApi(env)

@@ -1,11 +1,13 @@
-"""Load a task's reward module (``reward.py`` beside its ``task.yaml``).
+"""Load a reward module of a task version (the task's, or one stage's; :class:`~gendex_envs.task_version.TaskLayout`).
 
-A reward module is a small file of pure functions of the env state, all batched over ``[num_envs]``:
+A reward module is a small file of pure functions of the env state, all batched over ``[num_envs]``. It shapes
+learning; it does not decide success, which the spec declares (:mod:`gendex_envs.success`):
 
 ``evaluate(env) -> dict[str, Tensor]``
-    must contain ``success`` ([N] bool); may contain ``fail`` ([N] bool) and any [N] diagnostics.
+    may contain ``fail`` ([N] bool: the episode failed, e.g. the object fell off the table; it vetoes success) and
+    any [N] diagnostics the reward and observations use. It must not contain ``success``.
 ``compute_dense_reward(env, obs, action, info) -> Tensor``
-    [N] float reward; ``info`` is what ``evaluate`` returned.
+    [N] float reward; ``info`` is what ``evaluate`` returned, with ``success`` and ``fail`` decided.
 ``_get_obs_extra(env, info) -> dict[str, Tensor]``  (optional)
     task observations, each [N, ...].
 ``REWARD_MAX: float``  (optional, default 1.0)
@@ -49,7 +51,7 @@ def load_reward_module(path: str | Path) -> RewardModule:
     """Import ``path`` as a private module and check its interface; raises :class:`RewardModuleError`."""
     path = Path(path).resolve()
     if not path.is_file():
-        raise RewardModuleError(f"reward module {path} does not exist; every task folder needs a reward.py")
+        raise RewardModuleError(f"reward module {path} does not exist; every task version needs a task reward module")
     digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
     name = f"gendex_reward_{path.parent.parent.name}_{path.parent.name}_{digest}"
     spec = importlib.util.spec_from_file_location(name, path)

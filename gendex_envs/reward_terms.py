@@ -1,6 +1,6 @@
 """Vetted, batched reward terms that task reward modules compose. Every function returns [N] tensors in [0, 1].
 
-Reward modules (``generated_tasks/<Name>/v<N>/reward.py``) may import this module; the generator's validator
+The reward modules of task versions may import this module; the generator's validator
 allows it alongside ``torch`` and ``math``.
 """
 

@@ -1,10 +1,13 @@
-"""Typed schema of a task YAML file (``generated_tasks/<Name>/v<N>/task.yaml``).
+"""Typed schema of a task YAML file (the spec of a task version, see :mod:`gendex_envs.task_version`).
 
-A task file is loaded with dacite in strict mode into the frozen dataclasses below, then checked
-semantically (ranges, name patterns, cross references). Every problem is reported as one
-:class:`~gendex_envs.errors.TaskSpecError` naming the file, the field path (``objects[1].scale``),
-the bad value and what is allowed. Lengths are in metres, angles in degrees. The table top is the
-world plane z = 0. See ``docs/task_spec.md`` for the field reference and a full example.
+A task file is loaded with dacite in strict mode into the frozen dataclasses below (:mod:`gendex_envs.typed_yaml`),
+then checked semantically (ranges, name patterns, cross references, which fields each condition type takes). Every
+problem is reported as one :class:`~gendex_envs.errors.TaskSpecError` naming the file, the field path
+(``objects[1].scale``), the bad value and what is allowed. Lengths are in metres, angles in degrees. The table top is
+the world plane z = 0. See ``docs/task_spec.md`` for the field reference and a full example.
+
+Success is declared here and nowhere else: ``success.conditions`` for the whole task and ``stages[k].success`` for a
+stage (a stage that declares none succeeds when the task does). :mod:`gendex_envs.success` evaluates them.
 """
 
 from __future__ import annotations
@@ -13,16 +16,16 @@ import dataclasses
 import logging
 import math
 import re
-import types
 from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
+from typing import Any, Literal, get_args
 
-import dacite
+import numpy as np
 import yaml
 
-from gendex_envs.errors import TaskSpecError, suggest
+from gendex_envs.errors import StageError, TaskSpecError, suggest
+from gendex_envs.typed_yaml import UniqueKeyLoader, build, join_path, spec_error, suggest_value
 
 log = logging.getLogger(__name__)
 
@@ -30,13 +33,33 @@ RobotUid = Literal["ur10e_shadow"]
 Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
-ConditionType = Literal["lifted", "inside", "joint_open", "near"]
+Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient"]
+ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
+                        "hand_at", "fingertips_near", "hand_open"]
+Part = Literal["handle"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
 STAGE_METHODS: tuple[str, ...] = get_args(StageMethod)
 CONTROL_JOINT_MODES: tuple[str, ...] = get_args(ControlJoint)
+SKILLS: tuple[str, ...] = get_args(Skill)
 CONDITION_TYPES: tuple[str, ...] = get_args(ConditionType)
+
+SKILL_MEANINGS: dict[str, str] = {
+    "reach": "bring the open hand to where the next skill starts (a pre-grasp pose, a handle)",
+    "grasp": "close the fingers on the target (a rigid object: hold it; an articulated one: hook its handle)",
+    "lift": "raise the held target off its support",
+    "carry": "move the held object to above another object or place",
+    "place": "set the held object down on or into its destination",
+    "release": "open the hand and let go of the held target",
+    "open": "open the target's joint (a door, a lid, a drawer) by its handle",
+    "close": "close the target's joint by its handle",
+    "push": "push or slide the target across its support without grasping it",
+    "turn": "turn the target about its own axis (a knob, a valve, a lid)",
+    "reorient": "rotate the target inside the hand (in-hand manipulation)",
+}
+"""What each skill of :data:`SKILLS` does; the stage's ``target`` is the object it acts on."""
+assert set(SKILL_MEANINGS) == set(SKILLS)
 
 SCALE_RANGE: tuple[float, float] = (0.3, 2.0)
 QUAT_NORM_TOL = 1e-3
@@ -117,13 +140,92 @@ class GoalSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class ConditionSpec:
+    """One success condition. ``type`` says which other fields it takes (:data:`CONDITION_FIELDS`); a field that
+    does not apply to the type is an error. Optional fields left out take :data:`CONDITION_DEFAULTS`."""
+
+    type: ConditionType
+    """Condition kind; one of CONDITION_TYPES."""
+    object: str | None = None
+    """Name of the object the condition is about (every type but ``hand_open``)."""
+    target: str | None = None
+    """inside: the container; near: an object or 'goal'; over: the object to be above."""
+    negate: bool = False
+    """True: the condition must *not* hold (e.g. ``grasped`` negated: the hand has let go)."""
+    part: Part | None = None
+    """grasped, released, hand_at, fingertips_near: 'handle' = the handle of an articulated object's joint instead
+    of the object itself."""
+    joint: str | None = None
+    """joint_open, or with ``part: handle``: the joint (default: the asset's main joint)."""
+    min_height_m: float | None = None
+    """lifted: required rise above the object's height at reset (m), > 0."""
+    min_fraction: float | None = None
+    """joint_open: required opening as a fraction of the joint range, in (0, 1]."""
+    max_dist_m: float | None = None
+    """near: object to target; hand_at: palm to the point; fingertips_near: mean fingertip distance (m), > 0."""
+    min_deg: float | None = None
+    """rotated: twist about world z since reset, degrees, counter-clockwise seen from above (negative: clockwise),
+    non-zero; the twist must reach it."""
+    min_fingers: int | None = None
+    """grasped: fingers other than the thumb that must touch (1-4; default 2)."""
+    thumb: bool | None = None
+    """grasped: the thumb must touch too (default true)."""
+    min_force_n: float | None = None
+    """grasped: a link group touches when its mean contact force exceeds this (N, > 0; default 0.3)."""
+    max_palm_force_n: float | None = None
+    """grasped: the palm may press with at most this mean force (N, > 0); unset: no limit."""
+    max_force_n: float | None = None
+    """released: no finger, thumb or palm group presses with more than this (N, > 0; default 0.3)."""
+    max_xy_m: float | None = None
+    """over: horizontal distance of the object from the target (m), > 0."""
+    min_dz_m: float | None = None
+    """over: least height of the object above the target's origin (m)."""
+    max_dz_m: float | None = None
+    """over: greatest height of the object above the target's origin (m), > min_dz_m."""
+    ring_radius_m: float | None = None
+    """hand_at: the point lies on a ring of this radius about the object's vertical axis, on the side the palm is
+    (m, >= 0; default 0: on the axis)."""
+    above_m: float | None = None
+    """hand_at: height of the point above the object's origin (m; default 0)."""
+    min_spread_m: float | None = None
+    """hand_open: mean fingertip distance from the palm (m), > 0."""
+
+
+CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_force_n": 0.3, "max_force_n": 0.3,
+                                      "ring_radius_m": 0.0, "above_m": 0.0}
+"""Values of optional condition fields left out."""
+
+CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
+    "lifted": (("object", "min_height_m"), (), "the object has risen at least min_height_m since reset"),
+    "inside": (("object", "target"), (), "the object rests inside the container target"),
+    "near": (("object", "target", "max_dist_m"), (), "the object is within max_dist_m of target (or the goal)"),
+    "joint_open": (("object", "min_fraction"), ("joint",), "the joint is open at least min_fraction of its range"),
+    "rotated": (("object", "min_deg"), (), "the object has turned min_deg about world z since reset"),
+    "grasped": (("object",), ("part", "joint", "min_fingers", "thumb", "min_force_n", "max_palm_force_n"),
+                "the thumb and at least min_fingers fingers touch the object (or its handle)"),
+    "released": (("object",), ("part", "joint", "max_force_n"), "no part of the hand presses on the object"),
+    "over": (("object", "target", "max_xy_m", "min_dz_m", "max_dz_m"), (),
+             "the object is above target: within max_xy_m horizontally, min_dz_m..max_dz_m higher"),
+    "hand_at": (("object", "max_dist_m"), ("part", "joint", "ring_radius_m", "above_m"),
+                "the palm is within max_dist_m of a point by the object (its origin, a ring about it, its handle)"),
+    "fingertips_near": (("object", "max_dist_m"), ("part", "joint"),
+                        "the fingertips are on average within max_dist_m of the object's origin (or its handle)"),
+    "hand_open": (("min_spread_m",), (), "the fingertips are on average at least min_spread_m from the palm"),
+}
+"""Condition type -> (required fields, optional fields, meaning). ``type`` and ``negate`` apply to every type."""
+assert set(CONDITION_FIELDS) == set(CONDITION_TYPES)
+
+
+@dataclass(frozen=True, kw_only=True)
 class StageSpec:
-    """One stage of the task, solved by motion planning or RL."""
+    """One stage of the task: a skill applied to a target, solved by motion planning or RL."""
 
     name: str
     """Stage identifier, snake_case (^[a-z][a-z0-9_]*$); unique within the task."""
     instruction: str
     """Non-empty natural-language description of the stage."""
+    skill: Skill
+    """What the stage does; one of SKILLS (see SKILL_MEANINGS). The solver, stage rewards and critic read it."""
     method: StageMethod
     """Solver; one of STAGE_METHODS."""
     control_joint: ControlJoint
@@ -132,26 +234,8 @@ class StageSpec:
     """Number of control steps of the stage, >= 1."""
     target: str | None = None
     """Optional name of the object the stage acts on."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class ConditionSpec:
-    """One success condition; which fields are used depends on ``type``."""
-
-    type: ConditionType
-    """Condition kind; one of CONDITION_TYPES."""
-    object: str
-    """Name of the object the condition is about."""
-    target: str | None = None
-    """inside: container object name (required); near: object name or 'goal' (required)."""
-    min_height_m: float | None = None
-    """lifted: required clearance above the table (m), > 0."""
-    min_fraction: float | None = None
-    """joint_open: required opening as a fraction of the joint range, in (0, 1]."""
-    joint: str | None = None
-    """joint_open: optional joint name (default: the asset's main joint)."""
-    max_dist_m: float | None = None
-    """near: required maximum distance between object and target (m), > 0."""
+    success: tuple[ConditionSpec, ...] | None = None
+    """When the stage has done its job (all must hold); None: when the task's success holds."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -196,149 +280,25 @@ class TaskSpec:
                 return obj
         names = [o.name for o in self.objects]
         raise TaskSpecError(f"task {self.name!r} has no object {name!r}; objects: {', '.join(names)}."
-                            f"{_suggest(name, names)}")
+                            f"{suggest_value(name, names)}")
+
+    def stage_conditions(self, stage: StageSpec) -> tuple[ConditionSpec, ...]:
+        """What decides ``stage``'s success: its own conditions, else the task's."""
+        return stage.success if stage.success is not None else self.success.conditions
 
 
-# ----------------------------------------------------------------------------------------- loading
-def _number_hook(tp: type) -> Any:
-    """dacite hook: reject bools (an int subclass: YAML `true` must not become 1), widen ints for float fields."""
-    def hook(value: Any) -> Any:
-        if isinstance(value, bool):
-            raise dacite.WrongTypeError(field_type=tp, value=value)
-        return float(value) if tp is float and isinstance(value, int) else value
-    return hook
-
-
-_DACITE_CONFIG = dacite.Config(strict=True, cast=[tuple],
-                               type_hooks={float: _number_hook(float), int: _number_hook(int)})
-
-
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """SafeLoader that rejects duplicate mapping keys instead of silently keeping the last one."""
-
-    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict:
-        seen: set = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            if isinstance(key, str):
-                if key in seen:
-                    raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r}", key_node.start_mark)
-                seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
-def _suggest(value: str, options: Collection[str]) -> str:
-    """Close-name suggestion; exact case-insensitive matches ('rl' -> 'RL') first."""
-    same = [o for o in options if o.lower() == str(value).lower()]
-    return f" Did you mean: {', '.join(map(repr, same))}?" if same else suggest(str(value), options)
-
-
-def _fail(source: str, problems: list[str]) -> TaskSpecError:
-    if len(problems) == 1:
-        return TaskSpecError(f"invalid task spec {source}: {problems[0]}")
-    return TaskSpecError(f"invalid task spec {source} ({len(problems)} problems):\n  - " + "\n  - ".join(problems))
-
-
-def _join(path: str, name: str) -> str:
-    return f"{path}.{name}" if path else name
-
-
-def _is_union(tp: Any) -> bool:
-    return get_origin(tp) in (Union, types.UnionType)
-
-
-def _type_name(tp: Any) -> str:
-    simple = {float: "a number", int: "an integer", str: "a string", bool: "a boolean (true/false)",
-              type(None): "null"}
-    if tp in simple:
-        return simple[tp]
-    origin, args = get_origin(tp), get_args(tp)
-    if origin is Literal:
-        return "one of " + ", ".join(repr(a) for a in args)
-    if _is_union(tp):
-        return " or ".join(_type_name(a) for a in args)
-    if origin is tuple and len(args) == 2 and args[1] is Ellipsis:
-        item = f"mappings ({args[0].__name__})" if dataclasses.is_dataclass(args[0]) else _type_name(args[0])
-        return f"a list of {item}"
-    if origin is tuple:
-        kinds = {_type_name(a) for a in args}
-        return f"a list of {len(args)} numbers" if kinds == {"a number"} else f"a list of {len(args)} items"
-    if origin is dict:
-        return f"a mapping from {_type_name(args[0])} to {_type_name(args[1])}"
-    if dataclasses.is_dataclass(tp):
-        return f"a mapping ({tp.__name__})"
-    return str(tp)
-
-
-def _wrong_type(path: str, value: Any, tp: Any) -> str:
-    return f"{path} = {value!r} has the wrong type ({type(value).__name__}); expected {_type_name(tp)}"
-
-
-def _strip_none(tp: Any) -> Any:
-    """X for X | None, else tp unchanged."""
-    args = [a for a in get_args(tp) if a is not type(None)]
-    return args[0] if _is_union(tp) and len(args) == 1 else tp
-
-
-def _nested_dataclass(tp: Any) -> tuple[type | None, bool]:
-    """(dataclass, is_sequence) for fields typed DC, DC | None or tuple[DC, ...]; (None, False) otherwise."""
-    tp = _strip_none(tp)
-    args = get_args(tp)
-    if dataclasses.is_dataclass(tp):
-        return tp, False
-    if get_origin(tp) is tuple and len(args) == 2 and args[1] is Ellipsis and dataclasses.is_dataclass(args[0]):
-        return args[0], True
-    return None, False
-
-
-def _build(cls: type, data: Any, path: str, source: str) -> Any:
-    """Build ``cls`` from ``data`` with dacite; nested dataclasses are built here so paths carry list indices."""
-    where = path or "top level"
-    names = [f.name for f in dataclasses.fields(cls)]
-    if not isinstance(data, Mapping):
-        raise _fail(source, [f"{where}: expected a mapping with keys {', '.join(names)}; "
-                             f"got {data!r} ({type(data).__name__})"])
-    hints = get_type_hints(cls)
-    prepared = dict(data)
-    for name in names:
-        if name not in data:
-            continue
-        sub, value = _join(path, name), data[name]
-        dc, is_seq = _nested_dataclass(hints[name])
-        bare = _strip_none(hints[name])
-        container = {tuple: (list, tuple), dict: Mapping}.get(get_origin(bare))
-        if container and not isinstance(value, container) and not (value is None and bare is not hints[name]):
-            raise _fail(source, [_wrong_type(sub, value, hints[name])])  # dacite's tuple cast would crash/split
-        if dc is not None and not is_seq and isinstance(value, Mapping):
-            prepared[name] = _build(dc, value, sub, source)
-        elif dc is not None and is_seq:
-            prepared[name] = tuple(_build(dc, item, f"{sub}[{i}]", source) for i, item in enumerate(value))
-    try:
-        return dacite.from_dict(cls, prepared, _DACITE_CONFIG)
-    except dacite.UnexpectedDataError as e:
-        problems = [f"{where}: unknown key {key!r}.{_suggest(str(key), names)} Allowed keys: {', '.join(names)}."
-                    for key in sorted(e.keys, key=str)]
-        raise _fail(source, problems) from None
-    except dacite.MissingValueError as e:
-        name = (e.field_path or "").split(".")[0]
-        expected = _type_name(hints[name]) if name in hints else "a value"
-        raise _fail(source, [f"{_join(path, e.field_path or '')}: required field is missing "
-                             f"(expected {expected})"]) from None
-    except dacite.DaciteFieldError as e:
-        name = (e.field_path or "").split(".")[0]
-        full, tp = _join(path, name), hints.get(name)
-        value = data.get(name, getattr(e, "value", None))
-        if get_origin(tp) is Literal:
-            allowed = [str(a) for a in get_args(tp)]
-            msg = (f"{full} = {value!r} is not allowed; allowed values: {', '.join(map(repr, allowed))}."
-                   f"{_suggest(str(value), allowed)}")
-        elif isinstance(e, dacite.WrongTypeError):
-            msg = _wrong_type(full, value, tp)
-        else:
-            msg = f"{full}: {e}"
-        raise _fail(source, [msg]) from None
-    except (dacite.DaciteError, TypeError, ValueError) as e:  # pragma: no cover - defensive: one error type out
-        raise _fail(source, [f"{where}: {e}"]) from None
+def resolve_stage(spec: TaskSpec, stage: str | int) -> tuple[int, StageSpec]:
+    """(index, spec) of ``stage`` given by name or index; :class:`StageError` naming the stages otherwise."""
+    names = [s.name for s in spec.stages]
+    if isinstance(stage, (int, np.integer)) and not isinstance(stage, bool):
+        if not 0 <= int(stage) < len(names):
+            raise StageError(f"task {spec.name!r} has no stage {int(stage)}; stages 0..{len(names) - 1}: {names}")
+        return int(stage), spec.stages[int(stage)]
+    if isinstance(stage, str) and stage.isdigit():
+        return resolve_stage(spec, int(stage))
+    if stage not in names:
+        raise StageError(f"task {spec.name!r} has no stage {stage!r}; stages: {names}.{suggest(str(stage), names)}")
+    return names.index(stage), spec.stages[names.index(stage)]
 
 
 # ---------------------------------------------------------------------------------- semantic checks
@@ -347,10 +307,54 @@ def _floats(value: Any, path: str) -> Iterator[tuple[str, float]]:
         yield path, value
     elif isinstance(value, Mapping):
         for k, v in value.items():
-            yield from _floats(v, _join(path, str(k)))
+            yield from _floats(v, join_path(path, str(k)))
     elif isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
             yield from _floats(v, f"{path}[{i}]")
+
+
+_POSITIVE = {"min_height_m", "max_dist_m", "min_force_n", "max_palm_force_n", "max_force_n", "max_xy_m",
+             "min_spread_m"}
+
+
+def _condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
+    """Problems of one condition at path ``at``; ``ref(value, path, allow_goal)`` checks an object reference."""
+    required, optional, meaning = CONDITION_FIELDS[c.type]
+    p: list[str] = []
+    fields = required + optional
+    for f in dataclasses.fields(ConditionSpec):
+        if f.name in ("type", "negate") or f.name in fields or getattr(c, f.name) is None:
+            continue
+        p.append(f"{at}.{f.name} = {getattr(c, f.name)!r} does not apply to type {c.type!r} ({meaning}); its "
+                 f"fields: {', '.join(fields)}")
+    for name in required:
+        if getattr(c, name) is None:
+            p.append(f"{at}.{name} is required for type {c.type!r} ({meaning})")
+
+    def bad(name: str, allowed: str) -> None:
+        p.append(f"{at}.{name} = {getattr(c, name)!r} is not allowed; must be {allowed}")
+
+    for name in _POSITIVE & set(fields):
+        if getattr(c, name) is not None and not getattr(c, name) > 0:
+            bad(name, "> 0")
+    if c.min_fraction is not None and not 0 < c.min_fraction <= 1:
+        bad("min_fraction", "a fraction in (0, 1]")
+    if c.min_deg is not None and c.min_deg == 0:
+        bad("min_deg", "non-zero (positive: counter-clockwise seen from above)")
+    if c.min_fingers is not None and not 1 <= c.min_fingers <= 4:
+        bad("min_fingers", "between 1 and 4 (fingers other than the thumb)")
+    if c.ring_radius_m is not None and c.ring_radius_m < 0:
+        bad("ring_radius_m", ">= 0")
+    if c.min_dz_m is not None and c.max_dz_m is not None and not c.max_dz_m > c.min_dz_m:
+        bad("max_dz_m", f"> min_dz_m ({c.min_dz_m})")
+    if c.object is not None:
+        ref(c.object, f"{at}.object")
+    if c.target is not None:
+        if c.target == c.object:
+            bad("target", "another object's name, not the condition's own object")
+        else:
+            ref(c.target, f"{at}.target", allow_goal=c.type == "near")
+    return p
 
 
 def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> list[str]:
@@ -383,7 +387,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         seen.add(o.name)
         need(bool(o.asset.strip()), f"{at}.asset", o.asset, "must be a non-empty asset id (`gendex assets` lists them)")
         if known_assets is not None and o.asset.strip() and o.asset not in known_assets:
-            p.append(f"{at}.asset = {o.asset!r} is not a known asset.{_suggest(o.asset, known_assets)} "
+            p.append(f"{at}.asset = {o.asset!r} is not a known asset.{suggest_value(o.asset, known_assets)} "
                      f"Run `gendex assets` to list the available asset ids.")
         need(lo <= o.scale <= hi, f"{at}.scale", o.scale, f"allowed range {lo} <= scale <= {hi}")
         need(o.pos_m[2] >= 0, f"{at}.pos_m", list(o.pos_m), "z is the clearance above the table and must be >= 0")
@@ -403,7 +407,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         options = names + ([GOAL_TARGET] if allow_goal and spec.goal is not None else [])
         extra = (f" ({GOAL_TARGET!r} needs a top-level `goal:`)" if allow_goal and value == GOAL_TARGET else "")
         p.append(f"{path} = {value!r} does not name an object{extra}; allowed: {', '.join(map(repr, options))}."
-                 f"{_suggest(value, options)}")
+                 f"{suggest_value(value, options)}")
 
     need(len(spec.stages) >= 1, "stages", [], "at least one stage is required")
     stage_names: set[str] = set()
@@ -415,43 +419,28 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         need(bool(s.instruction.strip()), f"{at}.instruction", s.instruction, "must be a non-empty string")
         need(s.horizon >= 1, f"{at}.horizon", s.horizon, "must be >= 1")
         ref(s.target, f"{at}.target")
+        if s.success is not None:
+            need(len(s.success) >= 1, f"{at}.success", [], "leave it out (the stage then succeeds with the task) "
+                 "or give at least one condition")
+            for j, c in enumerate(s.success):
+                p += _condition_problems(c, f"{at}.success[{j}]", ref)
 
     need(bool(spec.success.description.strip()), "success.description", spec.success.description,
          "must be a non-empty string")
     need(spec.success.hold_steps >= 0, "success.hold_steps", spec.success.hold_steps, "must be >= 0")
     need(len(spec.success.conditions) >= 1, "success.conditions", [], "at least one condition is required")
     for i, c in enumerate(spec.success.conditions):
-        at = f"success.conditions[{i}]"
-        ref(c.object, f"{at}.object")
-
-        def required(fname: str, ok: Any, allowed: str, c: ConditionSpec = c, at: str = at) -> None:
-            value = getattr(c, fname)
-            if value is None:
-                p.append(f"{at}.{fname} is required for type {c.type!r} ({allowed})")
-            else:
-                need(bool(ok(value)), f"{at}.{fname}", value, f"must be {allowed}")
-
-        if c.type == "lifted":
-            required("min_height_m", lambda v: v > 0, "a height in m, > 0")
-        elif c.type == "joint_open":
-            required("min_fraction", lambda v: 0 < v <= 1, "a fraction in (0, 1]")
-        elif c.type in ("inside", "near"):
-            required("target", lambda v: v != c.object, "another object's name"
-                     + (f" or {GOAL_TARGET!r}" if c.type == "near" else ""))
-            if c.target is not None and c.target != c.object:
-                ref(c.target, f"{at}.target", allow_goal=c.type == "near")
-            if c.type == "near":
-                required("max_dist_m", lambda v: v > 0, "a distance in m, > 0")
+        p += _condition_problems(c, f"success.conditions[{i}]", ref)
     return p
 
 
 # -------------------------------------------------------------------------------------- public API
 def parse_task_spec(raw: Mapping, source: str = "<dict>", known_assets: Collection[str] | None = None) -> TaskSpec:
     """Validate an already-parsed task mapping; raise TaskSpecError naming ``source`` on any problem."""
-    spec = _build(TaskSpec, raw, "", source)
+    spec = build(TaskSpec, raw, "", source)
     problems = _semantic_problems(spec, known_assets)
     if problems:
-        raise _fail(source, problems)
+        raise spec_error(source, problems)
     log.debug("parsed task spec %s from %s", spec.name, source)
     return spec
 
@@ -464,7 +453,7 @@ def load_task_spec(path: str | Path, known_assets: Collection[str] | None = None
     except (OSError, UnicodeDecodeError) as e:
         raise TaskSpecError(f"cannot read task spec {path}: {e}") from None
     try:
-        raw = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - SafeLoader subclass
+        raw = yaml.load(text, Loader=UniqueKeyLoader)  # a SafeLoader subclass
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
@@ -488,11 +477,13 @@ def spec_to_dict(spec: TaskSpec) -> dict:
     return _plain(dataclasses.asdict(spec))
 
 
-def _drop_none(value: Any) -> Any:
+def _compact(value: Any) -> Any:
+    """Drop None-valued fields, and ``negate: false`` of conditions (the default that a reader need not see)."""
     if isinstance(value, dict):
-        return {k: _drop_none(v) for k, v in value.items() if v is not None}
+        return {k: _compact(v) for k, v in value.items()
+                if v is not None and not (k == "negate" and v is False and "type" in value)}
     if isinstance(value, list):
-        return [_drop_none(v) for v in value]
+        return [_compact(v) for v in value]
     return value
 
 
@@ -510,5 +501,5 @@ _Dumper.add_representer(list, _represent_list)
 
 def dump_task_spec(spec: TaskSpec) -> str:
     """YAML text of ``spec``; None-valued (default) fields are omitted. parse(safe_load(dump(s))) == s."""
-    return yaml.dump(_drop_none(spec_to_dict(spec)), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
+    return yaml.dump(_compact(spec_to_dict(spec)), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
                      default_flow_style=False, width=100)

@@ -1,7 +1,13 @@
-"""``TaskEnv``: the one ManiSkill environment class that builds any GenDex task from its folder.
+"""``TaskEnv``: the one ManiSkill environment class that builds any GenDex task from its version folder.
 
-A task is data (``task.yaml``, see :mod:`gendex_envs.spec`) plus a small reward module (``reward.py``, see
-:mod:`gendex_envs.reward_module`). There are no per-task env classes.
+A task is data (the spec, :mod:`gendex_envs.spec`) plus a small reward module (:mod:`gendex_envs.reward_module`),
+owned by a :class:`~gendex_envs.task_version.TaskVersion`. There are no per-task env classes. Success is decided by
+the spec's conditions (:mod:`gendex_envs.success`); the reward module adds ``fail``, diagnostics, the dense reward
+and task observations.
+
+``TaskEnv`` is ManiSkill's torch-batched env: every quantity is a tensor ``[num_envs, ...]`` on ``env.device``, also
+with one env. ``gym.make`` wraps it into the plain Gymnasium API (numpy, no batch dimension) for one CPU env; the
+wrapped env's ``env.unwrapped`` is always this class.
 
 Members that reward code may use (all batched over ``num_envs``, tensors on ``env.device``):
 
@@ -17,8 +23,9 @@ Members that reward code may use (all batched over ``num_envs``, tensors on ``en
   ``env.joint_open_fraction(name)`` [N].
 * ``env.goal_pos`` [N, 3] (when the task has a goal), ``env.init_obj_pos(name)`` [N, 3] and
   ``env.init_obj_quat(name)`` [N, 4] (pose at the start of the task episode).
+* ``env.hand_forces(name)`` [N, 6] — mean contact force of each hand group (th, ff, mf, rf, lf, palm) on an object.
 * ``env.task_spec`` — the loaded :class:`~gendex_envs.spec.TaskSpec` (``env.spec`` is Gymnasium's EnvSpec).
-* ``env.spec_success()`` [N] bool — the spec's ``success.conditions`` evaluated generically.
+* ``env.spec_success()`` [N] bool — the task's success conditions hold now (no ``hold_steps``, no ``fail``).
 * ``env.table_height`` (0.0: the table top is the plane z = 0).
 """
 
@@ -26,6 +33,8 @@ from __future__ import annotations
 
 import logging
 import math
+import os
+import sys
 from pathlib import Path
 
 import gymnasium as gym
@@ -34,18 +43,20 @@ import sapien
 import torch
 from mani_skill.envs.sapien_env import BaseEnv
 from mani_skill.sensors.camera import CameraConfig
-from mani_skill.utils import sapien_utils
+from mani_skill.utils import common, sapien_utils
 from mani_skill.utils.structs import Actor, Articulation, Link, Pose
 from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
-from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, asset_ids, get_asset, lowest_point_z
+from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
-from gendex_envs.errors import ControlModeError, RewardModuleError, StageError, TaskSpecError, suggest
-from gendex_envs.geometry import quat_mul, transform_points, xy_distance, yaw_quat
+from gendex_envs.errors import ControlModeError, GenDexError, StageError, TaskSpecError, suggest
+from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
 from gendex_envs.reward_module import RewardModule, load_reward_module
-from gendex_envs.spec import ConditionSpec, StageSpec, TaskSpec, load_task_spec
-from gendex_envs.stage import StartStates, resolve_stage, stage_reward_path, start_states_path
+from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
+from gendex_envs.start_states import StartStates
+from gendex_envs.success import Judge, conditions_hold
+from gendex_envs.task_version import TaskVersion
 
 log = logging.getLogger(__name__)
 
@@ -54,8 +65,25 @@ CONTROL_FREQ = 20
 VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 """The three scene views used by rendering, refinement and the docs."""
 HAND_CAMERA = "hand_camera"
-DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "default_reward.py"
-"""Reward module of an in-memory spec: success = the spec's conditions, reward = reaching the first target."""
+DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_reward.py"
+"""Reward module of an in-memory spec: no failure, reward = reaching the first stage's target."""
+
+
+class RenderModeError(GenDexError, ValueError):
+    """A render mode this machine cannot serve."""
+
+
+RENDER_MODES = (None, "rgb_array", "sensors", "all", "human")
+
+
+def _check_render_mode(mode: str | None) -> None:
+    if mode not in RENDER_MODES:
+        raise RenderModeError(f"render_mode={mode!r} is not a mode; allowed: {list(RENDER_MODES)}")
+    if mode == "human" and sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                                     or os.environ.get("WAYLAND_DISPLAY")):
+        raise RenderModeError("render_mode='human' opens a viewer window, but this machine has no display (DISPLAY "
+                              "and WAYLAND_DISPLAY are unset); use render_mode='rgb_array' for frames as arrays "
+                              "(env.render()), or run under a display or Xvfb")
 
 
 def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
@@ -63,53 +91,62 @@ def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
 
 
 class TaskEnv(BaseEnv):
-    """Generic GenDex task: ShadowHand on UR10e at a table, objects and reward from a task folder.
+    """Generic GenDex task: ShadowHand on UR10e at a table, objects and reward from a task version.
 
     Args:
-        task_dir: the task's version folder (``task.yaml``, ``reward.py``); or ``task_spec`` for a spec in memory.
-        control_joint: joint group actions drive (default: the stage's, else the first RL stage's, else ``both``).
-        stage: a sub-stage (name or index) to run on its own: its ``control_joint``, its reward module and start
-            states (see :mod:`gendex_envs.stage`). Stages after the first need start states.
-        start_states: a :class:`~gendex_envs.stage.StartStates` (or its ``.npz`` path) every reset starts from;
-            default for ``stage`` > 0: ``start_states/<stage>.npz`` of the task folder.
+        task: the :class:`~gendex_envs.task_version.TaskVersion` (or its folder); or ``task_spec`` for a spec held
+            in memory (scene previews, refinement), which gets a default reward module.
+        control_joint: joint group actions drive (default: the stage's when ``stage`` is given, else ``both``: the
+            whole arm and hand, as ``gendex collect`` records).
+        stage: a sub-stage (name or index) to run on its own: its ``control_joint``, its reward module, its success
+            conditions and start states; episodes are truncated at its ``horizon``. Stages after the first need
+            start states.
+        start_states: a :class:`~gendex_envs.start_states.StartStates` (or its ``.npz`` path) every reset starts
+            from; default for ``stage`` > 0: the task version's.
+        gym_api: how ``gym.make`` wraps the env: the plain numpy Gymnasium API (default for one CPU env) or the
+            torch-batched one (:class:`~gendex_envs.wrappers.GymApi`).
     """
 
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
     agent: UR10eShadowHand
 
-    def __init__(self, *args, task_dir: str | None = None, task_spec: TaskSpec | None = None,
+    def __init__(self, *args, task: TaskVersion | str | Path | None = None, task_spec: TaskSpec | None = None,
                  control_joint: str | None = None, stage: str | int | None = None,
                  start_states: StartStates | str | Path | None = None, view_resolution: int = 512,
-                 sensor_resolution: int = 128, **kwargs):
-        if (task_dir is None) == (task_spec is None):
-            raise TaskSpecError("TaskEnv needs exactly one of task_dir (a task folder) or task_spec (in memory)")
-        self.task_dir = Path(task_dir) if task_dir is not None else None
-        """The task's version folder (holds task.yaml and reward.py); None for an in-memory spec."""
-        if task_spec is None:
-            task_spec = load_task_spec(self.task_dir / "task.yaml", known_assets=asset_ids())
-            reward_path = self.task_dir / "reward.py"
-        else:
-            reward_path = DEFAULT_REWARD_MODULE
-        self.task_spec: TaskSpec = task_spec
+                 sensor_resolution: int = 128, gym_api: bool | None = None, **kwargs):
+        if (task is None) == (task_spec is None):
+            raise TaskSpecError("TaskEnv needs exactly one of task (a task version or its folder) or task_spec "
+                                "(a spec held in memory)")
+        _check_render_mode(kwargs.get("render_mode"))
+        self.task: TaskVersion | None = (task if isinstance(task, TaskVersion) or task is None
+                                         else TaskVersion.at(task))
+        """The task version this env runs; None for an in-memory spec."""
+        self.task_spec: TaskSpec = self.task.spec if self.task is not None else task_spec
         self.stage_index: int | None = None
         """Index of the stage this env runs on its own (``stage=``), else None (the whole task)."""
         self.stage_spec: StageSpec | None = None
         if stage is not None:
-            self.stage_index, self.stage_spec = resolve_stage(task_spec, stage)
-            if self.task_dir is not None:
-                reward_path = stage_reward_path(self.task_dir, self.stage_spec.name)
-        self.reward: RewardModule = load_reward_module(reward_path)
+            self.stage_index, self.stage_spec = resolve_stage(self.task_spec, stage)
+        if self.task is not None:
+            self.judge: Judge = self.task.judge(self.stage_spec.name if self.stage_spec else None)
+        else:
+            module = load_reward_module(DEFAULT_REWARD_MODULE)
+            self.judge = (Judge.of_stage(self.task_spec, self.stage_spec, module) if self.stage_spec
+                          else Judge.of_task(self.task_spec, module))
+        """Decides ``success`` of this env's episodes (the task's, or the stage's) and holds its reward module."""
         self.start_states: StartStates | None = self._load_start_states(start_states)
         """States every reset starts from (stage envs after the first), else None."""
         if control_joint is None:
-            rl = [s for s in self.task_spec.stages if s.method == "RL"]
-            control_joint = (self.stage_spec.control_joint if self.stage_spec is not None
-                             else rl[0].control_joint if rl else "both")
+            control_joint = self.stage_spec.control_joint if self.stage_spec is not None else "both"
         if control_joint not in CONTROL_JOINT_GROUPS:
             raise ControlModeError(f"control_joint={control_joint!r} is not a mode; allowed: "
                                    f"{sorted(CONTROL_JOINT_GROUPS)}.{suggest(control_joint, CONTROL_JOINT_GROUPS)}")
         self.control_joint = control_joint
-        """Joint group actions drive (default: the first RL stage's ``control_joint``, else ``both``)."""
+        """Joint group actions drive (default: ``both`` for the task, the stage's group for a stage env)."""
+        self.gym_api = gym_api
+        """Requested API of ``gym.make``'s wrapper (None: numpy for one CPU env, else batched torch)."""
+        self.horizon: int | None = self.stage_spec.horizon if self.stage_spec is not None else None
+        """Steps after which an episode is truncated whatever the time limit (a stage env's horizon), else None."""
         self.view_resolution = view_resolution
         self.sensor_resolution = sensor_resolution
         self.table_height = 0.0
@@ -122,21 +159,25 @@ class TaskEnv(BaseEnv):
                      self._records[o.name].bbox_max_m[2] * o.scale)
             for o in self.task_spec.objects
         }
-        """Per object: radius (80 % of the half footprint) and height of the space an ``inside`` condition checks."""
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
         super().__init__(*args, **kwargs)
+
+    @property
+    def reward(self) -> RewardModule:
+        """The reward module of this env (the stage's own for a stage env with one, else the task's)."""
+        return self.judge.module
 
     def _load_start_states(self, given: StartStates | str | Path | None) -> StartStates | None:
         if given is not None:
             states = given if isinstance(given, StartStates) else StartStates.load(given)
-        elif self.stage_index and self.task_dir is not None and start_states_path(self.task_dir,
-                                                                                  self.stage_spec.name).is_file():
-            states = StartStates.load(start_states_path(self.task_dir, self.stage_spec.name))
         elif self.stage_index:
-            where = start_states_path(self.task_dir, self.stage_spec.name) if self.task_dir else "(in-memory spec)"
-            prev = self.task_spec.stages[self.stage_index - 1].name
-            raise StageError(f"stage {self.stage_spec.name!r} starts where stage {prev!r} succeeded, but there are no "
-                             f"start states at {where}; `gendex train` collects them, or pass start_states=")
+            states = self.task.start_states(self.stage_spec.name) if self.task is not None else None
+            if states is None:
+                where = self.task.env_id if self.task is not None else "the in-memory spec"
+                prev = self.task_spec.stages[self.stage_index - 1].name
+                raise StageError(f"stage {self.stage_spec.name!r} starts where stage {prev!r} succeeded, but "
+                                 f"{where} has no start states for it; `gendex train` collects them into its run "
+                                 "folder (`gendex promote` makes them part of a new version), or pass start_states=")
         else:
             return None
         missing = sorted({o.name for o in self.task_spec.objects} - set(states.obj_reset_pos))
@@ -170,8 +211,9 @@ class TaskEnv(BaseEnv):
         views = [CameraConfig(uid=n, pose=p, width=res, height=res, fov=1.0, near=0.01, far=10.0)
                  for n, p in self._view_poses().items()]
         # hand camera: on the palm, looking out of the palm (-y of the palm frame) towards the grasp
-        hand = CameraConfig(uid=HAND_CAMERA, pose=sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068]),
-                            width=res, height=res, fov=1.4, near=0.01, far=5.0, mount=self.agent.palm_link)
+        mount = sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068])
+        hand = CameraConfig(uid=HAND_CAMERA, pose=mount, width=res, height=res, fov=1.4, near=0.01, far=5.0,
+                            mount=self.agent.palm_link)
         return [*views, hand]
 
     @property
@@ -252,8 +294,9 @@ class TaskEnv(BaseEnv):
         return np.array([x, y, z]), q
 
     def _initial_joint_state(self, name: str, rec: AssetRecord, art: Articulation) -> torch.Tensor:
-        """[dof] joint positions at reset: the spec's joint_state, else the joint's closed value, else its lower limit."""
-        where = self.task_dir / "task.yaml" if self.task_dir else "<in-memory spec>"
+        """[dof] joint positions at reset: the spec's joint_state, else the joint's closed value, else its lower
+        limit."""
+        where = self.task.files.spec if self.task is not None else "<in-memory spec>"
         names = [j.name for j in art.get_active_joints()]
         lower = art.get_qlimits()[0, :, 0].cpu()
         spec_state = self.task_spec.object(name).joint_state
@@ -326,10 +369,10 @@ class TaskEnv(BaseEnv):
         self.set_state_dict(sim, env_idx)
         sim_dim = start
         tail = state[:, sim_dim:]
-        target = self.agent.controller._target_qpos
+        target = self.agent.controller.target_qpos
         if tail.shape[-1] == target.shape[-1]:
             if env_idx is not None and len(tail) != len(target):
-                full = target.clone()
+                full = target
                 full[env_idx] = tail
                 tail = full
             self.agent.set_controller_state({"target_qpos": tail.clone()})
@@ -346,9 +389,12 @@ class TaskEnv(BaseEnv):
 
     def step(self, action):
         try:
-            return super().step(action)
+            obs, reward, terminated, truncated, info = super().step(action)
         finally:
             self._frame = None
+        if self.horizon is not None:  # a stage env's episode lasts the stage's horizon
+            truncated = truncated | (self.elapsed_steps >= self.horizon)
+        return obs, reward, terminated, truncated, info
 
     def _cached(self, key, compute):
         """Memoise ``compute()`` for the rest of the current step (no caching outside ``step``)."""
@@ -362,7 +408,8 @@ class TaskEnv(BaseEnv):
         self.agent.contacts.invalidate()
         with torch.device(self.device):
             b = len(env_idx)
-            qpos = torch.as_tensor(self.agent.qpos_from_names(KEYFRAME_QPOS_BY_NAME[self.task_spec.robot.init_keyframe]))
+            keyframe = KEYFRAME_QPOS_BY_NAME[self.task_spec.robot.init_keyframe]
+            qpos = torch.as_tensor(self.agent.qpos_from_names(keyframe))
             self.agent.robot.set_qpos(qpos.expand(b, -1).clone())
             self.agent.robot.set_qvel(torch.zeros(b, qpos.shape[0]))
             for obj in self.task_spec.objects:
@@ -412,6 +459,33 @@ class TaskEnv(BaseEnv):
         except KeyError:
             raise TaskSpecError(f"task {self.task_spec.name!r} has no object {name!r}; objects: {sorted(self.objects)}."
                                 f"{suggest(name, self.objects)}") from None
+
+    def asset_record(self, name: str) -> AssetRecord:
+        """The catalog record of object ``name``'s asset (size, bounding box, joints; unscaled)."""
+        self.obj(name)  # names the objects when ``name`` is not one
+        return self._records[name]
+
+    def container_extent(self, name: str) -> tuple[float, float]:
+        """(radius, height) of the space an ``inside`` condition checks in object ``name``: 80 % of its half
+        footprint, and its height (scaled)."""
+        self.obj(name)
+        return self._container_extent[name]
+
+    def joint_record(self, name: str, joint: str | None = None) -> JointEntry:
+        """The catalog entry of ``name``'s joint (default: its main joint)."""
+        return self._joint_record(name, joint)
+
+    def joint_index(self, name: str, joint: str | None = None) -> int:
+        """Position of ``name``'s joint among its articulation's active joints."""
+        return self._joint_index(name, joint)
+
+    def hand_forces(self, name: str, part: str | None = None, joint: str | None = None) -> torch.Tensor:
+        """[N, 6] mean contact force (N) of each hand group (th, ff, mf, rf, lf, palm) on object ``name``, or on its
+        handle link (``part='handle'``); read once per step."""
+        def compute():
+            entity = self.handle_link(name, joint) if part == "handle" else self.obj(name)
+            return self.agent.get_hand_group_obj_mean_force(entity)[..., 0]
+        return self._cached(("hand_forces", name, part, joint), compute)
 
     def _joint_record(self, name: str, joint: str | None = None) -> JointEntry:
         rec = self._records[name]
@@ -470,44 +544,16 @@ class TaskEnv(BaseEnv):
         """[N] how far object ``name`` has risen above its reset height, metres."""
         return self.obj_pose(name).p[:, 2] - self._obj_reset_pos[name][:, 2]
 
-    def _condition(self, c: ConditionSpec) -> torch.Tensor:
-        if c.type == "lifted":
-            return self.obj_height(c.object) >= c.min_height_m
-        if c.type == "joint_open":
-            return self.joint_open_fraction(c.object, c.joint) >= c.min_fraction
-        if c.type == "near":
-            target = self.goal_pos if c.target == "goal" else self.obj_pose(c.target).p
-            return torch.linalg.norm(self.obj_pose(c.object).p - target, dim=-1) <= c.max_dist_m
-        if c.type == "inside":
-            inner_r, top = self._container_extent[c.target]
-            box = self.obj_pose(c.target).p
-            p = self.obj_pose(c.object).p
-            dz = p[:, 2] - box[:, 2]
-            return (xy_distance(p, box) <= inner_r) & (dz >= -0.01) & (dz <= top)
-        raise TaskSpecError(f"unknown condition type {c.type!r}")
-
     def spec_success(self) -> torch.Tensor:
-        """[N] bool: every condition of the spec's ``success`` holds now."""
-        ok = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
-        for c in self.task_spec.success.conditions:
-            ok &= self._condition(c)
-        return ok
+        """[N] bool: every condition of the task's ``success`` holds now (without ``hold_steps`` or ``fail``)."""
+        return conditions_hold(self, self.task_spec.success.conditions)
 
     # ------------------------------------------------------------------ task hooks
     def evaluate(self) -> dict:
-        info = dict(self.reward.evaluate(self))
-        n = self.num_envs
-        for key in ("success", "fail"):
-            if key not in info:
-                if key == "success":
-                    raise RewardModuleError(f"{self.reward.path}: evaluate() must return 'success'")
-                info[key] = torch.zeros(n, dtype=torch.bool, device=self.device)
-            value = info[key]
-            if not isinstance(value, torch.Tensor) or value.shape != (n,) or value.dtype != torch.bool:
-                raise RewardModuleError(f"{self.reward.path}: evaluate()[{key!r}] must be a bool tensor of shape "
-                                        f"[{n}], got {getattr(value, 'dtype', type(value))} "
-                                        f"{tuple(getattr(value, 'shape', ()))}")
-        hold = self.task_spec.success.hold_steps
+        info = self.judge.evaluate(self)
+        # a stage judged by the task's own conditions also holds them for the task's hold_steps
+        own = self.stage_spec is not None and self.stage_spec.success is not None
+        hold = 0 if own else self.task_spec.success.hold_steps
         if hold > 0:  # count each control step once, however often evaluate() is called within it
             fresh = self._streak_counted_at != self.elapsed_steps
             self._success_streak = torch.where(fresh, (self._success_streak + 1) * info["success"],
@@ -516,6 +562,27 @@ class TaskEnv(BaseEnv):
             info["success"] = self._success_streak >= hold
         info["fail"] = info["fail"] & ~info["success"]
         return info
+
+    def state_observation(self, judge: Judge | None = None, info: dict | None = None) -> torch.Tensor:
+        """[N, D] the flat ``state`` observation of the current state as an env judged by ``judge`` would return it
+        (a stage env's: its module's extras are part of it); ``info``: ``judge.evaluate(env)`` when the caller has
+        it already. How a trained stage policy observes an env of another control mode."""
+        judge = self.judge if judge is None else judge
+        info = judge.evaluate(self) if info is None else info
+        active, self.judge = self.judge, judge
+        try:
+            state = self._get_obs_state_dict(info)
+        finally:
+            self.judge = active
+        return common.flatten_state_dict(state, use_torch=True, device=self.device)
+
+    def own_obs_keys(self) -> frozenset[str]:
+        """Names of the state observations the env provides itself (a reward module's extras may not reuse them)."""
+        keys = {"palm_pose", "tip_pos", *(f"{n}_pose" for n in self.objects),
+                *(f"{n}_qpos" for n in self.articulations)}
+        if self.goal_site is not None:
+            keys.add("goal_pos")
+        return frozenset(keys)
 
     def _get_obs_extra(self, info: dict) -> dict:
         extra = dict(palm_pose=self.palm_pose.raw_pose, tip_pos=self.tip_positions.flatten(1))

@@ -1,6 +1,6 @@
 """Prompt templates (``prompts/``): a manifest of Jinja2 templates rendered with strict variables.
 
-Each manifest entry names its file, the request stage it serves, its sampling temperature and the exact set of
+Each manifest entry names its file, the request step it serves, its sampling temperature and the exact set of
 variables it uses. Rendering with a variable missing, or with one the template does not use, raises
 :class:`~generator.errors.PromptError` — a silently empty field in a prompt is a bug that costs a model call.
 """
@@ -26,7 +26,7 @@ class PromptTemplate:
     name: str
     file: Path
     variables: frozenset[str]
-    stage: str | None = None
+    step: str | None = None
     temperature: float = 0.3
 
 
@@ -54,7 +54,7 @@ def load_manifest(root: Path = PROMPTS_DIR) -> dict[str, PromptTemplate]:
         if used != declared:
             raise PromptError(f"prompt {name!r} ({file.name}): template uses {sorted(used)} but the manifest declares "
                               f"{sorted(declared)}")
-        out[name] = PromptTemplate(name, file, declared, entry.get("stage"), float(entry.get("temperature", 0.3)))
+        out[name] = PromptTemplate(name, file, declared, entry.get("step"), float(entry.get("temperature", 0.3)))
     return out
 
 

@@ -1,4 +1,5 @@
-"""Typed records passed between the generator's stages. Each is JSON-able (``to_json``) and saved with the task."""
+"""Typed records passed between the generator's pipeline steps. Each is JSON-able (``to_json``) and saved with the
+task."""
 
 from __future__ import annotations
 
@@ -6,9 +7,9 @@ import json
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-ACTIONS = ("approach", "grasp", "lift", "move", "release", "open", "close", "push", "pull")
-"""Atomic step actions a proposal may use."""
 ROLES = ("graspable", "container", "articulated", "support")
+PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "near")
+"""Success condition types a proposal may state (the task's success; stages get theirs in the plan step)."""
 
 
 def to_json(record: Any) -> str:
@@ -24,7 +25,8 @@ class ProposedObject:
 
 @dataclass(frozen=True)
 class ProposedStep:
-    action: str
+    skill: str
+    """One of :data:`gendex_envs.spec.SKILLS`."""
     target: str
     control_joint: str
     instruction: str
@@ -32,7 +34,8 @@ class ProposedStep:
 
 @dataclass(frozen=True)
 class Proposal:
-    """What the task is: objects from the catalog, atomic steps, and one checkable success condition."""
+    """What the task is: objects from the catalog, atomic steps (a skill on a target each), and one checkable
+    success condition."""
 
     name: str
     description: str
@@ -78,7 +81,8 @@ class RefineLog:
 
 @dataclass(frozen=True)
 class RewardAttempt:
-    stage: str
+    module: str
+    """The module's path in the task folder."""
     attempt: int
     ok: bool
     feedback: str
@@ -86,7 +90,7 @@ class RewardAttempt:
 
 @dataclass(frozen=True)
 class GenerationInfo:
-    """Provenance written to ``generation.json``: enough to rerun the exact generation."""
+    """Provenance saved as the version's generation record: enough to rerun the exact generation."""
 
     generator_version: str
     backend: str

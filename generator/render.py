@@ -17,7 +17,7 @@ RESOLUTION = 384
 
 def png_bytes(rgb: np.ndarray) -> bytes:
     """Encode an [H, W, 3] uint8 image as PNG with no metadata (same pixels, same bytes)."""
-    from PIL import Image  # noqa: PLC0415
+    from PIL import Image
 
     buf = io.BytesIO()
     Image.fromarray(rgb).save(buf, format="PNG", optimize=False)
@@ -26,9 +26,9 @@ def png_bytes(rgb: np.ndarray) -> bytes:
 
 def render_spec(spec: TaskSpec, *, seed: int = 0, resolution: int = RESOLUTION) -> dict[str, bytes]:
     """PNG bytes of each view of ``spec`` after a reset with ``seed`` (object pose noise included)."""
-    import torch  # noqa: PLC0415
+    import torch
 
-    from gendex_envs.task_env import TaskEnv  # noqa: PLC0415
+    from gendex_envs.task_env import TaskEnv
 
     env = TaskEnv(task_spec=spec, num_envs=1, render_mode="rgb_array", view_resolution=resolution,
                   render_backend="gpu" if torch.cuda.is_available() else "cpu")

@@ -1,15 +1,15 @@
 """Reward modules composed from vetted terms (:mod:`gendex_envs.reward_terms`): what the offline backend writes.
 
 Each function returns the source of a complete reward module (``REWARD_MAX``, ``evaluate``,
-``compute_dense_reward``, ``_get_obs_extra``). The source still goes through the validator like model-written
-code. Object names are inserted as string literals; they are snake_case by the task schema.
+``compute_dense_reward``, ``_get_obs_extra``), chosen by the stage's skill. ``evaluate`` returns ``fail`` and the
+diagnostics the reward uses; success is the stage's declared conditions. The source still goes through the
+validator like model-written code. Object names are inserted as string literals; they are snake_case by the task
+schema.
 """
 
 from __future__ import annotations
 
 from typing import Any
-
-STAGE_KINDS = ("grasp", "lift", "release", "move", "pull", "open", "push", "close")
 
 _HEADER = '''"""{title}
 
@@ -30,10 +30,6 @@ _FAIL_RIGID = '''    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=e
 _FAIL_NONE = '''    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
 '''
 
-_HELD = '''    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
-    touching = force[..., 0] > 0.3  # [N, 6]
-    held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 2)  # thumb opposing at least two fingers
-'''
 
 
 def _success_condition(spec: dict) -> dict:
@@ -47,26 +43,20 @@ def _stage(spec: dict, name: str) -> dict:
     raise KeyError(f"no stage {name!r}; stages: {[s['name'] for s in spec['stages']]}")
 
 
-def stage_kind(stage: dict) -> str:
-    """The action a stage performs, from its name (``grasp_apple`` -> ``grasp``); ``move`` when unknown."""
-    head = stage["name"].split("_")[0]
-    return head if head in STAGE_KINDS else "move"
-
-
 def _rigid(spec: dict, roles: dict[str, str]) -> list[str]:
     return [o["name"] for o in spec["objects"] if roles.get(o["name"]) != "articulated" and not o.get("fixed")]
 
 
 def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> str:
-    """Reward module for one RL stage of ``spec`` (a task dict), by the stage's kind."""
+    """Reward module for one RL stage of ``spec`` (a task dict), by the stage's skill."""
     stage = _stage(spec, stage_name)
-    kind, obj = stage_kind(stage), stage["target"]
+    kind, obj = stage["skill"], stage["target"]
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
     src = _HEADER.format(title=title)
-    if kind in ("pull", "open", "push", "close"):
+    if kind in ("open", "push", "close"):
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         sign = "-" if kind == "close" else ""
         src += f'''REWARD_MAX = 4.0
@@ -74,9 +64,7 @@ OPEN_FRACTION = {frac}
 
 
 def evaluate(env):
-{fail}    opened = env.joint_open_fraction({obj!r})
-    success = ({sign}opened >= {"-" if sign else ""}OPEN_FRACTION) & ~fail
-    return {{"success": success, "fail": fail, "open_fraction": opened}}
+{fail}    return {{"fail": fail, "open_fraction": env.joint_open_fraction({obj!r})}}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -92,14 +80,13 @@ def _get_obs_extra(env, info):
             "open_fraction": info["open_fraction"][:, None]}}
 '''
         return src
-    held = _HELD.format(obj=obj)
     if kind == "grasp":
         src += f'''REWARD_MAX = 4.0
 
 
 def evaluate(env):
-{fail}{held}    success = held & ~fail
-    return {{"success": success, "fail": fail, "contact": rt.contact(force)}}
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    return {{"fail": fail, "contact": rt.contact(force)}}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -122,9 +109,8 @@ LIFT_M = {h}
 
 
 def evaluate(env):
-{fail}{held}    height = env.obj_height({obj!r})
-    success = held & (height >= LIFT_M) & ~fail
-    return {{"success": success, "fail": fail, "height": height, "contact": rt.contact(force)}}
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    return {{"fail": fail, "height": env.obj_height({obj!r}), "contact": rt.contact(force)}}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -136,16 +122,15 @@ def _get_obs_extra(env, info):
     return {{"height": info["height"][:, None], "palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p}}
 '''
         return src
-    # move / release: bring the held object to the success condition's target, then let go
+    # carry / place / release: bring the held object to the success condition's target, then let go
     target = cond.get("target") or obj
     release = kind == "release"
     src += f'''REWARD_MAX = 3.0
 
 
 def evaluate(env):
-{fail}{held}    placed = env.spec_success()
-    success = placed {"& ~held " if release else ""}& ~fail
-    return {{"success": success, "fail": fail, "contact": rt.contact(force)}}
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    return {{"fail": fail, "contact": rt.contact(force)}}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -161,7 +146,7 @@ def _get_obs_extra(env, info):
 
 
 def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
-    """Reward module of the whole task (``reward.py``): staged terms towards the task's success condition."""
+    """Reward module of the whole task: staged terms towards the task's success condition."""
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
@@ -172,8 +157,7 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
 
 
 def evaluate(env):
-{fail}    success = env.spec_success() & ~fail
-    return {{"success": success, "fail": fail, "open_fraction": env.joint_open_fraction({obj!r})}}
+{fail}    return {{"fail": fail, "open_fraction": env.joint_open_fraction({obj!r})}}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -194,8 +178,7 @@ LIFT_M = 0.1
 
 
 def evaluate(env):
-{fail}    success = env.spec_success() & ~fail
-    return {{"success": success, "fail": fail, "height": env.obj_height({obj!r})}}
+{fail}    return {{"fail": fail, "height": env.obj_height({obj!r})}}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Set up (if needed) and run the test suite. Extra arguments go to pytest.
-#   scripts/test.sh            fast + physics tests (what CI runs)
+#   scripts/test.sh            lint (ruff) + fast and physics tests (what CI runs)
 #   scripts/test.sh --slow     also the slow checks (marker "slow")
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -11,4 +11,5 @@ marker="not slow and not gpu"
 for a in "$@"; do
   if [ "$a" = "--slow" ]; then marker="not gpu"; else args+=("$a"); fi
 done
+"$ROOT/.venv/bin/ruff" check "$ROOT"
 exec "$ROOT/.venv/bin/python" -m pytest -m "$marker" "${args[@]}"

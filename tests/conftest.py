@@ -1,15 +1,56 @@
-"""Shared fixtures. Sim tests run ManiSkill on the CPU (physx_cpu, num_envs=1)."""
+"""Shared fixtures. Sim tests run ManiSkill on the CPU (physx_cpu, num_envs=1).
+
+Tests reach committed tasks only through :func:`task_version` (a registered version by name) or :func:`task_copy`
+(a private copy under a scratch task root, registered for the test and unregistered after it).
+"""
 
 from __future__ import annotations
 
 import logging
+import shutil
+from pathlib import Path
 
 import gymnasium as gym
 import pytest
 
 import gendex_envs  # noqa: F401  (registers the GenDex tasks)
+from gendex_envs.registry import register_tasks, resolve_task, unregister_tasks
+from gendex_envs.task_version import NAMESPACE, TaskLayout, TaskVersion
 
 logging.getLogger("gymnasium_robotics").setLevel(logging.ERROR)
+
+
+@pytest.fixture(scope="session")
+def task_version():
+    """``task_version("PutAppleBowl")`` (highest version) or ``task_version("PutAppleBowl", 0)``: a committed task."""
+
+    def get(name: str, version: int | None = None) -> TaskVersion:
+        return resolve_task(name if version is None else f"{NAMESPACE}/{name}-v{version}")
+
+    return get
+
+
+@pytest.fixture
+def task_copy(tmp_path):
+    """``task_copy("PutAppleBowl", as_name="ScratchApple", version=3)``: a copy of a committed task version under a
+    scratch task root (``tmp_path/tasks``), registered with Gymnasium; its ids are removed afterwards."""
+    made: list[str] = []
+
+    def copy(name: str, as_name: str | None = None, version: int = 0, register: bool = True) -> TaskVersion:
+        source = resolve_task(name)
+        new_name = as_name or name
+        folder = tmp_path / "tasks" / new_name / f"v{version}"
+        shutil.copytree(source.root, folder, ignore=shutil.ignore_patterns("__pycache__"))
+        if new_name != source.name:
+            spec = TaskLayout(folder).spec
+            spec.write_text(spec.read_text().replace(f"name: {source.name}\n", f"name: {new_name}\n"))
+        copied = TaskVersion.at(folder)
+        if register:
+            made.extend(register_tasks([folder.parent.parent], override=True))
+        return copied
+
+    yield copy
+    unregister_tasks(made)
 
 
 @pytest.fixture
@@ -25,3 +66,9 @@ def make_env():
     yield _make
     for env in made:
         env.close()
+
+
+@pytest.fixture(scope="session")
+def repo_root() -> Path:
+    """The repository (for tests of its own files: docs, benchmarks, the source tree)."""
+    return Path(__file__).resolve().parent.parent

@@ -15,6 +15,8 @@ import numpy as np
 import torch
 from mani_skill.utils.structs import Actor, Link
 
+from gendex_envs.physx import px_bodies
+
 
 class ContactTable:
     """Net and pairwise contact impulses [N, 3] (N·s) on a fixed set of bodies (e.g. a robot's links).
@@ -61,7 +63,7 @@ class ContactTable:
         """PhysX entity id of a (CPU, single-env) body, memoised per wrapper object."""
         hit = self._keys.get(id(body))
         if hit is None:
-            hit = self._keys[id(body)] = (body, body._bodies[0].entity.per_scene_id)
+            hit = self._keys[id(body)] = (body, px_bodies(body)[0].entity.per_scene_id)
         return hit[1]
 
     def _check(self, bodies: list[Actor | Link]) -> None:

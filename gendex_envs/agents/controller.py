@@ -17,6 +17,7 @@ from mani_skill.agents.controllers.pd_joint_pos import PDJointPosController, PDJ
 from mani_skill.utils.structs.types import Array
 
 from gendex_envs.errors import ControlModeError
+from gendex_envs.physx import px_objects
 
 
 class FreezingJointPosController(PDJointPosController):
@@ -44,13 +45,13 @@ class FreezingJointPosController(PDJointPosController):
         self.free_joint_names = tuple(free)
         self._qlimits = self.articulation.get_qlimits()[0, self.active_joint_indices].to(device)
         """[J, 2] limits of every driven joint."""
-        self._px_joints = [joint._objs[0] for joint in self.joints]
+        self._px_joints = [px_objects(joint)[0] for joint in self.joints]
 
     def set_drive_targets(self, targets: torch.Tensor):
         if self.scene.gpu_sim_enabled:
             return super().set_drive_targets(targets)
         # CPU (one env): straight to the PhysX joints; ManiSkill's per-joint wrapper costs ~5 us a joint
-        for joint, target in zip(self._px_joints, targets[0].tolist()):
+        for joint, target in zip(self._px_joints, targets[0].tolist(), strict=True):
             joint.set_drive_target(target)
 
     def _get_joint_limits(self) -> np.ndarray:
@@ -81,6 +82,16 @@ class FreezingJointPosController(PDJointPosController):
             self._step_size = (self._target_qpos - self._start_qpos) / self._sim_steps
         else:
             self.set_drive_targets(self._target_qpos)
+
+    @property
+    def target_qpos(self) -> torch.Tensor:
+        """[N, J] a copy of the current drive targets of every joint (free, frozen and coupled), in
+        ``config.joint_names`` order."""
+        return self._target_qpos.clone()
+
+    def free_targets(self) -> torch.Tensor:
+        """[N, F] a copy of the current drive targets of the joints the action drives."""
+        return self._target_qpos[:, self.free_idx].clone()
 
     def joint_indices(self, names: Sequence[str]) -> torch.Tensor:
         """[K] positions of joints ``names`` in this controller's ``joint_names``."""

@@ -170,7 +170,7 @@ def ur10e_urdf_links(arm_rgba: str = "0.72 0.74 0.78 1") -> tuple[list[str], lis
 
 def shadow_hand_mjcf_path() -> Path:
     """The ShadowHand scene MJCF shipped by gymnasium-robotics (includes robot.xml, shared.xml, meshes)."""
-    import gymnasium_robotics  # noqa: PLC0415  (heavy; only needed when building)
+    import gymnasium_robotics
 
     return Path(gymnasium_robotics.__file__).parent / "envs" / "assets" / "hand" / "reach.xml"
 
@@ -188,7 +188,7 @@ def shadow_hand_urdf_links(mesh_dir: Path) -> tuple[list[str], list[str]]:
 
     Writes the compiled visual/collision meshes as OBJ files into ``mesh_dir``.
     """
-    import mujoco  # noqa: PLC0415
+    import mujoco
 
     model = mujoco.MjModel.from_xml_path(str(shadow_hand_mjcf_path()))
     root = model.body(HAND_ROOT_BODY).id
@@ -292,7 +292,7 @@ def cache_root() -> Path:
 
 
 def _source_key() -> str:
-    from importlib.metadata import version  # noqa: PLC0415
+    from importlib.metadata import version
 
     text = f"{BUILDER_VERSION}|{version('mujoco')}|{version('gymnasium-robotics')}|{Path(__file__).read_bytes()!r}"
     return hashlib.sha256(text.encode()).hexdigest()[:12]

@@ -39,6 +39,7 @@ from gendex_envs.agents.controller import FreezingJointPosControllerConfig
 from gendex_envs.agents.robot_model import robot_urdf_path
 from gendex_envs.errors import ControlModeError
 from gendex_envs.geometry import quat_rotate
+from gendex_envs.physx import px_objects
 
 log = logging.getLogger(__name__)
 
@@ -132,9 +133,9 @@ _CUPPED_HAND = _OPEN_HAND | {"FFJ2": 0.25, "FFJ1": 0.2, "FFJ0": 0.2, "MFJ2": 0.2
                             "LFJ0": 0.2, "THJ4": 1.0, "THJ3": 0.2}
 """Fingers a little flexed, little-finger metacarpal cupped and thumb abducted: a shallow bowl a ball rests in."""
 KEYFRAME_QPOS_BY_NAME: dict[str, dict[str, float]] = {
-    "rest": dict(zip(ARM_JOINTS, _REST_ARM)) | _RELAXED_HAND,
-    "pregrasp_open": dict(zip(ARM_JOINTS, _REST_ARM)) | _OPEN_HAND | {"THJ4": 1.0, "THJ3": 0.2},
-    "palm_up": dict(zip(ARM_JOINTS, _PALM_UP_ARM)) | _CUPPED_HAND,
+    "rest": dict(zip(ARM_JOINTS, _REST_ARM, strict=True)) | _RELAXED_HAND,
+    "pregrasp_open": dict(zip(ARM_JOINTS, _REST_ARM, strict=True)) | _OPEN_HAND | {"THJ4": 1.0, "THJ3": 0.2},
+    "palm_up": dict(zip(ARM_JOINTS, _PALM_UP_ARM, strict=True)) | _CUPPED_HAND,
 }
 
 
@@ -174,7 +175,7 @@ class UR10eShadowHand(BaseAgent):
     # ------------------------------------------------------------------ loading
     def _after_loading_articulation(self):
         for link in self.robot.get_links():
-            for obj in link._objs:
+            for obj in px_objects(link):
                 obj.disable_gravity = True
                 for shape in obj.collision_shapes:
                     groups = shape.get_collision_groups()
@@ -188,7 +189,7 @@ class UR10eShadowHand(BaseAgent):
         }
         self._tip_offsets = torch.tensor(TIP_OFFSETS_M, dtype=torch.float32, device=self.device)
         self._tip_offsets_np = np.asarray(TIP_OFFSETS_M, dtype=np.float32)
-        self._px_tip_links = [link._objs[0] for link in self.tip_links]
+        self._px_tip_links = [px_objects(link)[0] for link in self.tip_links]
         self._group_link_list = [link for links in self.group_links.values() for link in links]
         self._group_index = torch.tensor([g for g, links in enumerate(self.group_links.values()) for _ in links],
                                          device=self.device)

@@ -92,7 +92,8 @@ class Shape:
 
 def box(lo: Vec3, hi: Vec3, rgba: RGBA) -> Shape:
     """Axis-aligned box between corners ``lo`` and ``hi``."""
-    return Shape("box", tuple((a + b) / 2 for a, b in zip(lo, hi)), tuple(b - a for a, b in zip(lo, hi)), "z", rgba)
+    centre = tuple((a + b) / 2 for a, b in zip(lo, hi, strict=True))
+    return Shape("box", centre, tuple(b - a for a, b in zip(lo, hi, strict=True)), "z", rgba)
 
 
 def cyl(centre: Vec3, radius: float, length: float, axis: Literal["x", "y", "z"], rgba: RGBA) -> Shape:
@@ -127,12 +128,12 @@ class Link:
         vols = [s.size[0] * s.size[1] * s.size[2] if s.kind == "box" else
                 math.pi * s.size[0] ** 2 * s.size[1] if s.kind == "cylinder" else 4 / 3 * math.pi * s.size[0] ** 3
                 for s in self.shapes]
-        return tuple(sum(v * s.centre[i] for v, s in zip(vols, self.shapes)) / sum(vols) for i in range(3))
+        return tuple(sum(v * s.centre[i] for v, s in zip(vols, self.shapes, strict=True)) / sum(vols) for i in range(3))
 
     def inertial_xml(self) -> str:
         lo, hi = bounds(self.shapes)
         c = self.com if self.com is not None else self.centroid()
-        sx, sy, sz = (b - a for a, b in zip(lo, hi))
+        sx, sy, sz = (b - a for a, b in zip(lo, hi, strict=True))
         m = self.mass
         ixx, iyy, izz = m * (sy * sy + sz * sz) / 12, m * (sx * sx + sz * sz) / 12, m * (sx * sx + sy * sy) / 12
         return (f'  <inertial>\n   <origin xyz="{_v(c)}" rpy="0 0 0"/>\n   <mass value="{_f(m)}"/>\n'
@@ -181,12 +182,13 @@ class Model:
         for j in self.joints:
             if j.child == name:
                 p = self.link_origin(j.parent)
-                return tuple(a + b for a, b in zip(p, j.origin))
+                return tuple(a + b for a, b in zip(p, j.origin, strict=True))
         return (0.0, 0.0, 0.0)
 
     def bounds(self) -> tuple[Vec3, Vec3]:
         """Bounds of all collision shapes at qpos 0 (the closed pose), asset frame."""
-        shapes = [Shape(s.kind, tuple(a + b for a, b in zip(s.centre, self.link_origin(link.name))), s.size, s.axis)
+        shapes = [Shape(s.kind, tuple(a + b for a, b in zip(s.centre, self.link_origin(link.name), strict=True)),
+                        s.size, s.axis)
                   for link in self.links for s in link.shapes]
         return bounds(shapes)
 

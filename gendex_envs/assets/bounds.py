@@ -7,6 +7,8 @@ import sapien
 from mani_skill.utils.structs import Articulation
 from sapien import physx
 
+from gendex_envs.physx import px_bodies, px_objects
+
 _RING = np.stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
                   np.sin(np.linspace(0, 2 * np.pi, 16, endpoint=False))], axis=1)  # [16, 2]
 
@@ -45,9 +47,9 @@ def body_points(body_pose: sapien.Pose, shapes) -> np.ndarray:
 def entity_aabb(entity) -> tuple[np.ndarray, np.ndarray]:
     """World AABB (min [3], max [3]) of a ManiSkill Actor or Articulation (first sub-scene)."""
     if isinstance(entity, Articulation):
-        bodies = [link._objs[0] for link in entity.get_links()]
+        bodies = [px_objects(link)[0] for link in entity.get_links()]
         pts = np.concatenate([body_points(b.entity_pose, b.collision_shapes) for b in bodies])
     else:
-        body = entity._bodies[0]
+        body = px_bodies(entity)[0]
         pts = body_points(body.entity.pose, body.collision_shapes)
     return pts.min(axis=0), pts.max(axis=0)

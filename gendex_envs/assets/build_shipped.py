@@ -1,4 +1,4 @@
-"""Import licence-clean textured meshes that ship inside installed packages: ``python -m gendex_envs.assets.build_shipped``.
+"""Import licence-clean textured meshes shipped in installed packages (`python -m gendex_envs.assets.build_shipped`).
 
 Each source mesh is turned into the GenDex asset frame (z up, origin at the bottom centre), scaled to its real-world
 size, and written as ``<id>/visual.glb`` (textures kept) plus ``<id>/collision.obj`` (its convex hull: only convex-ish
@@ -58,7 +58,7 @@ The conversion (rotation to z up, uniform scaling to real size, convex-hull coll
 
 
 def _source_file(src: ShippedMesh) -> Path:
-    import importlib  # noqa: PLC0415
+    import importlib
 
     return Path(importlib.import_module(src.package).__file__).parent / src.path
 
@@ -70,13 +70,15 @@ def convert(src: ShippedMesh, out: Path) -> AssetEntry:
     lo, hi = scene.bounds
     scale = src.size_m / (hi - lo)[src.size_axis]
     centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]])
-    scene.apply_transform(trimesh.transformations.scale_matrix(scale) @ trimesh.transformations.translation_matrix(-centre))
+    tf = trimesh.transformations
+    scene.apply_transform(tf.scale_matrix(scale) @ tf.translation_matrix(-centre))
     folder = out / src.id
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "visual.glb").write_bytes(scene.export(file_type="glb"))
     hull = scene.to_geometry().convex_hull
     hull.vertices = np.round(hull.vertices, 6)
-    (folder / "collision.obj").write_text(f"# convex hull of {src.package}/{src.path}\n" + _obj_block(hull, "hull_0", 1))
+    header = f"# convex hull of {src.package}/{src.path}\n"
+    (folder / "collision.obj").write_text(header + _obj_block(hull, "hull_0", 1))
     lo, hi = scene.bounds
     return AssetEntry(
         id=src.id, category=src.category, kind="rigid", source=f"{src.package} package: {src.path}",

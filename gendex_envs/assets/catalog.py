@@ -140,7 +140,7 @@ class AssetRecord:
 @functools.lru_cache(maxsize=1)
 def catalog() -> dict[str, AssetRecord]:
     """Every known asset by id: shipped manifests, then user datasets found on disk (ids must be unique)."""
-    from gendex_envs.assets.user_datasets import user_dataset_entries  # noqa: PLC0415
+    from gendex_envs.assets.user_datasets import user_dataset_entries
 
     records: dict[str, AssetRecord] = {}
 

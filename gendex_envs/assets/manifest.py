@@ -93,7 +93,7 @@ class AssetEntry:
 
     @property
     def size_m(self) -> tuple[float, float, float]:
-        return tuple(float(b - a) for a, b in zip(self.bbox_min_m, self.bbox_max_m))
+        return tuple(float(b - a) for a, b in zip(self.bbox_min_m, self.bbox_max_m, strict=True))
 
 
 _CONFIG = dacite.Config(strict=True, cast=[tuple])

@@ -126,7 +126,7 @@ def finish(parts: Parts, *, id: str, category: str, tags, mass_kg: float, fricti
         hulls.append(hull)
     out = {k: (round(v, DECIMALS) if isinstance(v, float) else v) for k, v in (params or {}).items()}
     for name, p in parts.anchors.items():
-        for axis, value in zip("xyz", _round(p + offset)):
+        for axis, value in zip("xyz", _round(p + offset), strict=True):
             out[f"{name}_{axis}"] = float(value)
     return ProceduralShape(id=id, category=category, tags=tuple(tags), mass_kg=float(mass_kg),
                            friction=float(friction), rgba=tuple(float(c) for c in rgba), visual=visual,
@@ -267,7 +267,7 @@ def revolved_solid(profile, splits=(), sections: int = 48, hull_sections: int = 
     cuts = [0, *splits, len(prof) - 1]
     angles = 2 * np.pi * np.arange(hull_sections) / hull_sections
     hulls = []
-    for a, b in zip(cuts[:-1], cuts[1:]):
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         band = prof[a:b + 1]
         axis = np.array([[0.0, band[0, 1]], [0.0, band[-1, 1]]])
         hulls.append(revolve_pts(np.vstack([band, axis]), angles))
@@ -340,7 +340,7 @@ def vessel(outer, wall: float, floor: float, *, wall_from: int = 1, groups: int 
             hulls.append(revolve_pts(seg, ang))
     # one probe point per profile segment: the wall's mid-surface half-way between the segment's end ribs
     seals = [(out_p[ribs[a]] + inner[ribs[a]] + out_p[ribs[b]] + inner[ribs[b]]) / 4
-             for a, b in zip(bounds[:-1], bounds[1:])]
+             for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
     info = {"floor_z": float(floor), "top_z": float(out_p[-1, 1]), "seals": seals}
     return visual, hulls, info
 

@@ -12,10 +12,29 @@ from collections.abc import Callable
 
 import numpy as np
 
-from gendex_envs.assets.procedural import (SOURCE_PRIMITIVES, SOURCE_REVOLVE, SOURCE_TUBE, Parts,
-                                           ProceduralShape, box_pts, cyl_between, ellipsoid_pts, finish,
-                                           hull_mesh, prism_pts, revolve_mesh, revolve_pts, revolved_solid,
-                                           ring_hulls, rng_for, rot, rounded_box_pts, tube, vessel, wobble)
+from gendex_envs.assets.procedural import (
+    SOURCE_PRIMITIVES,
+    SOURCE_REVOLVE,
+    SOURCE_TUBE,
+    Parts,
+    ProceduralShape,
+    box_pts,
+    cyl_between,
+    ellipsoid_pts,
+    finish,
+    hull_mesh,
+    prism_pts,
+    revolve_mesh,
+    revolve_pts,
+    revolved_solid,
+    ring_hulls,
+    rng_for,
+    rot,
+    rounded_box_pts,
+    tube,
+    vessel,
+    wobble,
+)
 
 CM = np.diag([0.01, 0.01, 0.01, 1.0])
 
@@ -70,7 +89,7 @@ def _fruit(asset_id, profile, mass, rgba, amp, splits=(), stem=None, friction=0.
     vis.vertices = warp(vis.vertices)
     cuts = [0, *splits, len(profile) - 1]
     hulls = []
-    for a, b in zip(cuts[:-1], cuts[1:]):
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         idx = set(np.linspace(a, b, min(b - a + 1, 7)).round().astype(int))
         z_off_axis = np.where(profile[a:b + 1, 0] > 0, profile[a:b + 1, 1], np.inf)
         idx |= {a + int(np.argmin(z_off_axis)), a + int(np.argmax(profile[a:b + 1, 0]))}  # lowest ring, equator

@@ -52,7 +52,7 @@ def build_content(request: ModelRequest) -> list[dict[str, Any]]:
     blocks: list[dict[str, Any]] = []
     for im in request.images:
         if not im.png.startswith(PNG_MAGIC):
-            raise BackendError(f"image {im.name!r} of the {request.stage} request is not a PNG "
+            raise BackendError(f"image {im.name!r} of the {request.step} request is not a PNG "
                                f"(starts with {im.png[:8]!r}); the anthropic backend sends images as image/png")
         blocks.append({"type": "text", "text": f"View: {im.name}"})
         blocks.append({"type": "image", "source": {"type": "base64", "media_type": "image/png", "data": im.b64()}})
@@ -123,24 +123,24 @@ class AnthropicBackend:
             except anthropic.APIConnectionError as err:  # includes APITimeoutError
                 last, wait = err, None
             except anthropic.AnthropicError as err:
-                raise BackendError(f"anthropic backend, stage {request.stage}, model {self.model!r}: "
+                raise BackendError(f"anthropic backend, step {request.step}, model {self.model!r}: "
                                    f"{type(err).__name__}: {err}") from err
             else:
                 return self._response(message, request, time.monotonic() - t0)
             if attempt + 1 >= attempts:
                 raise BackendError(
-                    f"anthropic backend: the {request.stage} request to model {self.model!r} failed after {attempts} "
+                    f"anthropic backend: the {request.step} request to model {self.model!r} failed after {attempts} "
                     f"attempt(s) (max_retries={self.max_retries}); last error: {_describe(last)}") from last
             if wait is None:
                 wait = min(self._backoff_s * 2.0 ** attempt, self._max_backoff_s)
-            log.warning("anthropic %s request (model %s) failed: %s; retry %d/%d in %.1f s", request.stage,
+            log.warning("anthropic %s request (model %s) failed: %s; retry %d/%d in %.1f s", request.step,
                         self.model, _describe(last), attempt + 1, self.max_retries, wait)
             self._sleep(wait)
         raise AssertionError("unreachable")  # pragma: no cover
 
     def _status_message(self, err: anthropic.APIStatusError, request: ModelRequest) -> str:
         what = err.api_message or str(err)
-        msg = (f"Anthropic API answered {err.status_code} ({err.type or 'error'}) to the {request.stage} request "
+        msg = (f"Anthropic API answered {err.status_code} ({err.type or 'error'}) to the {request.step} request "
                f"for model {self.model!r}: {what}")
         if err.status_code == 401:
             msg += f"; check {API_KEY_ENV} (or use --backend offline)"
@@ -153,10 +153,10 @@ class AnthropicBackend:
         texts = [block.text for block in content if getattr(block, "type", None) == "text"]
         stop = getattr(message, "stop_reason", None)
         if not texts:
-            raise BackendError(f"anthropic backend: the {request.stage} reply of model {self.model!r} holds no text "
+            raise BackendError(f"anthropic backend: the {request.step} reply of model {self.model!r} holds no text "
                                f"(stop_reason={stop!r}, blocks={[getattr(b, 'type', '?') for b in content]})")
         if stop == "max_tokens":
-            log.warning("anthropic %s reply was cut at max_tokens=%d; the answer may be incomplete", request.stage,
+            log.warning("anthropic %s reply was cut at max_tokens=%d; the answer may be incomplete", request.step,
                         request.max_tokens)
         usage: dict[str, int] = {}
         raw_usage = getattr(message, "usage", None)
@@ -165,7 +165,7 @@ class AnthropicBackend:
             if isinstance(value, int):
                 usage[field] = value
         model = getattr(message, "model", None) or self.model
-        log.info("anthropic %s: model %s, %d image(s), %s in / %s out tokens, %.1f s", request.stage, model,
+        log.info("anthropic %s: model %s, %d image(s), %s in / %s out tokens, %.1f s", request.step, model,
                  len(request.images), usage.get("input_tokens", "?"), usage.get("output_tokens", "?"), elapsed_s)
         return ModelResponse(text="".join(texts), backend=self.name, model=model, usage=usage)
 

@@ -1,6 +1,6 @@
 """The backend interface: a :class:`ModelRequest` (text, optional images) in, a :class:`ModelResponse` out.
 
-Stages render a prompt template into ``prompt`` and put the typed inputs the prompt was made from into
+Pipeline steps render a prompt template into ``prompt`` and put the typed inputs the prompt was made from into
 ``context`` (JSON-able). Language-model backends send ``system``, ``prompt`` and ``images`` and ignore ``context``;
 the offline backend answers from ``context`` alone. Both answer in the same text format, so every answer goes
 through the same parser and validator.
@@ -14,8 +14,8 @@ import json
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
-STAGES = ("propose", "propose_guided", "scene", "analyze", "plan", "reward")
-"""Request kinds; the offline backend dispatches on them, transcripts record them."""
+STEPS = ("propose", "propose_guided", "scene", "analyze", "plan", "reward")
+"""Request kinds (the pipeline step asking); the offline backend dispatches on them, transcripts record them."""
 
 
 @dataclass(frozen=True)
@@ -37,8 +37,8 @@ class ImagePart:
 class ModelRequest:
     """One request to a backend."""
 
-    stage: str
-    """One of STAGES."""
+    step: str
+    """The pipeline step asking; one of STEPS."""
     prompt: str
     """The rendered user prompt."""
     system: str = ""
@@ -49,13 +49,13 @@ class ModelRequest:
     """Structured inputs the prompt was rendered from (JSON-able); used by the offline backend only."""
 
     def __post_init__(self) -> None:
-        if self.stage not in STAGES:
-            raise ValueError(f"unknown request stage {self.stage!r}; allowed: {', '.join(STAGES)}")
+        if self.step not in STEPS:
+            raise ValueError(f"unknown request step {self.step!r}; allowed: {', '.join(STEPS)}")
 
     def digest(self) -> str:
         """SHA-256 over everything that defines the request (replay checks it)."""
         h = hashlib.sha256()
-        head = {"stage": self.stage, "system": self.system, "prompt": self.prompt, "temperature": self.temperature,
+        head = {"step": self.step, "system": self.system, "prompt": self.prompt, "temperature": self.temperature,
                 "max_tokens": self.max_tokens, "context": self.context}
         h.update(json.dumps(head, sort_keys=True, default=str).encode())
         for im in self.images:
@@ -70,7 +70,7 @@ class ModelRequest:
         was hashed. The record cannot be turned back into a request (the image bytes are not in it).
         """
         return {
-            "stage": self.stage,
+            "step": self.step,
             "system": self.system,
             "prompt": self.prompt,
             "temperature": self.temperature,

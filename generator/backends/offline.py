@@ -15,7 +15,8 @@ validators as a model's:
     a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1. It checks
     nothing on purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
 ``plan``
-    one stage per proposal step (approach / move -> motion planning; finger and contact work -> RL).
+    one stage per proposal step, with its skill (reach / carry -> motion planning; finger and contact work -> RL);
+    the plan step adds the standard success conditions of each RL stage's skill.
 ``reward``
     modules composed from the vetted terms of :mod:`gendex_envs.reward_terms` (see
     :mod:`generator.reward_library`).
@@ -53,8 +54,8 @@ def _w(name: str) -> str:
     return name.replace("_", " ")
 
 
-def _step(action: str, target: str, control_joint: str, instruction: str) -> dict:
-    return {"action": action, "target": target, "control_joint": control_joint, "instruction": instruction}
+def _step(skill: str, target: str, control_joint: str, instruction: str) -> dict:
+    return {"skill": skill, "target": target, "control_joint": control_joint, "instruction": instruction}
 
 
 def _fence(lang: str, body: str) -> str:
@@ -107,12 +108,12 @@ class OfflineBackend:
         self.seed = int(seed)
 
     def _rng(self, request: ModelRequest, *keys: int) -> np.random.Generator:
-        return np.random.default_rng([self.seed, *(int(k) for k in keys), len(request.stage)])
+        return np.random.default_rng([self.seed, *(int(k) for k in keys), len(request.step)])
 
     def complete(self, request: ModelRequest) -> ModelResponse:
-        handler = getattr(self, "_" + request.stage, None)
+        handler = getattr(self, "_" + request.step, None)
         if handler is None:
-            raise BackendError(f"the offline backend cannot answer {request.stage!r} requests (it sees no images)")
+            raise BackendError(f"the offline backend cannot answer {request.step!r} requests (it sees no images)")
         return ModelResponse(text=handler(request, request.context), backend=self.name, model=self.model)
 
     # ------------------------------------------------------------------ proposals
@@ -146,7 +147,7 @@ class OfflineBackend:
             "name": _camel("lift", a["id"]), "description": f"Grasp the {_w(n)} and lift it off the table.",
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [
-                _step("approach", n, "arm", f"Bring the open hand to the {_w(n)}."),
+                _step("reach", n, "arm", f"Bring the open hand to the {_w(n)}."),
                 _step("grasp", n, "hand", f"Close the fingers around the {_w(n)}."),
                 _step("lift", n, "lift_inspire", f"Lift the {_w(n)} 10 cm."),
             ],
@@ -158,9 +159,9 @@ class OfflineBackend:
     @staticmethod
     def _carry_steps(n: str, t: str, where: str) -> list[dict]:
         return [
-            _step("approach", n, "arm", f"Bring the open hand to the {_w(n)}."),
+            _step("reach", n, "arm", f"Bring the open hand to the {_w(n)}."),
             _step("grasp", n, "hand", f"Close the fingers around the {_w(n)}."),
-            _step("move", t, "arm", f"Carry the {_w(n)} {where} the {_w(t)}."),
+            _step("carry", t, "arm", f"Carry the {_w(n)} {where} the {_w(t)}."),
             _step("release", n, "hand", f"Open the hand to let go of the {_w(n)}."),
         ]
 
@@ -197,9 +198,9 @@ class OfflineBackend:
             "name": _camel("open", a["id"]), "description": f"Open the {_w(n)}'s {part} by its handle.",
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": [
-                _step("approach", n, "arm", f"Bring the open hand to the {part} handle."),
+                _step("reach", n, "arm", f"Bring the open hand to the {part} handle."),
                 _step("grasp", n, "hand", "Hook the fingers around the handle."),
-                _step("pull", n, "both", f"Pull the {part} open along its path."),
+                _step("open", n, "both", f"Pull the {part} open along its path."),
             ],
             "success": {"type": "joint_open", "object": n, "target": None, "min_height_m": None, "min_fraction": 0.8,
                         "max_dist_m": None},
@@ -219,7 +220,7 @@ class OfflineBackend:
         subs: dict[str, str] = {}
 
         def pick(pred, fallback_words) -> dict | None:
-            for word, a in mentioned:  # an object the person named is used whenever it can play the role
+            for _word, a in mentioned:  # an object the person named is used whenever it can play the role
                 if pred(a) or (pred is graspable and "graspable" in a["tags"] and not a.get("joints")
                                and not container(a)):
                     return a
@@ -297,10 +298,10 @@ class OfflineBackend:
             objects.append(entry)
         stages = []
         for i, s in enumerate(proposal["steps"]):
-            method = "motion_planning" if s["action"] in ("approach", "move") else "RL"
-            repeated = i > 0 and s["action"] == proposal["steps"][i - 1]["action"]
-            stages.append({"name": f"{s['action']}_{s['target']}" + (f"_{i}" if repeated else ""),
-                           "instruction": s["instruction"], "method": method,
+            method = "motion_planning" if s["skill"] in ("reach", "carry") else "RL"
+            repeated = i > 0 and s["skill"] == proposal["steps"][i - 1]["skill"]
+            stages.append({"name": f"{s['skill']}_{s['target']}" + (f"_{i}" if repeated else ""),
+                           "instruction": s["instruction"], "skill": s["skill"], "method": method,
                            "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
                            "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})
         cond = {k: v for k, v in proposal["success"].items() if v is not None}
@@ -310,25 +311,22 @@ class OfflineBackend:
         return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
 
     # ------------------------------------------------------------------ plan
-    _PLAN = {"approach": ("motion_planning", "arm", 60), "move": ("motion_planning", "arm", 60),
+    _PLAN = {"reach": ("motion_planning", "arm", 60), "carry": ("motion_planning", "arm", 60),
              "grasp": ("RL", "hand", 40), "lift": ("RL", "lift_inspire", 40), "release": ("RL", "hand", 20),
-             "pull": ("RL", "both", 80), "open": ("RL", "both", 80), "close": ("RL", "both", 80),
-             "push": ("RL", "both", 60)}
+             "open": ("RL", "both", 80), "close": ("RL", "both", 80), "push": ("RL", "both", 60)}
 
     def _plan(self, request: ModelRequest, ctx: dict) -> str:
-        spec = ctx["spec"]
-        steps = ctx["proposal"]["steps"]
         out = []
-        for i, s in enumerate(spec["stages"]):
-            action = steps[i]["action"] if len(steps) == len(spec["stages"]) else s["name"].split("_")[0]
-            method, joint, horizon = self._PLAN.get(action, (s["method"], s["control_joint"], s.get("horizon", 60)))
-            out.append({"name": s["name"], "instruction": s["instruction"], "method": method,
+        for s in ctx["spec"]["stages"]:
+            method, joint, horizon = self._PLAN.get(s["skill"], (s["method"], s["control_joint"],
+                                                                 s.get("horizon", 60)))
+            out.append({"name": s["name"], "instruction": s["instruction"], "skill": s["skill"], "method": method,
                         "control_joint": joint, "horizon": horizon, "target": s.get("target")})
         return _fence("yaml", yaml.safe_dump(out, sort_keys=False, width=110))
 
     # ------------------------------------------------------------------ reward
     def _reward(self, request: ModelRequest, ctx: dict) -> str:
-        from generator.reward_library import compose_stage_module, compose_task_module  # noqa: PLC0415
+        from generator.reward_library import compose_stage_module, compose_task_module
 
         if ctx.get("stage") is None:
             return _fence("python", compose_task_module(ctx["spec"], ctx["roles"]))

@@ -3,10 +3,10 @@
 A transcript is one JSON object per line, appended and flushed exchange by exchange (a crashed run keeps what it
 got). The first line is a header describing the recorded backend, so a replay takes the same pipeline branches::
 
-    {"header": {"format": "gendex-transcript", "version": 1, "backend": "anthropic", "model": "...",
+    {"header": {"format": "gendex-transcript", "version": 2, "backend": "anthropic", "model": "...",
                 "sees_images": true, "is_language_model": true}}
-    {"index": 0, "stage": "propose", "digest": "<ModelRequest.digest()>",
-     "request": {"stage", "system", "prompt", "temperature", "max_tokens", "context",
+    {"index": 0, "step": "propose", "digest": "<ModelRequest.digest()>",
+     "request": {"step", "system", "prompt", "temperature", "max_tokens", "context",
                  "images": [{"name", "sha256", "bytes"}]},
      "response": {"text", "backend", "model", "usage"}}
 
@@ -15,7 +15,7 @@ Images are stored by SHA-256, not inline; the digest covers them. An exchange wh
 replays as the same error, so a pipeline that retried after a failed call makes the same calls on replay.
 
 Replay is strict: the request at position ``i`` must have the digest recorded at ``i``, else
-:class:`~generator.errors.TranscriptMismatchError` names the index, the stage and which fields differ.
+:class:`~generator.errors.TranscriptMismatchError` names the index, the step and which fields differ.
 """
 
 from __future__ import annotations
@@ -32,7 +32,9 @@ from generator.errors import BackendError, TranscriptMismatchError
 log = logging.getLogger(__name__)
 
 FORMAT = "gendex-transcript"
-VERSION = 1
+VERSION = 2
+"""Transcript format; 2 names the asking pipeline step ``step`` (1 said ``stage``), so version 1 transcripts,
+recorded by an older generator with other prompts, document how a task was made but do not replay."""
 _HINT_CHARS = 40
 
 
@@ -87,7 +89,7 @@ class RecordingBackend:
 
     def _append(self, request: ModelRequest, outcome: dict[str, Any]) -> None:
         with self._lock:
-            line = {"index": self._count, "stage": request.stage, "digest": request.digest(),
+            line = {"index": self._count, "step": request.step, "digest": request.digest(),
                     "request": request.to_record(), **outcome}
             try:
                 with self.path.open("a", encoding="utf-8") as fh:
@@ -135,15 +137,15 @@ class ReplayBackend:
             index = self._next
             if index >= len(self._exchanges):
                 raise TranscriptMismatchError(
-                    f"replay of {self.path}: request {index} (stage {request.stage}) is past the end of the "
+                    f"replay of {self.path}: request {index} (step {request.step}) is past the end of the "
                     f"transcript, which holds {len(self._exchanges)} exchange(s); the run asks for more than was "
                     "recorded")
             exchange = self._exchanges[index]
             digest = request.digest()
             if digest != exchange["digest"]:
                 raise TranscriptMismatchError(
-                    f"replay of {self.path}: request {index} (stage {request.stage}) differs from the recorded one "
-                    f"(stage {exchange['stage']}, line {exchange['line']}): {_differences(exchange, request)}")
+                    f"replay of {self.path}: request {index} (step {request.step}) differs from the recorded one "
+                    f"(step {exchange['step']}, line {exchange['line']}): {_differences(exchange, request)}")
             self._next += 1
         if "error" in exchange:
             err = exchange["error"]
@@ -156,7 +158,7 @@ class ReplayBackend:
             nxt = self._exchanges[self._next]
             raise TranscriptMismatchError(
                 f"replay of {self.path}: the run made {self._next} request(s) but {len(self._exchanges)} were "
-                f"recorded; the next unused one is exchange {self._next} (stage {nxt['stage']}, line {nxt['line']})")
+                f"recorded; the next unused one is exchange {self._next} (step {nxt['step']}, line {nxt['line']})")
 
 
 def _dumps(obj: Any) -> str:
@@ -214,12 +216,12 @@ def _check_exchange(obj: dict[str, Any], where: str, lineno: int, expected_index
     if obj.get("index") != expected_index:
         raise TranscriptMismatchError(f"{where}: exchange index {obj.get('index')!r}, expected {expected_index} "
                                       "(lines missing or reordered)")
-    for key in ("stage", "digest"):
+    for key in ("step", "digest"):
         if not isinstance(obj.get(key), str):
             raise TranscriptMismatchError(f"{where}: field {key!r} must be a string, got {obj.get(key)!r:.80}")
     if not isinstance(obj.get("request"), dict):
         raise TranscriptMismatchError(f"{where}: field 'request' must be an object")
-    out = {"index": expected_index, "line": lineno, "stage": obj["stage"], "digest": obj["digest"],
+    out = {"index": expected_index, "line": lineno, "step": obj["step"], "digest": obj["digest"],
            "request": obj["request"]}
     if "error" in obj:
         if not isinstance(obj["error"], dict):
@@ -237,7 +239,7 @@ def _differences(exchange: dict[str, Any], request: ModelRequest) -> str:
     """Which request fields differ from the recorded ones, with a short hint for text fields."""
     old, new = exchange["request"], request.to_record()
     parts: list[str] = []
-    for key in ("stage", "temperature", "max_tokens"):
+    for key in ("step", "temperature", "max_tokens"):
         if old.get(key) != new[key]:
             parts.append(f"{key} {old.get(key)!r} -> {new[key]!r}")
     for key in ("system", "prompt"):

@@ -49,19 +49,19 @@ How each check is measured (the thresholds are the module constants below):
     table, OFF_TABLE_MARGIN_M from the edge (centred when it is larger than the table), combined with the reach fix.
 ``scale``
     (a) :func:`check_raw_scales` on a raw task mapping: a scale outside SCALE_RANGE (such a spec cannot be parsed);
-    fix: the factor back into range. (b) A graspable, rigid object that the task grasps (a stage targeting it
-    says grasp/pick/lift/hold/grab/wrap/pinch/grip, or a ``lifted`` condition names it, or it is the object of an
-    ``inside`` condition) whose smallest horizontal width as placed exceeds GRASP_MAX_WIDTH_M, or whose largest
+    fix: the factor back into range. (b) A graspable, rigid object that the task grasps (a stage targeting it has a
+    skill of :data:`GRASP_SKILLS`, or a ``lifted`` condition names it, or it is the object of an ``inside``
+    condition) whose smallest horizontal width as placed exceeds GRASP_MAX_WIDTH_M, or whose largest
     extent is below GRASP_MIN_SIZE_M; fix: the scale factor that brings it inside. (c) A scale outside
     REALISTIC_SCALE_RANGE is reported with severity ``warning`` (a catalog asset at 0.3x or 2x is no longer the
     object it depicts); warnings do not make a report fail.
 ``joint_state`` (static)
-    An articulated object whose initial joint state contradicts the first stage that targets it and states an
-    intent: "open" while the joint starts at least JOINT_OPEN_FRACTION open, "close"/"shut" while it starts less
-    than that open. Words about the hand ("open hand", "close the fingers") are not intents. With no stage intent, a
-    ``joint_open`` success condition on the object means "open". The fraction is (q - closed) / (open - closed) of
-    the joint the conditions name, else the asset's main joint. Fix: ``joint_fix`` = {object, joint, value} setting
-    the joint to its closed (resp. open) value; the directive grammar has no joint edit.
+    An articulated object whose initial joint state contradicts the first stage that targets it with skill
+    ``open`` or ``close``: "open" while the joint starts at least JOINT_OPEN_FRACTION open, "close" while it starts
+    less than that open. With no such stage, a ``joint_open`` success condition on the object means "open". The
+    fraction is (q - closed) / (open - closed) of the joint the conditions name, else the asset's main joint.
+    Fix: ``joint_fix`` = {object, joint, value} setting the joint to its closed (resp. open) value; the directive
+    grammar has no joint edit.
 """
 
 from __future__ import annotations
@@ -70,7 +70,6 @@ import dataclasses
 import json
 import logging
 import math
-import re
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -79,6 +78,7 @@ from typing import Any, Literal
 import numpy as np
 
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
+from gendex_envs.physx import px_objects
 from gendex_envs.spec import (
     SCALE_RANGE,
     ObjectSpec,
@@ -144,10 +144,11 @@ kind vary about +/-50 %; a 2x apple (15 cm) or a 0.3x bottle (7 cm) no longer lo
 JOINT_OPEN_FRACTION = 0.5
 """A joint at least this fraction of the way from closed to open counts as open (joint_state check)."""
 
-_GRASP_WORDS = re.compile(r"\b(grasp|grab|pick|lift|hold|wrap|pinch|grip)\w*", re.IGNORECASE)
-_INTENT = re.compile(r"\b(?P<verb>open|opens|opening|close|closes|closing|shut|shuts|shutting)\b"
-                     r"(?P<after>(?:\W+\w+){0,2})", re.IGNORECASE)
-_HAND_WORDS = frozenset({"hand", "hands", "palm", "palms", "finger", "fingers", "gripper", "thumb", "grip", "grasp"})
+GRASP_SKILLS = frozenset({"grasp", "lift"})
+"""Skills whose target is the object in the hand, so it must fit the hand (the ``scale`` check); a carry's target is
+the destination."""
+JOINT_SKILLS = {"open": "open", "close": "close"}
+"""Skills that state what an articulated target's joint should do (the ``joint_state`` check)."""
 
 
 # ------------------------------------------------------------------------------------------------ records
@@ -325,7 +326,7 @@ def _separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
 def _moves(obj: str, dxy: Iterable[float]) -> tuple[Directive, ...]:
     """move_x / move_y directives for an xy translation, rounded to mm away from zero (components < 0.5 mm dropped)."""
     out = []
-    for axis, d in zip("xy", dxy):
+    for axis, d in zip("xy", dxy, strict=True):
         if abs(d) >= 5e-4:
             out.append(Directive.move(obj, axis, math.copysign(math.ceil(abs(d) * 1000) / 1000, d)))
     return tuple(out)
@@ -355,7 +356,7 @@ def _task_objects(spec: TaskSpec) -> set[str]:
 
 
 def _grasped(spec: TaskSpec, name: str) -> bool:
-    if any(s.target == name and _GRASP_WORDS.search(s.instruction) for s in spec.stages):
+    if any(s.target == name and s.skill in GRASP_SKILLS for s in spec.stages):
         return True
     return any(c.object == name and c.type in ("lifted", "inside") for c in spec.success.conditions)
 
@@ -519,15 +520,6 @@ def _scale_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violat
                 limit=rlo if o.scale < rlo else rhi, fix=(Directive.scale(name, f),), severity="warning"))
 
 
-def _intent(text: str) -> str | None:
-    for m in _INTENT.finditer(text):
-        after = {w.lower() for w in re.findall(r"\w+", m.group("after"))}
-        if after & _HAND_WORDS:
-            continue
-        return "open" if m.group("verb").lower().startswith("open") else "close"
-    return None
-
-
 def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
     for name, p in placed.items():
         rec = p.record
@@ -535,11 +527,9 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violat
             continue
         intent, source = None, None
         for s in spec.stages:
-            if s.target == name:
-                intent = _intent(s.instruction)
-                if intent:
-                    source = f"stage {s.name!r} ({s.instruction!r})"
-                    break
+            if s.target == name and s.skill in JOINT_SKILLS:
+                intent, source = JOINT_SKILLS[s.skill], f"stage {s.name!r} (skill {s.skill!r})"
+                break
         conds = [c for c in spec.success.conditions if c.object == name and c.type == "joint_open"]
         if intent is None and conds:
             intent, source = "open", "the joint_open success condition"
@@ -646,8 +636,8 @@ def _entity_ids(entity) -> list[int]:
     from mani_skill.utils.structs import Articulation
 
     if isinstance(entity, Articulation):
-        return [link._objs[0].entity.per_scene_id for link in entity.get_links()]
-    return [obj.per_scene_id for obj in entity._objs]
+        return [px_objects(link)[0].entity.per_scene_id for link in entity.get_links()]
+    return [obj.per_scene_id for obj in px_objects(entity)]
 
 
 def _contact_penetrations(env, placed: dict[str, _Placed], boxes: dict[str, tuple], start: dict[str, np.ndarray],
@@ -656,8 +646,8 @@ def _contact_penetrations(env, placed: dict[str, _Placed], boxes: dict[str, tupl
     from gendex_envs.assets.bounds import body_points
 
     owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in _entity_ids(entity)}
-    robot_links = {link._objs[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
-    table_id = env.table._objs[0].per_scene_id
+    robot_links = {px_objects(link)[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
+    table_id = px_objects(env.table)[0].per_scene_id
     pairs: dict[tuple[str, str], float] = {}  # (object, object) sorted, or (object, "table")
     robot: dict[str, dict[str, float]] = {}  # object -> robot link -> depth
     for c in env.scene.px.get_contacts():
@@ -704,7 +694,8 @@ def _contact_penetrations(env, placed: dict[str, _Placed], boxes: dict[str, tupl
         # one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the
         # object's top (moving away from one finger would push it into the next)
         lo, hi = boxes[a]
-        pts = [body_points(link._objs[0].entity_pose, link._objs[0].collision_shapes) for link in robot_links.values()]
+        bodies = [px_objects(link)[0] for link in robot_links.values()]
+        pts = [body_points(b.entity_pose, b.collision_shapes) for b in bodies]
         low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
         obstacle = np.concatenate(low)
         fix = _moves(a, _separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), float(start[a][1]),

@@ -12,13 +12,15 @@ pytestmark = pytest.mark.gpu
 if not torch.cuda.is_available():
     pytest.skip("ManiSkill's GPU backend needs a CUDA device; none here", allow_module_level=True)
 
-from generator.rl.presets import PRESETS  # noqa: E402
-from generator.rl.train import train_stage  # noqa: E402
+from gendex.train.presets import PRESETS  # noqa: E402
+from gendex.train.train import train_stage  # noqa: E402
+from gendex_envs.task_version import TaskLayout  # noqa: E402
 
 
-def test_paper_preset_trains_a_stage_with_start_states(tmp_path):
+def test_paper_preset_trains_a_stage_with_start_states(task_version, tmp_path):
     preset = dataclasses.replace(PRESETS["paper"], n_envs=64, batch_size=512, net_arch=(256, 256))
-    r = train_stage("generated_tasks/PickUpBottle/v0", "grasp_bottle", steps=64 * 16 * 4, preset=preset,
-                    policy_dir=tmp_path / "policies", eval_episodes=2, progress=False)
-    assert r.policy_path.is_file() and r.steps >= 64 * 16 * 4
-    assert (tmp_path / "start_states" / "grasp_bottle.npz").is_file()
+    run = tmp_path / "run"
+    r = train_stage(task_version("PickUpBottle", 0), "grasp_bottle", steps=64 * 16 * 4, preset=preset, run_dir=run,
+                    eval_episodes=2, progress=False)
+    assert r.policy.model.is_file() and r.steps >= 64 * 16 * 4
+    assert TaskLayout(run).start_states("grasp_bottle").is_file()

@@ -7,17 +7,19 @@ import numpy as np
 import pytest
 import torch
 
-import gendex_envs  # noqa: F401
+from gendex.solve.executor import StageExecutor
+from gendex.solve.policy import StagePolicy, stage_observation
+from gendex.train.envs import make_stage_env
+from gendex.train.start_states import collect_executor_states
 from gendex_envs.errors import StageError
-from gendex_envs.registry import make_task_env
-from gendex_envs.reward_module import load_reward_module
-from gendex_envs.solve.executor import StageExecutor
-from gendex_envs.solve.policy import StagePolicy, stage_observation
-from gendex_envs.stage import StartStates, stage_reward_path
-from generator.rl.envs import make_stage_env
-from generator.rl.start_states import collect_executor_states
+from gendex_envs.registry import make_env
+from gendex_envs.start_states import StartStates
+from gendex_envs.task_version import Artifacts
 
-BOTTLE = "generated_tasks/PickUpBottle/v0"
+
+@pytest.fixture
+def bottle(task_version):
+    return task_version("PickUpBottle", 0)
 
 
 class _FixedModel:
@@ -30,27 +32,26 @@ class _FixedModel:
         return np.broadcast_to(self.action, (len(obs), len(self.action))).copy(), None
 
 
-def _policy(stage, control_joint, action, dim):
-    module = load_reward_module(stage_reward_path(BOTTLE, stage))
-    return StagePolicy(stage=stage, control_joint=control_joint, module=module, model=_FixedModel(action),
+def _policy(version, stage, control_joint, action, dim):
+    return StagePolicy(stage=stage, control_joint=control_joint, judge=version.judge(stage), model=_FixedModel(action),
                        obs_mean=np.zeros(dim, np.float32), obs_var=np.ones(dim, np.float32), clip_obs=1e9, meta={})
 
 
-def test_policy_sees_and_drives_the_same_in_the_executor_env():
-    stage_env = make_stage_env(BOTTLE, "approach_bottle", training=False)
-    full = make_task_env(BOTTLE, control_mode="pd_joint_pos", control_joint="both")
+def test_policy_sees_and_drives_the_same_in_the_executor_env(bottle):
+    stage_env = make_stage_env(bottle, "approach_bottle", training=False)
+    full = make_env(bottle, control_mode="pd_joint_pos", control_joint="both", gym_api=False)
     try:
         obs, _ = stage_env.reset(seed=3)
         full.reset(seed=3)
-        policy = _policy("approach_bottle", "arm", np.linspace(-1, 1, 6), obs.shape[-1])
-        np.testing.assert_allclose(stage_observation(full, policy.module)[0].cpu().numpy(), obs, atol=1e-5)
+        policy = _policy(bottle, "approach_bottle", "arm", np.linspace(-1, 1, 6), obs.shape[-1])
+        np.testing.assert_allclose(stage_observation(full, policy.judge)[0].cpu().numpy(), obs, atol=1e-5)
         for _ in range(5):  # same action in both envs: delta controller there, absolute targets here
             action = policy.predict(obs[None])[0]
             obs, *_ = stage_env.step(action)
             free = full.unwrapped.agent.controller.free_idx.cpu().numpy()
             target = policy.targets(full, action[None])[0].cpu().numpy()
             full.step(target[free])
-        np.testing.assert_allclose(stage_observation(full, policy.module)[0].cpu().numpy(), obs, atol=1e-4)
+        np.testing.assert_allclose(stage_observation(full, policy.judge)[0].cpu().numpy(), obs, atol=1e-4)
         moved = full.unwrapped.agent.robot.get_qpos()[0, :6] - torch.tensor(
             [2.683, -1.71, 2.408, -0.699, 1.112, 0.0])
         assert moved.abs().max() > 0.05  # the arm really moved (the comparison is not between two idle robots)
@@ -59,13 +60,13 @@ def test_policy_sees_and_drives_the_same_in_the_executor_env():
         full.close()
 
 
-def test_later_stage_needs_start_states_and_restores_them(tmp_path):
-    with pytest.raises(StageError, match="no start states"):
-        make_stage_env(BOTTLE, "grasp_bottle", training=False)
-    got = collect_executor_states(BOTTLE, "grasp_bottle", 2, seed=0)
+def test_later_stage_needs_start_states_and_restores_them(bottle, tmp_path):
+    with pytest.raises(StageError, match="has no start states for it"):
+        make_stage_env(bottle, "grasp_bottle", training=False)
+    got = collect_executor_states(bottle, "grasp_bottle", 2, seed=0)
     assert len(got.states) == 2 and got.env_steps > 0
     path = got.states.save(tmp_path / "grasp_bottle.npz")
-    env = make_stage_env(BOTTLE, "grasp_bottle", start_states=StartStates.load(path), training=False)
+    env = make_stage_env(bottle, "grasp_bottle", start_states=StartStates.load(path), training=False)
     try:
         u = env.unwrapped
         env.reset(seed=0)
@@ -81,18 +82,22 @@ def test_later_stage_needs_start_states_and_restores_them(tmp_path):
         env.close()
 
 
-def test_executor_runs_a_present_policy(tmp_path):
-    """With policies/<stage>.zip present the executor runs it (here: a real SB3 model trained for one rollout)."""
-    from generator.rl.train import train_stage
+def test_executor_runs_a_present_policy(bottle, tmp_path):
+    """With a trained policy of a stage in its sources the executor runs it (here: a real SB3 model trained for one
+    rollout, in a training run folder)."""
+    from gendex.train.presets import PRESETS
+    from gendex.train.train import train_stage
 
-    r = train_stage(BOTTLE, "lift_bottle", steps=256, n_envs=1, policy_dir=tmp_path / "policies",
-                    eval_episodes=1, progress=False,
-                    preset=dataclasses.replace(__import__("generator.rl.presets", fromlist=["x"]).PRESETS["cpu"],
-                                               n_steps=256, batch_size=64, n_epochs=1))
-    assert r.policy_path.is_file() and (tmp_path / "start_states" / "lift_bottle.npz").is_file()
-    assert (tmp_path / "policies" / "lift_bottle" / "progress.csv").is_file()
-    env = make_task_env(BOTTLE, control_mode="pd_joint_pos", control_joint="both")
-    ex = StageExecutor(policy_dir=tmp_path / "policies")
+    run = tmp_path / "run"
+    r = train_stage(bottle, "lift_bottle", steps=256, n_envs=1, run_dir=run, eval_episodes=1, progress=False,
+                    preset=dataclasses.replace(PRESETS["cpu"], n_steps=256, batch_size=64, n_epochs=1))
+    layout = Artifacts(run).layout
+    assert r.policy.model == layout.policy("lift_bottle") and r.policy.model.is_file()
+    assert layout.start_states("lift_bottle").is_file() and layout.record("run").is_file()
+    assert (layout.policy_curves("lift_bottle") / "progress.csv").is_file()
+    assert bottle.policy("lift_bottle") is None  # the version itself is untouched
+    env = make_env(bottle, control_mode="pd_joint_pos", control_joint="both")
+    ex = StageExecutor(policy_sources=[Artifacts(run)])
     try:
         obs, _ = env.reset(seed=0)
         ex.reset(env, obs)

@@ -4,14 +4,13 @@ import numpy as np
 import pytest
 import torch
 
-from gendex_envs.assets.catalog import get_asset
-
 from gendex_envs.agents.ur10e_shadow import (
     ALL_JOINTS,
-    COUPLED_DISTAL,
     CONTROL_JOINT_GROUPS,
+    COUPLED_DISTAL,
     KEYFRAME_QPOS_BY_NAME,
 )
+from gendex_envs.assets.catalog import get_asset
 
 TASK = "GenDex/PickUpBottle-v0"
 
@@ -72,7 +71,7 @@ def test_distal_joints_follow_middle_joints(make_env):
     agent = env.unwrapped.agent
     env.reset(seed=0)
     controller = agent.controller
-    action = controller._target_qpos[0, controller.free_idx].cpu().numpy().copy()
+    action = controller.free_targets()[0].cpu().numpy().copy()
     names = controller.free_joint_names
     for leader in COUPLED_DISTAL.values():
         action[names.index(leader)] = 0.9
@@ -114,7 +113,7 @@ def _push_bottle(env, target_p: torch.Tensor, steps: int = 12) -> tuple[torch.Te
     p = target_p.clone()[None]
     p[0, 2] -= get_asset("bottle").size_m[2] + 0.004  # the origin is at the bottle's base
     bottle.set_pose(type(pose).create_from_pq(p, pose.q))
-    hold = u.agent.controller._target_qpos[0, u.agent.controller.free_idx].cpu().numpy()
+    hold = u.agent.controller.free_targets()[0].cpu().numpy()
     tips, groups = torch.zeros(5), torch.zeros(6)
     for _ in range(steps):
         bottle.set_linear_velocity(torch.tensor([[0.0, 0.0, 0.05]]))

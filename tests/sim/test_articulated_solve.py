@@ -4,18 +4,16 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-import yaml
 
 import gendex_envs  # noqa: F401
-from gendex_envs.registry import REPO_TASKS_DIR
-from gendex_envs.solve import articulated
-from gendex_envs.solve.articulated import (
+from gendex.solve import articulated
+from gendex.solve.articulated import (
     handle_local,
     hook_grasps,
     opening_goal,
     read_joint,
 )
-from gendex_envs.solve.executor import ExecutionError, StageExecutor
+from gendex.solve.executor import ExecutionError, StageExecutor
 
 
 @pytest.fixture(scope="module")
@@ -111,12 +109,12 @@ def test_pull_without_a_hook_stalls_and_ends_the_attempt(cabinet_env, monkeypatc
     assert float(env.joint_qpos("cabinet")[0]) < 0.5
 
 
-def test_stage_executor_refuses_a_sliding_joint():
+def test_stage_executor_refuses_a_sliding_joint(task_version):
     """The articulated primitives open revolute joints only; a drawer is refused with the named error."""
-    from gendex_envs.spec import parse_task_spec
+    from gendex_envs.spec import parse_task_spec, spec_to_dict
     from gendex_envs.task_env import TaskEnv
 
-    raw = yaml.safe_load((REPO_TASKS_DIR / "OpenCabinet" / "v0" / "task.yaml").read_text())
+    raw = spec_to_dict(task_version("OpenCabinet", 0).spec)
     raw["objects"][0].update(asset="drawer_chest_1", joint_state={})
     env = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_pos", control_joint="both",
                   render_backend="none")

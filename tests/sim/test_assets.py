@@ -29,7 +29,8 @@ def _grid_spec(objects: list[dict], table_m: float) -> dict:
         "name": "AssetCheck", "instruction": "Check assets.",
         "table": {"size_m": [table_m, table_m]},
         "objects": objects,
-        "stages": [{"name": "idle", "instruction": "Idle.", "method": "RL", "control_joint": "hand"}],
+        "stages": [{"name": "idle", "instruction": "Idle.", "skill": "reorient", "method": "RL",
+                    "control_joint": "hand"}],
         "success": {"description": "never", "conditions": [{"type": "lifted", "object": objects[0]["name"],
                                                              "min_height_m": 10.0}]},
     }, source="<test_assets>")
@@ -57,7 +58,7 @@ def _idle(env: TaskEnv, seconds: float) -> None:
 @pytest.fixture(scope="module")
 def rigid_scene():
     objs = [{"name": f"a_{aid}", "asset": aid, "pos_m": [x, y, 0.0]}
-            for aid, (x, y) in zip(RIGID, _grid_positions(len(RIGID), SPACING_M))]
+            for aid, (x, y) in zip(RIGID, _grid_positions(len(RIGID), SPACING_M), strict=True)]
     env = _make(objs)
     start = {o["name"]: env.obj(o["name"]).pose.raw_pose[0].clone() for o in objs}
     _idle(env, 2.0)
@@ -104,7 +105,7 @@ def test_containers_hold_a_dropped_ball():
     assert CONTAINERS, "the catalog has no open containers"
     positions = _grid_positions(len(CONTAINERS), 0.35)
     objs = []
-    for aid, (x, y) in zip(CONTAINERS, positions):
+    for aid, (x, y) in zip(CONTAINERS, positions, strict=True):
         height = catalog()[aid].size_m[2]
         objs.append({"name": f"c_{aid}", "asset": aid, "pos_m": [x, y, 0.0]})
         objs.append({"name": f"b_{aid}", "asset": "golf_ball", "pos_m": [x, y, height + 0.03]})
@@ -126,7 +127,7 @@ def test_containers_hold_a_dropped_ball():
 @pytest.fixture(scope="module")
 def articulated_scene():
     objs = [{"name": f"j_{aid}", "asset": aid, "pos_m": [x, y, 0.0], "fixed": True}
-            for aid, (x, y) in zip(ARTICULATED, _grid_positions(len(ARTICULATED), 1.0, start_x=1.2))]
+            for aid, (x, y) in zip(ARTICULATED, _grid_positions(len(ARTICULATED), 1.0, start_x=1.2), strict=True)]
     env = _make(objs, 1.0)
     yield env
     env.close()
@@ -155,7 +156,7 @@ def test_articulated_joints_move_through_their_limits(articulated_scene, asset_i
 @pytest.mark.parametrize("asset_id", ARTICULATED)
 def test_handles_are_reachable_from_the_robot_base(asset_id):
     """With the asset at x = 0.45 m, the palm can be put 6 cm in front of each handle, facing it (IK)."""
-    from gendex_envs.solve.ik import ArmIK
+    from gendex.solve.ik import ArmIK
 
     record = catalog()[asset_id]
     env = _make([{"name": "item", "asset": asset_id, "pos_m": [REACH_TEST_X, 0.0, 0.0], "fixed": True}])
@@ -204,7 +205,7 @@ FREE_ARTICULATED = sorted(r.id for r in catalog().values() if r.articulated and 
 def test_free_articulated_assets_rest_on_table():
     assert FREE_ARTICULATED, "laptops and boxes with lids stand free"
     objs = [{"name": f"f_{aid}", "asset": aid, "pos_m": [x, y, 0.0]}
-            for aid, (x, y) in zip(FREE_ARTICULATED, _grid_positions(len(FREE_ARTICULATED), 0.6))]
+            for aid, (x, y) in zip(FREE_ARTICULATED, _grid_positions(len(FREE_ARTICULATED), 0.6), strict=True)]
     env = _make(objs, 0.6)
     try:
         start = {o["name"]: env.obj(o["name"]).pose.p[0].clone() for o in objs}

@@ -3,16 +3,17 @@
 import json
 import shutil
 
-import gymnasium as gym
 import pyarrow.parquet as pq
 import pytest
 import yaml
 from typer.testing import CliRunner
 
-import gendex_envs.data.collector as collector
+import gendex.data.collector as collector
 from gendex.cli import app
-from gendex_envs.data.collector import CollectConfig, HoldSolver, collect
-from gendex_envs.registry import REPO_TASKS_DIR, register_tasks
+from gendex.data.collector import CollectConfig, collect
+from gendex.solve import HoldSolver
+from gendex_envs.registry import register_tasks, resolve_task, unregister_tasks
+from gendex_envs.task_version import TaskLayout
 
 TASK = "GenDex/ScratchNear-v0"
 
@@ -22,15 +23,16 @@ def near_task(tmp_path_factory):
     """PutAppleBowl with success 'apple within 28 cm of the bowl': true for some reset seeds, false for others."""
     root = tmp_path_factory.mktemp("tasks")
     folder = root / "ScratchNear" / "v0"
-    shutil.copytree(REPO_TASKS_DIR / "PutAppleBowl" / "v0", folder)
-    raw = yaml.safe_load((folder / "task.yaml").read_text())
+    shutil.copytree(resolve_task("GenDex/PutAppleBowl-v0").root, folder)
+    spec = TaskLayout(folder).spec
+    raw = yaml.safe_load(spec.read_text())
     raw["name"] = "ScratchNear"
     raw["success"] = {"description": "apple near the bowl",
                       "conditions": [{"type": "near", "object": "apple", "target": "bowl", "max_dist_m": 0.28}]}
-    (folder / "task.yaml").write_text(yaml.safe_dump(raw))
+    spec.write_text(yaml.safe_dump(raw))
     register_tasks([root])
     yield TASK
-    del gym.registry[TASK]
+    unregister_tasks([TASK])
 
 
 def _cfg(out, **kw):
@@ -85,6 +87,8 @@ def test_cli_collect_then_replay(near_task, tmp_path):
     result = CliRunner().invoke(app, ["collect", TASK, "--num-success", "2", "--out", str(out), "--format", "both"])
     assert result.exit_code == 0, result.output
     assert "2/" in result.output and (out / "lerobot" / "README.md").is_file()
+    card = (out / "lerobot" / "README.md").read_text()  # the exact env the actions belong to
+    assert f"gym.make('{TASK}', control_mode='pd_joint_pos', control_joint='both', obs_mode='state')" in card
     replayed = CliRunner().invoke(app, ["replay", str(out / "trajectories.h5")])
     assert replayed.exit_code == 0, replayed.output
     assert replayed.output.count(": OK") == 2

@@ -52,7 +52,7 @@ def test_env_api_prompt_matches_task_env(make_env, env_id, placeholder, name):
         if other in expr:
             continue
         code = expr.replace(placeholder, repr(name))
-        value = eval(code, {"torch": torch}, {"env": u})  # noqa: S307  (our own prompt text, not model output)
+        value = eval(code, {"torch": torch}, {"env": u})
         _check(value, shape, u.num_envs, expr)
         checked += 1
     assert checked >= 12

@@ -15,14 +15,12 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from gendex_envs.registry import register_tasks
+from gendex_envs.task_version import DRAFTS, TaskLayout
 from generator.backends.base import ModelResponse
 from generator.backends.offline import OfflineBackend
 from generator.backends.transcript import ReplayBackend
 from generator.errors import RetriesExhaustedError
 from generator.pipeline import generate
-from generator.stages.commit import REQUIRED_FILES, STAGING
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 def _offline(seed: int = 0):
@@ -47,15 +45,20 @@ def offline_run(tmp_path_factory):
 def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
     root, summaries = offline_run
     [folder] = _task_folders(root)
-    assert folder == summaries[0].committed.path
-    for f in REQUIRED_FILES:
-        assert (folder / f).is_file(), f
-    for stage in ("before", "after"):
+    version = summaries[0].committed
+    assert folder == version.root
+    for f in version.files.generated:
+        assert f.is_file(), f
+    for when in ("before", "after"):
         for view in ("left_overhead", "right_overhead", "top_down"):
-            assert (folder / "renders" / f"{stage}_{view}.png").read_bytes()[:4] == b"\x89PNG"
-    info = json.loads((folder / "generation.json").read_text())
+            assert version.files.render(f"{when}_{view}").read_bytes()[:4] == b"\x89PNG"
+    info = version.provenance()["generation"]
     assert info["backend"] == "offline" and info["is_language_model"] is False and info["seed"] == 0
-    assert not list((root / STAGING).iterdir())  # nothing left half-written
+    assert not list((root / DRAFTS).iterdir())  # nothing left half-written
+    # every RL stage declares its goal (the skill's standard one), and its module does not decide success
+    for stage in version.spec.stages:
+        assert stage.method != "RL" or stage.success, stage
+    assert version.judge(version.spec.stages[1].name).conditions[0].type == "grasped"
     env_id = summaries[0].committed.env_id
     assert env_id in register_tasks([root], override=True)
     env = gym.make(env_id)
@@ -67,19 +70,19 @@ def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
 
 def test_replayed_transcript_reproduces_the_task_files(offline_run, tmp_path):
     root, summaries = offline_run
-    src = summaries[0].committed.path
-    replay = generate(lambda: ReplayBackend(src / "transcript.jsonl"), tmp_path, n=1, seed=0, command="test")
-    assert _tree(replay[0].committed.path) == _tree(src)
+    src = summaries[0].committed
+    replay = generate(lambda: ReplayBackend(src.files.transcript), tmp_path, n=1, seed=0, command="test")
+    assert _tree(replay[0].committed.root) == _tree(src.root)
 
 
 def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path):
     [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction="grab the apple", command="test")
-    spec = json.loads((s.committed.path / "proposal.json").read_text())
+    spec = s.committed.provenance()["proposal"]
     assert [o["asset"] for o in spec["objects"]] == ["apple"]
-    assert any(st["action"] == "grasp" for st in spec["steps"])
+    assert any(st["skill"] == "grasp" for st in spec["steps"])
     assert spec["success"]["type"] == "lifted"
-    text = (s.committed.path / "task.yaml").read_text()
-    assert "asset: apple" in text and "control_joint: hand" in text
+    text = s.committed.files.spec.read_text()
+    assert "asset: apple" in text and "control_joint: hand" in text and "skill: grasp" in text
 
 
 # ---------------------------------------------------------------- adversarial answers (nothing is committed)
@@ -97,8 +100,8 @@ class Scripted:
         self.seen: list[str] = []
 
     def complete(self, request):
-        self.seen.append(request.stage)
-        a = self.answers.get(request.stage)
+        self.seen.append(request.step)
+        a = self.answers.get(request.step)
         if a is None:
             return self.offline.complete(request)
         text = a(request) if callable(a) else a
@@ -107,15 +110,15 @@ class Scripted:
 
 _APPLE = ('```json\n{"name": "LiftTheApple", "description": "Lift the apple.", '
           '"objects": [{"name": "apple", "asset": "%s", "role": "graspable"}], '
-          '"steps": [{"action": "approach", "target": "apple", "control_joint": "arm", "instruction": "Reach."}, '
-          '{"action": "grasp", "target": "apple", "control_joint": "hand", "instruction": "Grasp."}], '
+          '"steps": [{"skill": "reach", "target": "apple", "control_joint": "arm", "instruction": "Reach."}, '
+          '{"skill": "grasp", "target": "apple", "control_joint": "hand", "instruction": "Grasp."}], '
           '"success": {"type": "lifted", "object": "apple", "target": null, "min_height_m": 0.1}, '
           '"success_text": "The apple is lifted."}\n```')
 
 
 def _assert_nothing_committed(root: Path) -> None:
     assert _task_folders(root) == []
-    assert not (root / STAGING).exists() or not list((root / STAGING).iterdir())
+    assert not (root / DRAFTS).exists() or not list((root / DRAFTS).iterdir())
 
 
 def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(tmp_path):
@@ -144,7 +147,7 @@ def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path)
 
 def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path):
     nan = ("```python\nimport torch\n\ndef evaluate(env):\n    z = torch.zeros(env.num_envs, dtype=torch.bool, "
-           "device=env.device)\n    return {'success': z, 'fail': z}\n\n"
+           "device=env.device)\n    return {'fail': z}\n\n"
            "def compute_dense_reward(env, obs, action, info):\n"
            "    return torch.full((env.num_envs,), float('nan'), device=env.device)\n```")
     offline = OfflineBackend(seed=0)
@@ -158,28 +161,32 @@ def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path
 
     b = Scripted(propose=_APPLE % "apple", reward=reward)
     [s] = generate(lambda: b, tmp_path, n=1, command="test")
-    attempts = json.loads((s.committed.path / "reward_attempts.json").read_text())["attempts"]
+    attempts = s.committed.provenance()["reward_attempts"]["attempts"]
     assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
     assert "rejected" in calls[-1] or any("nan" in c.lower() for c in calls[1:])
 
 
-def test_killed_run_leaves_no_partial_task_folder(tmp_path):
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+def test_killed_run_leaves_no_partial_task_folder(tmp_path, repo_root):
+    env = {**os.environ, "PYTHONPATH": str(repo_root)}
     proc = subprocess.Popen([sys.executable, "-m", "gendex.cli", "generate", "--backend", "offline", "--n", "3",
-                             "--out", str(tmp_path)], env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
+                             "--out", str(tmp_path)], env=env, cwd=repo_root, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
+
+    def drafts_with_a_spec():
+        return [d for d in (tmp_path / DRAFTS).glob("*") if TaskLayout(d).spec.is_file()]
+
     try:
         deadline = time.time() + 120
-        while time.time() < deadline and not list(tmp_path.glob(f"{STAGING}/*/task.yaml")):
+        while time.time() < deadline and not drafts_with_a_spec():
             time.sleep(0.2)
-        assert list(tmp_path.glob(f"{STAGING}/*/task.yaml")), "the run never reached the reward stage"
+        assert drafts_with_a_spec(), "the run never reached the reward step"
     finally:
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
     for folder in _task_folders(tmp_path):  # tasks committed before the kill are complete
-        assert all((folder / f).is_file() for f in REQUIRED_FILES), folder
-    names = {p.name for p in tmp_path.iterdir()} - {STAGING}
-    assert all(list((tmp_path / n).glob("v*/task.yaml")) for n in names)
+        assert all(f.is_file() for f in TaskLayout(folder).generated), folder
+    names = {p.name for p in tmp_path.iterdir()} - {DRAFTS}
+    assert all(list((tmp_path / n).glob("v*/" + TaskLayout(".").spec.name)) for n in names)
     assert register_tasks([tmp_path], override=True) == [f"GenDex/{f.parent.name}-{f.name}"
                                                          for f in _task_folders(tmp_path)]
 
@@ -194,7 +201,7 @@ def test_five_offline_tasks_are_distinct_reproducible_and_pass_check_env(tmp_pat
     assert len({s.committed.name for s in a}) == 5
     assert [s.committed.name for s in a] == [s.committed.name for s in b]
     for sa, sb in zip(a, b, strict=True):
-        assert _tree(sa.committed.path) == _tree(sb.committed.path), sa.committed.name
+        assert _tree(sa.committed.root) == _tree(sb.committed.root), sa.committed.name
     ids = register_tasks([root_a], override=True)
     assert sorted(ids) == sorted(s.committed.env_id for s in a)
     for env_id in ids:
@@ -212,15 +219,18 @@ instruction: Lift the apple.
 objects:
   - {name: apple, asset: apple, pos_m: [0.1, 0.0, 0.0]}
 stages:
-  - {name: approach_apple, instruction: Reach., method: motion_planning, control_joint: arm, target: apple}
-  - {name: grasp_apple, instruction: Grasp., method: RL, control_joint: hand, target: apple}
+  - {name: approach_apple, instruction: Reach., skill: reach, method: motion_planning, control_joint: arm,
+     target: apple}
+  - {name: grasp_apple, instruction: Grasp., skill: grasp, method: RL, control_joint: hand, target: apple}
 success:
   description: The apple is lifted.
   conditions: [{type: lifted, object: apple, min_height_m: 0.1}]
 ```"""
 _PLAN = """```yaml
-- {name: approach_apple, instruction: Reach the apple., method: motion_planning, control_joint: arm, target: apple}
-- {name: grasp_apple, instruction: Grasp the apple., method: RL, control_joint: hand, horizon: 40, target: apple}
+- {name: approach_apple, instruction: Reach the apple., skill: reach, method: motion_planning, control_joint: arm,
+   target: apple}
+- {name: grasp_apple, instruction: Grasp the apple., skill: grasp, method: RL, control_joint: hand, horizon: 40,
+   target: apple, success: [{type: grasped, object: apple, min_fingers: 3}]}
 ```"""
 _REWARD = """```python
 import torch
@@ -231,8 +241,7 @@ REWARD_MAX = 1.0
 
 
 def evaluate(env):
-    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
-    return {"success": env.spec_success() & ~fail, "fail": fail}
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}
 
 
 def compute_dense_reward(env, obs, action, info):
@@ -278,17 +287,20 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     factory = lambda: AnthropicBackend(model="claude-test", http_client=httpx2.Client(  # noqa: E731
         transport=httpx2.MockTransport(api)), sleep=lambda s: None)
     [s] = generate(factory, tmp_path, n=1, command="test", candidates=1)
-    folder = s.committed.path
+    version = s.committed
+    folder = version.root
     vision = [b for b in bodies if any(c["type"] == "image" for c in b["messages"][0]["content"])]
     assert len(vision) == 2  # one analysis per refinement round, until the critic asked for nothing
     images = [c for c in vision[0]["messages"][0]["content"] if c["type"] == "image"]
     assert len(images) == 3 and all(i["source"]["media_type"] == "image/png" for i in images)
-    critique = json.loads((folder / "critique.json").read_text())
+    critique = version.provenance()["critique"]
     assert "Position_Action: apple - move_y 0.05" in critique["rounds"][0]["directives"]
-    assert "pos_m: [0.1, 0.05, 0.0]" in (folder / "task.yaml").read_text()
-    info = json.loads((folder / "generation.json").read_text())
+    assert "pos_m: [0.1, 0.05, 0.0]" in version.files.spec.read_text()
+    # the model's own stage goal is kept (a stage without one would get the skill's standard goal)
+    assert version.spec.stages[1].success[0].min_fingers == 3
+    info = version.provenance()["generation"]
     assert info["backend"] == "anthropic" and info["model"] == "claude-test" and info["is_language_model"]
     # the recorded transcript replays to the same files without the API
-    again = generate(lambda: ReplayBackend(folder / "transcript.jsonl"), tmp_path / "replay", n=1, command="test",
+    again = generate(lambda: ReplayBackend(version.files.transcript), tmp_path / "replay", n=1, command="test",
                      candidates=1)
-    assert _tree(again[0].committed.path) == _tree(folder)
+    assert _tree(again[0].committed.root) == _tree(folder)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex_envs.solve.ik import ArmIK
+from gendex.solve.ik import ArmIK
 
 
 @pytest.fixture(scope="module")

@@ -7,8 +7,7 @@ import json
 
 import pytest
 
-from gendex_envs.registry import REPO_TASKS_DIR
-from gendex_envs.spec import TaskSpec, load_task_spec, parse_task_spec, spec_to_dict
+from gendex_envs.spec import TaskSpec, parse_task_spec, spec_to_dict
 from generator.critic.directives import apply_directives
 from generator.critic.physical import (
     FALL_TOL_M,
@@ -17,15 +16,24 @@ from generator.critic.physical import (
     check_scene,
 )
 
-SEEDS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
+REFERENCE_TASKS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
 
 
-def seed(name: str) -> TaskSpec:
-    return load_task_spec(REPO_TASKS_DIR / name / "v0" / "task.yaml")
+REFERENCE: dict[str, TaskSpec] = {}
+"""Specs of the reference tasks' version 0, filled from the ``task_version`` fixture."""
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _reference_specs(task_version):
+    REFERENCE.update({name: task_version(name, 0).spec for name in REFERENCE_TASKS})
+
+
+def reference(name: str) -> TaskSpec:
+    return REFERENCE[name]
 
 
 def edited(name: str, **changes) -> TaskSpec:
-    raw = spec_to_dict(seed(name))
+    raw = spec_to_dict(reference(name))
     for obj in raw["objects"]:
         obj.update(changes.get(obj["name"], {}))
     return parse_task_spec(raw)
@@ -45,9 +53,9 @@ def assert_fixed(spec: TaskSpec, report) -> None:
     assert after.violations == [], after.summary()
 
 
-@pytest.mark.parametrize("name", SEEDS)
-def test_seed_tasks_have_no_violations(name):
-    report = check_scene(seed(name))
+@pytest.mark.parametrize("name", REFERENCE_TASKS)
+def test_reference_tasks_have_no_violations(name):
+    report = check_scene(reference(name))
     assert report.violations == [], report.summary()
     assert report.mode == "sim" and report.ok
     meas = json.loads(report.to_json())["measurements"]
@@ -102,7 +110,7 @@ def test_far_object_is_off_table_and_out_of_reach():
 
 
 def test_cabinet_starting_open_with_an_open_stage():
-    raw = spec_to_dict(seed("OpenCabinet"))
+    raw = spec_to_dict(reference("OpenCabinet"))
     raw["objects"][0]["joint_state"] = {"door_hinge": 1.2}
     raw["stages"][0]["instruction"] = "Open the door."
     spec = parse_task_spec(raw)

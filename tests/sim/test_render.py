@@ -2,10 +2,9 @@
 
 import numpy as np
 import pytest
+from mani_skill.utils.structs import Articulation
 from PIL import Image
 from typer.testing import CliRunner
-
-from mani_skill.utils.structs import Articulation
 
 from gendex.cli import app
 from gendex_envs.task_env import VIEW_CAMERAS
@@ -31,7 +30,7 @@ def test_views_show_robot_table_and_objects(make_env, env_id):
     for cam in VIEW_CAMERAS:
         seg = obs["sensor_data"][cam]["segmentation"][0, ..., 0].cpu().numpy()
         ids, counts = np.unique(seg, return_counts=True)
-        visible = dict(zip(ids.tolist(), counts.tolist()))
+        visible = dict(zip(ids.tolist(), counts.tolist(), strict=True))
         names = {id_map[i].name if i in id_map else None for i in visible}
         assert "table" in names, f"{cam}: table not visible ({names})"
         assert sum(visible.get(i, 0) for i in robot_ids) > 200, f"{cam}: robot barely visible"

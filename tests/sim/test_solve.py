@@ -5,12 +5,12 @@ import numpy as np
 import pytest
 
 import gendex_envs  # noqa: F401
-from gendex_envs.solve import grasp
-from gendex_envs.solve.collision import ArmCollisionModel, Box
-from gendex_envs.solve.executor import ExecutionError, StageExecutor
-from gendex_envs.solve.grasp import grasp_candidates
-from gendex_envs.solve.ik import ArmIK
-from gendex_envs.solve.planner import ArmPlanner, PlanningError
+from gendex.solve import grasp
+from gendex.solve.collision import ArmCollisionModel, Box
+from gendex.solve.executor import ExecutionError, StageExecutor
+from gendex.solve.grasp import grasp_candidates
+from gendex.solve.ik import ArmIK
+from gendex.solve.planner import ArmPlanner, PlanningError
 
 CONTROL_HZ = 20
 
@@ -119,7 +119,8 @@ def test_grasp_candidates_follow_the_object_geometry():
         rot = g.palm.to_transformation_matrix()[:3, :3]
         fingers, thumb, facing = rot[:, 2], rot[:, 0], -rot[:, 1]
         assert thumb[2] == pytest.approx(-1.0)  # thumb side down, fingers horizontal
-        assert np.allclose(g.approach, fingers, atol=1e-6)  # slides in along the fingers, the thumb pre-shaped behind the axis
+        # slides in along the fingers, the thumb pre-shaped behind the axis
+        assert np.allclose(g.approach, fingers, atol=1e-6)
         assert g.open_hand == grasp.SIDE_OPEN_HAND and g.thumb == grasp.SIDE_THUMB_CLOSED
         axis = np.array([0.1, 0.0, g.palm.p[2]])
         assert g.palm.p[2] == pytest.approx(0.55 * 0.22, abs=1e-6)
@@ -138,7 +139,7 @@ def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed)
     executor = StageExecutor()
     _run_stages(apple_env, seed, executor, stop_after=2)  # reach_apple + grasp_apple (closing and lifting)
     assert [log.primitive for log in executor.logs[:2]] == ["approach", "grasp"]
-    hold = env.agent.controller._target_qpos[0, executor._free].numpy()
+    hold = env.agent.controller.target_qpos[0, executor.motion.free].numpy()
     for _ in range(2 * CONTROL_HZ):
         apple_env.step(hold)
     assert float(env.obj_height("apple")[0]) >= 0.10
@@ -153,7 +154,7 @@ def test_synthesized_grasp_lifts_the_bottle_10cm_and_holds_it_2s(bottle_env, see
     _run_stages(bottle_env, seed, executor, stop_after=2, stop_when_done=False)
     assert [log.primitive for log in executor.logs[:2]] == ["approach", "grasp"]
     assert executor._plan.kind == "side"
-    hold = env.agent.controller._target_qpos[0, executor._free].numpy()
+    hold = env.agent.controller.target_qpos[0, executor.motion.free].numpy()
     for _ in range(2 * CONTROL_HZ):
         bottle_env.step(hold)
     assert float(env.obj_height("bottle")[0]) >= 0.10
@@ -172,16 +173,14 @@ def test_stage_executor_solves_put_apple_bowl(apple_env):
     assert all(wins)
 
 
-def test_stage_executor_refuses_a_stage_it_cannot_script():
+def test_stage_executor_refuses_a_stage_it_cannot_script(task_version):
     """A stage without a target object has no primitive: the attempt ends with the named error."""
-    import yaml
-
-    from gendex_envs.registry import REPO_TASKS_DIR
-    from gendex_envs.spec import parse_task_spec
+    from gendex_envs.spec import parse_task_spec, spec_to_dict
     from gendex_envs.task_env import TaskEnv
 
-    raw = yaml.safe_load((REPO_TASKS_DIR / "PutAppleBowl" / "v0" / "task.yaml").read_text())
-    del raw["stages"][0]["target"]
+    raw = spec_to_dict(task_version("PutAppleBowl", 0).spec)
+    raw["stages"][0]["target"] = None
+    raw["stages"][0]["success"] = None
     env = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_pos", control_joint="both",
                   render_backend="none")
     try:

@@ -8,11 +8,22 @@ import numpy as np
 import pytest
 import torch
 
-from gendex_envs.data.episode import Episode, EpisodeError
-from gendex_envs.data.rollout import (env_info, flat_env_state, object_positions, record_rollout, set_flat_env_state,
-                                      state_layout)
-from gendex_envs.data.trajectory_h5 import (ReplayError, TrajectoryFileError, TrajectoryWriter, replay_episode,
-                                            replay_file)
+from gendex.data.episode import Episode, EpisodeError
+from gendex.data.rollout import (
+    env_info,
+    flat_env_state,
+    object_positions,
+    record_rollout,
+    set_flat_env_state,
+    state_layout,
+)
+from gendex.data.trajectory_h5 import (
+    ReplayError,
+    TrajectoryFileError,
+    TrajectoryWriter,
+    replay_episode,
+    replay_file,
+)
 
 ENV_ID = "GenDex/PickUpBottle-v0"
 

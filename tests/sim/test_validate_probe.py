@@ -14,8 +14,9 @@ from pathlib import Path
 
 import pytest
 
+from gendex_envs.registry import resolve_task
 from generator.errors import RewardProbeError, UnsafeCodeError
-from generator.stages.validate import (
+from generator.steps.validate import (
     ProbeReport,
     ValidationReport,
     probe_task,
@@ -23,15 +24,15 @@ from generator.stages.validate import (
     validate_task,
 )
 
-REPO = Path(__file__).resolve().parents[2]
-TASK = REPO / "generated_tasks" / "PutAppleBowl" / "v0"
-SHIPPED = TASK / "reward.py"
+TASK = resolve_task("GenDex/PutAppleBowl-v0").root
+SHIPPED = resolve_task("GenDex/PutAppleBowl-v0").files.reward
+SHIPPED_NAME = resolve_task("GenDex/PutAppleBowl-v0").files.relative(SHIPPED)
 
 HEAD = "import torch\n\n"
 EVALUATE = (
     "def evaluate(env):\n"
     "    s = env.spec_success()\n"
-    "    return {'success': s, 'fail': torch.zeros_like(s)}\n"
+    "    return {'fail': torch.zeros_like(s)}\n"
 )
 REWARD = (
     "def compute_dense_reward(env, obs, action, info):\n"
@@ -51,20 +52,20 @@ BAD_MODULES = {
         "    return d / d\n"),
     "no_fail": HEAD + (
         "def evaluate(env):\n"
-        "    return {'success': env.spec_success()}\n") + REWARD,
-    "both": HEAD + (
+        "    return {'inside': env.spec_success()}\n") + REWARD,
+    "grants_success": HEAD + (
         "def evaluate(env):\n"
         "    s = torch.ones(env.num_envs, dtype=torch.bool, device=env.device)\n"
-        "    return {'success': s, 'fail': s}\n") + REWARD,
+        "    return {'success': s, 'fail': ~s}\n") + REWARD,
     "raises": HEAD + (
         "def evaluate(env):\n"
         "    apple = env.obj_pose('apple').p\n"
         "    s = apple[:, 0] > 1.0\n"
-        "    return {'success': s, 'fail': s & (apple[:, 2] / 0.0 > [1][3])}\n") + REWARD,
+        "    return {'fail': s & (apple[:, 2] / 0.0 > [1][3])}\n") + REWARD,
     "float_flags": HEAD + (
         "def evaluate(env):\n"
         "    s = env.spec_success().float()\n"
-        "    return {'success': s, 'fail': torch.zeros_like(s)}\n") + REWARD,
+        "    return {'fail': torch.zeros_like(s)}\n") + REWARD,
     "import_fails": HEAD + "SCALE = 1 / 0\n\n" + EVALUATE + REWARD,
     "bad_obs": HEAD + EVALUATE + REWARD + (
         "def _get_obs_extra(env, info):\n"
@@ -88,8 +89,8 @@ def write_modules(folder: Path, sources: dict[str, str]) -> list[Path]:
 
 @pytest.fixture(scope="module")
 def batch(tmp_path_factory) -> ValidationReport:
-    """The shipped reward.py plus every bad module, validated in one child process."""
-    folder = tmp_path_factory.mktemp("stage_rewards")
+    """The shipped task reward module plus every bad module, validated in one child process."""
+    folder = tmp_path_factory.mktemp("candidates")
     modules = [SHIPPED, *write_modules(folder, BAD_MODULES)]
     return validate_task(TASK, modules, steps=8, timeout_s=30, memory_limit_mb=1024)
 
@@ -107,7 +108,7 @@ def probe_error(report: ValidationReport, name: str) -> str:
 
 
 def test_shipped_reward_passes_static_check_and_probe(batch):
-    o = outcome(batch, "reward.py")
+    o = outcome(batch, SHIPPED_NAME)
     assert o.ok, o.error
     r = o.probe
     assert isinstance(r, ProbeReport) and r.steps == 8 and r.num_envs == 1
@@ -120,7 +121,7 @@ def test_report_is_json_and_lists_every_module(batch):
     assert not batch.ok and len(batch.modules) == 1 + len(BAD_MODULES)
     data = json.loads(batch.to_json())
     assert data == json.loads(json.dumps(dataclasses.asdict(batch)))
-    assert data["modules"][0]["module"] == "reward.py"
+    assert data["modules"][0]["module"] == SHIPPED_NAME
     with pytest.raises(RewardProbeError, match=r"^shape_n1\.py: "):
         batch.raise_first()
 
@@ -143,12 +144,12 @@ def test_nan_reward_is_rejected(batch):
 
 def test_evaluate_without_fail_is_rejected(batch):
     message = probe_error(batch, "no_fail")
-    assert "right after reset (step 0), evaluate returned keys ['success'] without ['fail']" in message
+    assert "right after reset (step 0), evaluate returned keys ['inside'] without 'fail'" in message
 
 
-def test_success_and_fail_together_are_rejected(batch):
-    message = probe_error(batch, "both")
-    assert "evaluate returned success and fail both True for env(s) [0]" in message
+def test_reward_code_cannot_grant_success(batch):
+    message = probe_error(batch, "grants_success")
+    assert "evaluate returned 'success', but success is declared in the task spec" in message
 
 
 def test_exception_in_evaluate_names_type_and_line(batch):
@@ -159,7 +160,7 @@ def test_exception_in_evaluate_names_type_and_line(batch):
 
 def test_float_flags_are_rejected(batch):
     message = probe_error(batch, "float_flags")
-    assert "returned 'success' as a torch.float32 tensor of shape (1,) on cpu; expected a torch.bool tensor" in \
+    assert "returned 'fail' as a torch.float32 tensor of shape (1,) on cpu; expected a torch.bool tensor" in \
         message
 
 
@@ -205,7 +206,8 @@ def test_killed_children_are_replaced_and_report_the_cause(tmp_path):
     loop_err, audit_err, crash_err, good_report = results
     assert isinstance(loop_err, RewardProbeError)
     assert re.search(r"^loop\.py: compute_dense_reward did not finish within the time limit of 8 s at step 1 "
-                     r"\(infinite loop\?\); it was stopped at line [78] \(`(while True:|pass)`\)", str(loop_err)), loop_err
+                     r"\(infinite loop\?\); it was stopped at line [78] \(`(while True:|pass)`\)",
+                     str(loop_err)), loop_err
     assert isinstance(audit_err, RewardProbeError)
     assert "compute_dense_reward tried to reach outside the simulator (open('/etc/hostname'" in str(audit_err)
     assert isinstance(crash_err, RewardProbeError)

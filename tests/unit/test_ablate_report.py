@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from generator.rl.ablate import Cell, StageRecord, _split, ablation_markers, load_cell, write_results
-from generator.rl.presets import TrainingError
+from gendex.train.ablate import Cell, StageRecord, _split, ablation_markers, load_cell, write_results
+from gendex.train.presets import TrainingError
 
 
 def _cell(variant, successes, train=10_000, collect=500, eval_steps=1600):

@@ -84,7 +84,7 @@ def test_urdf_matches_manifest(entry: AssetEntry):
     links = _links(art)
     body = art.root
     lo_b, hi_b = _link_points(body).min(0), _link_points(body).max(0)
-    for joint, spec in zip(active, entry.joints):
+    for joint, spec in zip(active, entry.joints, strict=True):
         assert joint.type.startswith(spec.type), (joint.type, spec.type)
         np.testing.assert_allclose(joint.get_limits()[0], spec.limits, atol=1e-5)
         assert spec.limits[0] <= spec.closed_qpos < spec.open_qpos <= spec.limits[1]
@@ -112,7 +112,7 @@ def test_urdf_matches_manifest(entry: AssetEntry):
 def _settle(scene, art, qpos: np.ndarray, targets: np.ndarray, stiffness: float, seconds: float) -> np.ndarray:
     art.set_qpos(qpos)
     art.set_qvel(np.zeros_like(qpos))
-    for j, t in zip(art.get_active_joints(), targets):
+    for j, t in zip(art.get_active_joints(), targets, strict=True):
         if not stiffness:
             j.set_friction(0.0)  # PhysX joint friction scales with the joint load; test gravity alone
         j.set_drive_properties(stiffness, 100.0 if stiffness else 0.0)

@@ -12,6 +12,7 @@ import httpx2
 import pytest
 from PIL import Image
 
+from gendex_envs.task_version import TaskLayout
 from generator.backends.anthropic_backend import DEFAULT_MODEL, AnthropicBackend
 from generator.backends.base import Backend, ImagePart, ModelRequest, ModelResponse
 from generator.backends.registry import (
@@ -42,7 +43,7 @@ WRIST = ImagePart("wrist", png((30, 30, 200)))
 
 
 def vision_request(**changes) -> ModelRequest:
-    fields = {"stage": "plan", "prompt": "Does the scene match the task?\nAnswer in YAML.",
+    fields = {"step": "plan", "prompt": "Does the scene match the task?\nAnswer in YAML.",
               "system": "You judge scenes.", "images": (LEFT, WRIST), "temperature": 0.2, "max_tokens": 512,
               "context": {"task": "PutAppleBowl"}}
     fields.update(changes)
@@ -50,7 +51,7 @@ def vision_request(**changes) -> ModelRequest:
 
 
 def text_request(**changes) -> ModelRequest:
-    fields = {"stage": "propose", "prompt": "Propose a task with: apple, bowl.",
+    fields = {"step": "propose", "prompt": "Propose a task with: apple, bowl.",
               "context": {"objects": ["apple", "bowl"]}}
     fields.update(changes)
     return ModelRequest(**fields)
@@ -291,27 +292,27 @@ class EchoBackend:
 
     def complete(self, request: ModelRequest) -> ModelResponse:
         self.calls += 1
-        text = f"{request.stage} #{self.calls} {request.digest()[:12]}\n  é ✓ \"quoted\"\t\\ \r\n{request.prompt}"
+        text = f"{request.step} #{self.calls} {request.digest()[:12]}\n  é ✓ \"quoted\"\t\\ \r\n{request.prompt}"
         return ModelResponse(text=text, backend=self.name, model=self.model, usage={"calls": self.calls})
 
 
 def record(tmp_path, requests, inner=None):
-    path = tmp_path / "run" / "transcript.jsonl"
+    path = TaskLayout(tmp_path / "run").transcript
     rec = RecordingBackend(inner or EchoBackend(), path)
     return path, [rec.complete(r) for r in requests]
 
 
 def test_record_then_replay_is_byte_identical_with_images(tmp_path):
-    requests = [text_request(), vision_request(), vision_request(stage="analyze", images=(WRIST,))]
+    requests = [text_request(), vision_request(), vision_request(step="analyze", images=(WRIST,))]
     path, recorded = record(tmp_path, requests)
 
     lines = path.read_text(encoding="utf-8").splitlines()
     assert len(lines) == 1 + len(requests)
     header = json.loads(lines[0])["header"]
-    assert header | {} == {"format": "gendex-transcript", "version": 1, "backend": "echo", "model": "echo-1",
+    assert header | {} == {"format": "gendex-transcript", "version": 2, "backend": "echo", "model": "echo-1",
                            "sees_images": True, "is_language_model": False}
     second = json.loads(lines[2])
-    assert (second["index"], second["stage"], second["digest"]) == (1, "plan", requests[1].digest())
+    assert (second["index"], second["step"], second["digest"]) == (1, "plan", requests[1].digest())
     assert second["request"]["images"] == [{"name": "left_overhead", "sha256": LEFT.sha256(), "bytes": len(LEFT.png)},
                                            {"name": "wrist", "sha256": WRIST.sha256(), "bytes": len(WRIST.png)}]
     assert LEFT.b64() not in path.read_text(encoding="utf-8")  # images are not stored inline
@@ -359,27 +360,27 @@ def test_replay_takes_the_recorded_backend_attributes(tmp_path):
     assert replay.recorded_backend == "echo" and len(replay) == 1
 
 
-def test_replay_of_changed_prompt_names_index_stage_and_where(tmp_path):
+def test_replay_of_changed_prompt_names_index_step_and_where(tmp_path):
     path, _ = record(tmp_path, [text_request(), text_request(prompt="line one\nline two: apple")])
     replay = ReplayBackend(path)
     replay.complete(text_request())
     with pytest.raises(TranscriptMismatchError) as info:
         replay.complete(text_request(prompt="line one\nline two: pear"))
     msg = str(info.value)
-    assert "request 1 (stage propose)" in msg and "prompt differs at line 2 col 11" in msg
+    assert "request 1 (step propose)" in msg and "prompt differs at line 2 col 11" in msg
     assert "recorded 'line two: apple'" in msg and "now 'line two: pear'" in msg
 
 
 def test_replay_of_changed_image_bytes_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [vision_request()])
-    with pytest.raises(TranscriptMismatchError, match=r"request 0 \(stage plan\).*image bytes of \['wrist'\]"):
+    with pytest.raises(TranscriptMismatchError, match=r"request 0 \(step plan\).*image bytes of \['wrist'\]"):
         ReplayBackend(path).complete(vision_request(images=(LEFT, ImagePart("wrist", png((30, 31, 200))))))
 
 
-def test_replay_of_changed_stage_context_or_settings_is_a_mismatch(tmp_path):
+def test_replay_of_changed_step_context_or_settings_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [vision_request()])
-    with pytest.raises(TranscriptMismatchError, match="stage 'plan' -> 'analyze'"):
-        ReplayBackend(path).complete(vision_request(stage="analyze"))
+    with pytest.raises(TranscriptMismatchError, match="step 'plan' -> 'analyze'"):
+        ReplayBackend(path).complete(vision_request(step="analyze"))
     with pytest.raises(TranscriptMismatchError, match=r"context keys \['task'\]"):
         ReplayBackend(path).complete(vision_request(context={"task": "Other"}))
     with pytest.raises(TranscriptMismatchError, match="max_tokens 512 -> 100"):
@@ -392,7 +393,7 @@ def test_replay_past_the_end_is_a_mismatch(tmp_path):
     path, _ = record(tmp_path, [text_request()])
     replay = ReplayBackend(path)
     replay.complete(text_request())
-    with pytest.raises(TranscriptMismatchError, match=r"request 1 \(stage plan\) is past the end.*holds 1"):
+    with pytest.raises(TranscriptMismatchError, match=r"request 1 \(step plan\) is past the end.*holds 1"):
         replay.complete(vision_request())
 
 
@@ -400,7 +401,7 @@ def test_replay_not_consumed_is_reported(tmp_path):
     path, _ = record(tmp_path, [text_request(), vision_request()])
     replay = ReplayBackend(path)
     replay.complete(text_request())
-    with pytest.raises(TranscriptMismatchError, match=r"made 1 request\(s\) but 2 were recorded.*stage plan"):
+    with pytest.raises(TranscriptMismatchError, match=r"made 1 request\(s\) but 2 were recorded.*step plan"):
         replay.assert_consumed()
 
 
@@ -430,7 +431,7 @@ def test_replay_missing_transcript(tmp_path):
 
 
 @pytest.mark.parametrize(("mangle", "line", "what"), [
-    (lambda lines: lines[:1] + ['{"index": 0, "stage": "propose", "dig'], 2, "not valid JSON"),
+    (lambda lines: lines[:1] + ['{"index": 0, "step": "propose", "dig'], 2, "not valid JSON"),
     (lambda lines: lines[1:], 1, "first line must be the header"),
     (lambda lines: [], 1, "empty"),
     (lambda lines: lines[:1] + lines[2:], 2, "index 1, expected 0"),

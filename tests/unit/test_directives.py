@@ -7,8 +7,7 @@ import math
 import pytest
 
 from gendex_envs.errors import TaskSpecError
-from gendex_envs.registry import REPO_TASKS_DIR
-from gendex_envs.spec import SCALE_RANGE, TaskSpec, load_task_spec, spec_to_dict
+from gendex_envs.spec import SCALE_RANGE, TaskSpec, spec_to_dict
 from generator.critic.directives import (
     Directive,
     apply_directives,
@@ -21,8 +20,8 @@ NAMES = ("apple", "bowl", "red_block")
 
 
 @pytest.fixture(scope="module")
-def spec() -> TaskSpec:
-    return load_task_spec(REPO_TASKS_DIR / "PutAppleBowl" / "v0" / "task.yaml")
+def spec(task_version) -> TaskSpec:
+    return task_version("PutAppleBowl", 0).spec
 
 
 # ------------------------------------------------------------------------------------------------ parsing
@@ -193,7 +192,7 @@ def test_rotations_compose_in_the_world_frame(spec):
 
 
 def test_rotation_keeps_unit_norm(spec):
-    ds = [Directive.rotate("apple", axis, deg) for axis, deg in zip("xyzxyz" * 20, range(7, 847, 7))]
+    ds = [Directive.rotate("apple", axis, deg) for axis, deg in zip("xyzxyz" * 20, range(7, 847, 7), strict=True)]
     q = apply_directives(spec, ds).object("apple").quat_wxyz
     assert math.sqrt(sum(v * v for v in q)) == pytest.approx(1.0, abs=1e-12)
 

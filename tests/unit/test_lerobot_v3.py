@@ -15,9 +15,9 @@ import pytest
 import yaml
 from PIL import Image
 
-from gendex_envs.data import lerobot_v3 as lv3
-from gendex_envs.data.episode import Episode, EpisodeError
-from gendex_envs.data.lerobot_v3 import LeRobotDatasetError, LeRobotV3Writer, read_episode_frames, write_dataset_card
+from gendex.data import lerobot_v3 as lv3
+from gendex.data.episode import Episode, EpisodeError
+from gendex.data.lerobot_v3 import LeRobotDatasetError, LeRobotV3Writer, read_episode_frames, write_dataset_card
 
 S, A, H, W, FPS = 5, 3, 8, 6, 20
 STATE_NAMES = [f"q{i}" for i in range(S)]
@@ -132,7 +132,7 @@ def test_data_schema_and_values(dataset, episodes):
 def test_tasks_parquet_pandas_index(dataset):
     tasks = pq.read_table(dataset / "meta/tasks.parquet")
     assert tasks.schema.field("task_index").type == pa.int64()
-    assert dict(zip(tasks["task"].to_pylist(), tasks["task_index"].to_pylist())) == {
+    assert dict(zip(tasks["task"].to_pylist(), tasks["task_index"].to_pylist(), strict=True)) == {
         "put the apple in the bowl": 0, "open the drawer": 1}
     pandas_meta = json.loads(tasks.schema.metadata[b"pandas"])
     assert pandas_meta["index_columns"] == ["task"]
@@ -293,7 +293,8 @@ def test_no_cameras(tmp_path):
 def test_dataset_card(dataset):
     info, _, _ = meta(dataset)
     path = write_dataset_card(dataset, task_id="GenDex/PutAppleBowl-v0", instruction="put the apple in the bowl",
-                              robot="ShadowHand on UR10e", control_mode="pd_joint_pos",
+                              robot="ShadowHand on UR10e",
+                              env_kwargs={"control_mode": "pd_joint_pos", "control_joint": "both", "obs_mode": "state"},
                               n_episodes=info["total_episodes"], n_frames=info["total_frames"],
                               how_made="Scripted grasp solver, successful rollouts only.")
     text = path.read_text()
@@ -301,6 +302,8 @@ def test_dataset_card(dataset):
     assert front["license"] == "apache-2.0" and front["task_categories"] == ["robotics"]
     assert {"LeRobot", "gendex", "shadowhand"} <= set(front["tags"])
     assert "pd_joint_pos" in text and "Scripted grasp solver" in text and '"codebase_version": "v3.0"' in text
+    assert ("gym.make('GenDex/PutAppleBowl-v0', control_mode='pd_joint_pos', control_joint='both', "
+            "obs_mode='state')") in text  # the exact env the actions belong to
 
 
 def test_loads_with_lerobot(dataset):

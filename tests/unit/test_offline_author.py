@@ -9,9 +9,9 @@ from generator.backends.base import ModelRequest
 from generator.backends.offline import OfflineBackend
 from generator.catalog_view import asset_dicts
 from generator.reward_library import compose_stage_module, compose_task_module, roles_of
-from generator.stages.propose import propose
-from generator.stages.scene import adjust_sizes, parse_scene
-from generator.stages.validate import check_reward_source
+from generator.steps.propose import propose
+from generator.steps.scene import adjust_sizes, parse_scene
+from generator.steps.validate import check_reward_source
 
 
 def _proposals(seed: int, n: int) -> list:
@@ -39,19 +39,19 @@ def test_guided_proposal_substitutes_the_closest_catalog_object():
     assert p.success["type"] == "lifted"
 
 
-def test_composed_reward_modules_pass_the_static_validator_for_every_stage_kind():
+def test_composed_reward_modules_pass_the_static_validator_for_every_skill():
     b = OfflineBackend(seed=0)
     kinds = set()
     for i, p in enumerate(_proposals(0, 12)):
         ids = {o.asset for o in p.objects}
         context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
                    "candidate_index": 0, "index": i, "attempt": 0}
-        text = b.complete(ModelRequest(stage="scene", prompt="", context=context)).text
+        text = b.complete(ModelRequest(step="scene", prompt="", context=context)).text
         spec = spec_to_dict(adjust_sizes(parse_scene(text, p), p))
         roles = roles_of(dataclasses.asdict(p))
         check_reward_source(compose_task_module(spec, roles))
         for st in spec["stages"]:
             if st["method"] == "RL":
-                kinds.add(st["name"].split("_")[0])
+                kinds.add(st["skill"])
                 check_reward_source(compose_stage_module(spec, st["name"], roles), filename=st["name"])
-    assert {"grasp", "lift", "release", "pull"} <= kinds
+    assert {"grasp", "lift", "release", "open"} <= kinds

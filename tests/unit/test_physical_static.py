@@ -7,11 +7,9 @@ import json
 
 import pytest
 
-from gendex_envs.registry import REPO_TASKS_DIR
 from gendex_envs.spec import (
     SCALE_RANGE,
     TaskSpec,
-    load_task_spec,
     parse_task_spec,
     spec_to_dict,
 )
@@ -26,16 +24,25 @@ from generator.critic.physical import (
 )
 from generator.errors import DirectiveError
 
-SEEDS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
+REFERENCE_TASKS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
 
 
-def seed(name: str) -> TaskSpec:
-    return load_task_spec(REPO_TASKS_DIR / name / "v0" / "task.yaml")
+REFERENCE: dict[str, TaskSpec] = {}
+"""Specs of the reference tasks' version 0, filled from the ``task_version`` fixture."""
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _reference_specs(task_version):
+    REFERENCE.update({name: task_version(name, 0).spec for name in REFERENCE_TASKS})
+
+
+def reference(name: str) -> TaskSpec:
+    return REFERENCE[name]
 
 
 def edited(name: str, **changes) -> TaskSpec:
-    """Seed task ``name`` with per-object field changes: edited('X', apple={'pos_m': [...]})."""
-    raw = spec_to_dict(seed(name))
+    """Reference task ``name`` with per-object field changes: edited('X', apple={'pos_m': [...]})."""
+    raw = spec_to_dict(reference(name))
     for obj in raw["objects"]:
         obj.update(changes.get(obj["name"], {}))
     return parse_task_spec(raw)
@@ -45,18 +52,18 @@ def checks(report) -> list[tuple[str, str | None]]:
     return [(v.check, v.object) for v in report.violations]
 
 
-@pytest.mark.parametrize("name", SEEDS)
-def test_seed_tasks_pass(name):
-    report = check_scene_static(seed(name))
+@pytest.mark.parametrize("name", REFERENCE_TASKS)
+def test_reference_tasks_pass(name):
+    report = check_scene_static(reference(name))
     assert report.violations == [], report.summary()
     assert report.ok and report.mode == "static"
     assert report.summary() == "no physical problems found"
     json.dumps(report.to_dict())  # JSON-able
 
 
-def test_seed_objects_are_within_the_reach_limit_with_margin_to_spare():
-    for name in SEEDS:
-        meas = check_scene_static(seed(name)).measurements["out_of_reach"]
+def test_reference_objects_are_within_the_reach_limit_with_margin_to_spare():
+    for name in REFERENCE_TASKS:
+        meas = check_scene_static(reference(name)).measurements["out_of_reach"]
         for obj, m in meas.items():
             assert REACH_MIN_M < m["centre_m"] and m["nearest_m"] + m["randomize_m"] <= REACH_MAX_M, (name, obj, m)
 
@@ -81,7 +88,7 @@ def test_object_at_the_robot_base_is_too_close():
 
 
 def test_untargeted_distractor_far_away_is_not_a_reach_problem():
-    raw = spec_to_dict(seed("PickUpBottle"))
+    raw = spec_to_dict(reference("PickUpBottle"))
     raw["objects"].append({"name": "decor", "asset": "plate", "pos_m": [0.7, 0.5, 0.0]})
     report = check_scene_static(parse_task_spec(raw))
     assert report.violations == [], report.summary()
@@ -97,7 +104,7 @@ def test_floating_object_is_unsupported_and_move_z_fixes_it():
 
 
 def test_stacked_and_contained_objects_are_supported():
-    raw = spec_to_dict(seed("PickUpBottle"))
+    raw = spec_to_dict(reference("PickUpBottle"))
     raw["objects"] += [{"name": "base_block", "asset": "block_large", "pos_m": [0.1, 0.2, 0.0]},
                        {"name": "top_block", "asset": "block_small", "pos_m": [0.1, 0.2, 0.06]}]
     assert check_scene_static(parse_task_spec(raw)).violations == []
@@ -128,11 +135,12 @@ def test_overlapping_objects_penetrate_and_the_fix_separates_them():
 
 
 def test_penetration_fix_moves_the_movable_smaller_object_clear_of_randomization():
-    raw = spec_to_dict(seed("PutAppleBowl"))
+    raw = spec_to_dict(reference("PutAppleBowl"))
     raw["objects"] = [raw["objects"][1],
                       {"name": "block", "asset": "block_large", "pos_m": [0.14, -0.14, 0.0],
                        "randomize": {"xy_m": [0.02, 0.02]}}]
     raw["stages"] = raw["stages"][2:3]
+    raw["stages"][0]["success"] = None  # its conditions are about the apple
     raw["success"]["conditions"] = [{"type": "inside", "object": "block", "target": "bowl"}]
     spec = parse_task_spec(raw)
     (v,) = check_scene_static(spec).violations
@@ -144,7 +152,7 @@ def test_penetration_fix_moves_the_movable_smaller_object_clear_of_randomization
 
 
 def test_raw_scales_out_of_range_get_a_factor_back_into_range():
-    raw = spec_to_dict(seed("PutAppleBowl"))
+    raw = spec_to_dict(reference("PutAppleBowl"))
     raw["objects"][0]["scale"] = 3.0
     raw["objects"][1]["scale"] = 0.1
     big, small = check_raw_scales(raw)
@@ -153,7 +161,7 @@ def test_raw_scales_out_of_range_get_a_factor_back_into_range():
     spec = apply_directives(raw, [*big.fix, *small.fix])
     assert SCALE_RANGE[0] <= spec.object("bowl").scale <= SCALE_RANGE[1]
     assert spec.object("apple").scale == pytest.approx(2.0, abs=1e-3)
-    assert check_raw_scales(spec_to_dict(seed("PutAppleBowl"))) == []
+    assert check_raw_scales(spec_to_dict(reference("PutAppleBowl"))) == []
     raw["objects"][0]["scale"] = "big"
     (bad, _) = check_raw_scales(raw)
     assert bad.fix == () and "'big'" in bad.message
@@ -182,48 +190,51 @@ def test_grasped_object_too_small_and_absurd_scales():
     assert big_bowl.directives() == [] and big_bowl.directives(include_warnings=True) == list(w.fix)
 
 
-def _cabinet(door: float, first_instruction: str | None = None) -> TaskSpec:
-    raw = spec_to_dict(seed("OpenCabinet"))
+def _cabinet(door: float, first_skill: str | None = None) -> TaskSpec:
+    raw = spec_to_dict(reference("OpenCabinet"))
     raw["objects"][0]["joint_state"] = {"door_hinge": door}
-    if first_instruction is not None:
-        raw["stages"][0]["instruction"] = first_instruction
+    if first_skill is not None:
+        raw["stages"][0]["skill"] = first_skill
+        raw["stages"][0]["success"] = None
     return parse_task_spec(raw)
 
 
 def test_cabinet_starting_open_for_an_open_stage():
-    spec = _cabinet(1.2, "Open the door.")
+    spec = _cabinet(1.2, "open")
     report = check_scene_static(spec)
     (v,) = report.violations
     assert (v.check, v.object, v.fix) == ("joint_state", "cabinet", ())
-    assert v.measured == pytest.approx(1.2 / 1.4) and "'Open the door.'" in v.message
+    assert v.measured == pytest.approx(1.2 / 1.4) and "stage 'approach_handle' (skill 'open')" in v.message
     assert report.joint_fixes() == [{"object": "cabinet", "joint": "door_hinge", "value": 0.0}]
     fixed = apply_joint_fix(spec, report.joint_fixes())
     assert fixed.object("cabinet").joint_state == {"door_hinge": 0.0}
     assert check_scene_static(fixed).violations == []
 
 
-def test_hand_words_are_not_intents_and_conditions_are_the_fallback():
-    # the seed's first stage says "Move the open hand ...": not about the door; the pull stage ("... is open") is
+def test_the_first_open_or_close_skill_states_the_intent_and_conditions_are_the_fallback():
+    # the reference task's first stage reaches the handle (skill reach: no intent); its pull stage has skill open
     spec = _cabinet(1.0)
     (v,) = check_scene_static(spec).violations
-    assert "pull_door" in v.message
+    assert "stage 'pull_door' (skill 'open')" in v.message
     raw = spec_to_dict(spec)
     for s in raw["stages"]:
-        s["instruction"] = "Move the open hand to the handle."
+        s["instruction"] = "Open the door."  # words do not matter, skills do
+        s["skill"] = "grasp" if s["skill"] == "open" else s["skill"]
+        s["success"] = None
     (v,) = check_scene_static(parse_task_spec(raw)).violations
     assert "joint_open success condition" in v.message
     assert check_scene_static(_cabinet(0.5)).violations == []  # 36 % open: still to be opened
 
 
 def test_close_stage_with_the_door_already_closed():
-    spec = _cabinet(0.0, "Close the cabinet door.")
+    spec = _cabinet(0.0, "close")
     (v,) = check_scene_static(spec).violations
     assert v.check == "joint_state" and v.joint_fix == {"object": "cabinet", "joint": "door_hinge", "value": 1.4}
     assert apply_joint_fix(spec, v.joint_fix).object("cabinet").joint_state["door_hinge"] == 1.4
 
 
 def test_apply_joint_fix_rejects_bad_fixes():
-    spec = seed("OpenCabinet")
+    spec = reference("OpenCabinet")
     with pytest.raises(DirectiveError, match="'drawer'"):
         apply_joint_fix(spec, {"object": "drawer", "joint": "door_hinge", "value": 0.0})
     with pytest.raises(DirectiveError, match="no joint 'lid'"):
@@ -231,7 +242,7 @@ def test_apply_joint_fix_rejects_bad_fixes():
     with pytest.raises(DirectiveError, match="outside"):
         apply_joint_fix(spec, {"object": "cabinet", "joint": "door_hinge", "value": 3.0})
     with pytest.raises(DirectiveError, match="no joint"):
-        apply_joint_fix(seed("PickUpBottle"), {"object": "bottle", "joint": "x", "value": 0.0})
+        apply_joint_fix(reference("PickUpBottle"), {"object": "bottle", "joint": "x", "value": 0.0})
 
 
 def test_report_does_not_modify_the_spec():

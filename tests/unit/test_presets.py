@@ -2,7 +2,7 @@
 
 import pytest
 
-from generator.rl.presets import PRESETS, TrainingError, get_preset
+from gendex.train.presets import PRESETS, TrainingError, get_preset
 
 
 def test_paper_preset_matches_the_seed_table():

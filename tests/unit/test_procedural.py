@@ -4,7 +4,7 @@ asset frame, real-world sizes and masses, open container cavities, and byte-iden
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
@@ -43,14 +43,14 @@ def _parse_obj(path) -> list[tuple[str, np.ndarray, np.ndarray]]:
     return out
 
 
-@lru_cache(maxsize=None)
+@cache
 def _hulls(asset_id: str) -> list[trimesh.Trimesh]:
     blocks = _parse_obj(OBJECTS / BY_ID[asset_id].collision)
     assert [b[0] for b in blocks] == [f"hull_{k}" for k in range(len(blocks))]
     return [trimesh.Trimesh(v, f, process=False) for _, v, f in blocks]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _visual(asset_id: str) -> trimesh.Trimesh:
     blocks = _parse_obj(OBJECTS / BY_ID[asset_id].visual)
     assert len(blocks) == 1

@@ -44,6 +44,6 @@ def test_manifest_that_disagrees_with_its_template_is_rejected(tmp_path):
 
 def test_rendered_guided_prompt_carries_the_instruction_and_the_library():
     text = render("propose_guided", instruction="grab the apple", asset_guidance="- apple | apple",
-                  existing_tasks="- (none)", actions="approach, grasp", condition_types="lifted",
+                  existing_tasks="- (none)", skills="  - reach: ...", condition_types="lifted",
                   control_joints="arm, hand")
     assert '"grab the apple"' in text and "- apple | apple" in text and "{{" not in text

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gendex_envs.agents import robot_model as rm
-from gendex_envs.agents.ur10e_shadow import ALL_JOINTS, COUPLED_DISTAL, CONTROL_JOINT_GROUPS, TIP_LINKS
+from gendex_envs.agents.ur10e_shadow import ALL_JOINTS, CONTROL_JOINT_GROUPS, COUPLED_DISTAL, TIP_LINKS
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +52,7 @@ def test_ur10e_flange_matches_published_dh(seed):
     dh = [(rm.D1, 0, np.pi / 2), (0, rm.A2, 0), (0, rm.A3, 0), (rm.D4, 0, np.pi / 2), (rm.D5, 0, -np.pi / 2),
           (rm.D6, 0, 0)]
     expected = np.eye(4)
-    for qi, (d, a, alpha) in zip(q, dh):
+    for qi, (d, a, alpha) in zip(q, dh, strict=True):
         expected = expected @ _dh(qi, d, a, alpha)
 
     scene = sapien.Scene()

@@ -16,6 +16,7 @@ from gendex_envs.spec import (
     CONTROL_JOINT_MODES,
     KEYFRAMES,
     ROBOT_UIDS,
+    SKILLS,
     STAGE_METHODS,
     ConditionSpec,
     ObjectSpec,
@@ -25,6 +26,7 @@ from gendex_envs.spec import (
     parse_task_spec,
     spec_to_dict,
 )
+from gendex_envs.task_version import TaskLayout
 
 PUT_APPLE_BOWL = """\
 name: PutAppleBowl
@@ -47,22 +49,26 @@ objects:
 stages:
   - name: reach
     instruction: Move the open hand above the apple.
+    skill: reach
     method: motion_planning
     control_joint: arm
     horizon: 60
     target: apple
   - name: grasp
     instruction: Close the fingers around the apple.
+    skill: grasp
     method: RL
     control_joint: hand
     target: apple
   - name: move
     instruction: Carry the apple above the bowl.
+    skill: carry
     method: motion_planning
     control_joint: arm
     target: bowl
   - name: release
     instruction: Open the hand to drop the apple into the bowl.
+    skill: release
     method: RL
     control_joint: hand
     horizon: 40
@@ -83,7 +89,7 @@ def raw() -> dict:
 
 
 def write(tmp_path: Path, data: dict | str) -> Path:
-    path = tmp_path / "task.yaml"
+    path = TaskLayout(tmp_path).spec
     path.write_text(data if isinstance(data, str) else yaml.safe_dump(data, sort_keys=False))
     return path
 
@@ -145,7 +151,7 @@ def test_round_trip_dump_parse(raw: dict) -> None:
 
 def test_load_file_round_trip(tmp_path: Path, raw: dict) -> None:
     spec = parse_task_spec(raw)
-    path = tmp_path / "task.yaml"
+    path = TaskLayout(tmp_path).spec
     path.write_text(dump_task_spec(spec))
     assert load_task_spec(path) == spec
 
@@ -153,7 +159,10 @@ def test_load_file_round_trip(tmp_path: Path, raw: dict) -> None:
 def test_allowed_value_constants() -> None:
     assert CONTROL_JOINT_MODES == ("arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire")
     assert STAGE_METHODS == ("motion_planning", "RL")
-    assert CONDITION_TYPES == ("lifted", "inside", "joint_open", "near")
+    assert CONDITION_TYPES == ("lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
+                               "hand_at", "fingertips_near", "hand_open")
+    assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
+                      "reorient")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
@@ -383,9 +392,59 @@ def test_empty_and_missing_file(tmp_path: Path) -> None:
         load_task_spec(tmp_path / "nope.yaml")
 
 
-def test_docs_example_is_valid() -> None:
-    doc = (Path(__file__).resolve().parents[2] / "docs" / "task_spec.md").read_text()
+def test_docs_example_is_valid(repo_root: Path) -> None:
+    doc = (repo_root / "docs" / "task_spec.md").read_text()
     block = re.search(r"```yaml\n(.*?)```", doc, re.S)
     assert block is not None
     spec = parse_task_spec(yaml.safe_load(block.group(1)), source="docs/task_spec.md")
     assert spec.name == "PutAppleBowl" and spec.goal is not None and len(spec.stages) == 4
+
+
+# --------------------------------------------------------------------- skills and declared success
+def test_skill_is_required_and_checked(raw: dict) -> None:
+    del raw["stages"][0]["skill"]
+    with pytest.raises(TaskSpecError, match=r"stages\[0\]\.skill: required field is missing.*'reach', 'grasp'"):
+        parse_task_spec(raw)
+    raw["stages"][0]["skill"] = "approach"
+    with pytest.raises(TaskSpecError, match=r"stages\[0\]\.skill = 'approach' is not allowed; allowed values: 'reach'"):
+        parse_task_spec(raw)
+
+
+def test_stage_success_conditions_parse_and_default_to_the_task(raw: dict) -> None:
+    raw["stages"][1]["success"] = [{"type": "grasped", "object": "apple", "min_fingers": 3, "max_palm_force_n": 10},
+                                   {"type": "hand_open", "min_spread_m": 0.1, "negate": True}]
+    spec = parse_task_spec(raw)
+    grasp = spec.stages[1]
+    assert grasp.success[0] == ConditionSpec(type="grasped", object="apple", min_fingers=3, max_palm_force_n=10.0)
+    assert grasp.success[1].negate is True and grasp.success[1].object is None
+    assert spec.stage_conditions(grasp) == grasp.success
+    assert spec.stages[0].success is None and spec.stage_conditions(spec.stages[0]) == spec.success.conditions
+    text = dump_task_spec(spec)
+    assert "negate: false" not in text and "negate: true" in text
+    assert parse_task_spec(yaml.safe_load(text)) == spec
+
+
+@pytest.mark.parametrize(("cond", "pattern"), [
+    ({"type": "lifted", "object": "apple", "min_height_m": 0.1, "min_fraction": 0.5},
+     r"min_fraction = 0\.5 does not apply to type 'lifted' \(the object has risen.*its fields: object, min_height_m"),
+    ({"type": "over", "object": "apple", "target": "bowl", "max_xy_m": 0.05, "min_dz_m": 0.1},
+     r"max_dz_m is required for type 'over'"),
+    ({"type": "over", "object": "apple", "target": "bowl", "max_xy_m": 0.05, "min_dz_m": 0.2, "max_dz_m": 0.1},
+     r"max_dz_m = 0\.1 is not allowed; must be > min_dz_m \(0\.2\)"),
+    ({"type": "grasped", "object": "apple", "min_fingers": 5}, r"min_fingers = 5 is not allowed; must be between 1"),
+    ({"type": "rotated", "object": "apple", "min_deg": 0}, r"min_deg = 0\.0 is not allowed; must be non-zero"),
+    ({"type": "hand_at", "object": "apple", "max_dist_m": -0.1}, r"max_dist_m = -0\.1 is not allowed; must be > 0"),
+    ({"type": "hand_open"}, r"min_spread_m is required for type 'hand_open'"),
+    ({"type": "grasped", "object": "apple", "part": "lid"}, r"part = 'lid' is not allowed; allowed values: 'handle'"),
+    ({"type": "released", "object": "pear"}, r"object = 'pear' does not name an object"),
+])
+def test_stage_condition_fields_are_checked_per_type(raw: dict, cond: dict, pattern: str) -> None:
+    raw["stages"][3]["success"] = [cond]
+    with pytest.raises(TaskSpecError, match=r"stages\[3\]\.success\[0\]\." + pattern):
+        parse_task_spec(raw)
+
+
+def test_empty_stage_success_is_refused(raw: dict) -> None:
+    raw["stages"][0]["success"] = []
+    with pytest.raises(TaskSpecError, match=r"stages\[0\]\.success = \[\] is not allowed; leave it out"):
+        parse_task_spec(raw)

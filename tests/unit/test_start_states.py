@@ -4,10 +4,9 @@ import numpy as np
 import pytest
 
 from gendex_envs.errors import StageError
-from gendex_envs.spec import load_task_spec
-from gendex_envs.stage import StartStates, resolve_stage, stage_reward_path
-
-BOTTLE = "generated_tasks/PickUpBottle/v0"
+from gendex_envs.spec import resolve_stage
+from gendex_envs.start_states import StartStates
+from gendex_envs.task_version import TaskLayout
 
 
 def _states(m=3, d=7):
@@ -19,7 +18,7 @@ def _states(m=3, d=7):
 
 def test_round_trip_and_no_leftovers(tmp_path):
     s = _states()
-    path = s.save(tmp_path / "start_states" / "grasp_bottle.npz")
+    path = s.save(TaskLayout(tmp_path).start_states("grasp_bottle"))
     back = StartStates.load(path)
     assert back.stage == "grasp_bottle" and back.source == "executor" and len(back) == 3
     np.testing.assert_array_equal(back.state, s.state)
@@ -52,8 +51,8 @@ def test_load_rejects_foreign_files(tmp_path):
         StartStates.load(tmp_path / "missing.npz")
 
 
-def test_resolve_stage_by_name_index_and_errors():
-    spec = load_task_spec(f"{BOTTLE}/task.yaml")
+def test_resolve_stage_by_name_index_and_errors(task_version):
+    spec = task_version("PickUpBottle", 0).spec
     assert resolve_stage(spec, 1)[1].name == "grasp_bottle"
     assert resolve_stage(spec, "2")[1].name == "lift_bottle"
     assert resolve_stage(spec, "approach_bottle")[0] == 0
@@ -63,8 +62,10 @@ def test_resolve_stage_by_name_index_and_errors():
         resolve_stage(spec, 3)
 
 
-def test_stage_reward_falls_back_to_task_reward(tmp_path):
-    (tmp_path / "stage_rewards").mkdir()
-    (tmp_path / "stage_rewards" / "grasp.py").write_text("")
-    assert stage_reward_path(tmp_path, "grasp").name == "grasp.py"
-    assert stage_reward_path(tmp_path, "lift") == tmp_path / "reward.py"
+def test_stage_reward_falls_back_to_task_reward(task_copy):
+    version = task_copy("PickUpBottle", as_name="ScratchBottle")
+    layout: TaskLayout = version.files
+    layout.stage_reward("lift_bottle").unlink()
+    assert version.reward_path("grasp_bottle") == layout.stage_reward("grasp_bottle")
+    assert version.reward_path("lift_bottle") == layout.reward
+    assert version.reward("lift_bottle").path == layout.reward.resolve()

@@ -13,6 +13,7 @@ import trimesh
 
 from gendex_envs.assets import user_datasets as ud
 from gendex_envs.assets.manifest import AssetEntry, read_manifest, write_manifest
+from gendex_envs.assets.user_datasets import common, partnet_mobility
 from gendex_envs.errors import AssetNotFoundError
 
 BOX = (0.06, 0.16, 0.21)  # cracker box extents, centred on the origin like ManiSkill's YCB meshes
@@ -198,7 +199,7 @@ def test_unreadable_collision_mesh_names_the_file(data):
 def test_ycb_id_and_tags_helpers():
     assert ud.ycb_category("002_master_chef_can") == "master_chef_can"
     assert ud.ycb_category("065-a_cups") == "cups"
-    assert ud._asset_id("ycb", "065-a_cups") == "ycb_065_a_cups"
+    assert common._asset_id("ycb", "065-a_cups") == "ycb_065_a_cups"
     assert "tool" in ud.ycb_tags("035_power_drill")
     assert "ball" in ud.ycb_tags("056_tennis_ball")
     assert {"kitchenware", "utensil"} <= set(ud.ycb_tags("031_spoon"))
@@ -269,9 +270,9 @@ def test_malformed_metadata_json_raises_typed_error_naming_the_file(data):
 
 
 def test_shipped_maniskill_metadata_is_found():
-    meta_dir = ud._maniskill_package_meta_dir()
+    meta_dir = common._maniskill_package_meta_dir()
     assert meta_dir is not None and (meta_dir / "info_cabinet_door_train.json").is_file()
-    meta = ud._pm_metadata(sorted(meta_dir.glob("info_*.json")))
+    meta = partnet_mobility._pm_metadata(sorted(meta_dir.glob("info_*.json")))
     assert meta["1000"].category == "cabinet" and meta["5000"].category == "faucet"
 
 

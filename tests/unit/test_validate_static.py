@@ -7,16 +7,19 @@ from pathlib import Path
 
 import pytest
 
+import gendex_envs
+from gendex_envs.registry import registered_tasks
 from generator.errors import RewardCodeError, UnsafeCodeError
-from generator.stages.validate import check_reward_file, check_reward_source
+from generator.steps.validate import check_reward_file, check_reward_source
 
-REPO = Path(__file__).resolve().parents[2]
+SHIPPED = [m for v in sorted(registered_tasks().values(), key=lambda v: v.env_id) for m in v.files.reward_modules()]
+PREVIEW = Path(gendex_envs.__file__).parent / "preview_reward.py"
 
 HEAD = "import torch\n\n"
 EVALUATE = (
     "def evaluate(env):\n"
     "    s = env.spec_success()\n"
-    "    return {'success': s, 'fail': torch.zeros_like(s)}\n"
+    "    return {'fail': torch.zeros_like(s)}\n"
 )
 REWARD = (
     "def compute_dense_reward(env, obs, action, info):\n"
@@ -43,8 +46,7 @@ def rejected(source: str, error: type[RewardCodeError] = UnsafeCodeError) -> str
 
 
 # ------------------------------------------------------------------------------------------------ accepted code
-@pytest.mark.parametrize("path", sorted(REPO.glob("generated_tasks/*/v*/reward.py")) +
-                         [REPO / "gendex_envs" / "default_reward.py"], ids=lambda p: p.parent.parent.name)
+@pytest.mark.parametrize("path", [*SHIPPED, PREVIEW], ids=lambda p: f"{p.parent.parent.name}/{p.stem}")
 def test_shipped_reward_modules_pass(path):
     check_reward_file(path)
 
@@ -278,7 +280,8 @@ def test_missing_reward_is_named():
 
 
 @pytest.mark.parametrize(("source", "pattern"), [
-    (HEAD + "def evaluate(env, info):\n    return {}\n" + REWARD, r"`evaluate` must be defined as `def evaluate\(env\):`"),
+    (HEAD + "def evaluate(env, info):\n    return {}\n" + REWARD,
+     r"`evaluate` must be defined as `def evaluate\(env\):`"),
     (HEAD + EVALUATE + "def compute_dense_reward(env, obs):\n    return obs\n", r"takes 2 positional"),
     (HEAD + EVALUATE + "def compute_dense_reward(*args):\n    return 0\n", r"\*args"),
     (module("def _get_obs_extra(env):\n    return {}\n"), r"`_get_obs_extra` must be defined as"),

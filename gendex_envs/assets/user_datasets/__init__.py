@@ -34,15 +34,36 @@ import logging
 from pathlib import Path
 
 from gendex_envs.assets.manifest import AssetEntry
-from gendex_envs.assets.user_datasets.common import _asset_id, _maniskill_package_meta_dir, maniskill_asset_dir
-from gendex_envs.assets.user_datasets.partnet_mobility import (PM_CONTAINERS, PM_DEFAULT_DENSITY, PM_DIR,
-                                                               PM_FRICTION, PM_LICENCE, PM_META_CATEGORY,
-                                                               PM_OPEN_FRACTION, PM_PRIORITY_LABELS, PM_SOURCE,
-                                                               PM_URDF_NAMES, PM_USER_META_DIR, _pm_metadata,
-                                                               load_partnet_mobility)
-from gendex_envs.assets.user_datasets.ycb import (YCB_COLLISIONS, YCB_DEFAULT_DENSITY, YCB_DIR, YCB_FRICTION,
-                                                  YCB_HARD_TO_GRASP, YCB_INFO, YCB_LICENCE, YCB_MODELS, YCB_SOURCE,
-                                                  YCB_VISUAL, load_ycb, ycb_category, ycb_tags)
+from gendex_envs.assets.user_datasets.common import maniskill_asset_dir
+from gendex_envs.assets.user_datasets.partnet_mobility import (
+    PM_CONTAINERS,
+    PM_DEFAULT_DENSITY,
+    PM_DIR,
+    PM_FRICTION,
+    PM_LICENCE,
+    PM_META_CATEGORY,
+    PM_OPEN_FRACTION,
+    PM_PRIORITY_LABELS,
+    PM_SOURCE,
+    PM_URDF_NAMES,
+    PM_USER_META_DIR,
+    load_partnet_mobility,
+)
+from gendex_envs.assets.user_datasets.ycb import (
+    YCB_COLLISIONS,
+    YCB_DEFAULT_DENSITY,
+    YCB_DIR,
+    YCB_FRICTION,
+    YCB_HARD_TO_GRASP,
+    YCB_INFO,
+    YCB_LICENCE,
+    YCB_MODELS,
+    YCB_SOURCE,
+    YCB_VISUAL,
+    load_ycb,
+    ycb_category,
+    ycb_tags,
+)
 
 log = logging.getLogger(__name__)
 
@@ -53,8 +74,6 @@ __all__ = [
     "YCB_LICENCE", "YCB_MODELS", "YCB_SOURCE", "YCB_VISUAL",
     "load_partnet_mobility", "load_ycb", "maniskill_asset_dir", "user_dataset_entries", "ycb_category", "ycb_tags",
 ]
-# Private helpers re-exported for tests/unit/test_user_datasets.py: _asset_id, _maniskill_package_meta_dir,
-# _pm_metadata (imported above; not part of __all__).
 
 
 def user_dataset_entries(root: Path | None = None) -> list[AssetEntry]:

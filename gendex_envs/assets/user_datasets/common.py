@@ -84,7 +84,7 @@ def _tuple3(a: np.ndarray) -> tuple[float, float, float]:
 def _load_parts(path: Path) -> list:
     """The convex parts SAPIEN makes of a collision file: one per ``o`` block of an .obj, one per connected
     component of any other format (what ``add_multiple_convex_collisions_from_file`` does)."""
-    import trimesh  # noqa: PLC0415 (heavy; only needed when a dataset is present)
+    import trimesh
 
     try:
         if path.suffix.lower() == ".obj":

@@ -24,9 +24,21 @@ from pathlib import Path
 import numpy as np
 
 from gendex_envs.assets.manifest import AssetEntry, JointEntry
-from gendex_envs.assets.user_datasets.common import (_bounds, _dataset_entry, _grounded, _hull_volume, _load_json,
-                                                   _load_parts, _maniskill_package_meta_dir, _number,
-                                                   _parts_vertices, _snake, _tuple3, _vec3, maniskill_asset_dir)
+from gendex_envs.assets.user_datasets.common import (
+    _bounds,
+    _dataset_entry,
+    _grounded,
+    _hull_volume,
+    _load_json,
+    _load_parts,
+    _maniskill_package_meta_dir,
+    _number,
+    _parts_vertices,
+    _snake,
+    _tuple3,
+    _vec3,
+    maniskill_asset_dir,
+)
 from gendex_envs.errors import AssetNotFoundError
 
 log = logging.getLogger(__name__)
@@ -395,7 +407,7 @@ def _pm_entry(model_id: str, model_dir: Path, urdf: Path, meta: _PMMeta | None) 
     by_parent: dict[str, list[_Joint]] = {}
     for j in joints:
         by_parent.setdefault(j.parent, []).append(j)
-    for i, j in enumerate(joints):
+    for j in joints:
         if j.type not in ("revolute", "prismatic", "continuous"):
             continue
         stack = [j.child]  # the child and everything below it moves with this joint

@@ -18,9 +18,19 @@ from pathlib import Path
 import numpy as np
 
 from gendex_envs.assets.manifest import AssetEntry
-from gendex_envs.assets.user_datasets.common import (_bounds, _dataset_entry, _grounded, _hull_volume, _load_json,
-                                                   _load_parts, _number, _parts_vertices, _snake, _vec3,
-                                                   maniskill_asset_dir)
+from gendex_envs.assets.user_datasets.common import (
+    _bounds,
+    _dataset_entry,
+    _grounded,
+    _hull_volume,
+    _load_json,
+    _load_parts,
+    _number,
+    _parts_vertices,
+    _snake,
+    _vec3,
+    maniskill_asset_dir,
+)
 from gendex_envs.errors import AssetNotFoundError
 
 log = logging.getLogger(__name__)

@@ -10,11 +10,10 @@ LIFT_M = 0.1
 
 def evaluate(env):
     height = env.obj_height("bottle")
-    lifted = env.spec_success()
     q = env.obj_pose("bottle").q  # [N, 4] wxyz
     up_z = 1.0 - 2.0 * (q[:, 1] ** 2 + q[:, 2] ** 2)  # z component of the bottle's axis
     toppled = (up_z < 0.5) & (height < 0.02)  # tilted past 60 degrees while still on the table
-    return {"success": lifted, "fail": toppled, "bottle_height": height}
+    return {"fail": toppled, "bottle_height": height}
 
 
 def compute_dense_reward(env, obs, action, info):

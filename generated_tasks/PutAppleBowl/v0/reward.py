@@ -9,10 +9,9 @@ LIFT_M = 0.1
 
 
 def evaluate(env):
-    inside = env.spec_success()  # the apple rests in the bowl
     apple = env.obj_pose("apple").p
     fell_off = apple[:, 2] < env.table_height - 0.05  # rolled off the table
-    return {"success": inside, "fail": fell_off, "apple_height": env.obj_height("apple")}
+    return {"fail": fell_off, "apple_height": env.obj_height("apple")}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -68,9 +68,7 @@ def evaluate(env):
     below = (offset * normal).sum(dim=-1) < -BALL_RADIUS_M
     dropped = (dist > DROP_DIST_M) | below
     rotation = z_twist(env.obj_pose("ball").q, env.init_obj_quat("ball"))
-    success = (rotation >= TARGET_RAD) & ~dropped
-    return {"success": success, "fail": dropped, "rotation": rotation, "palm_dist": dist,
-            "spec_success": env.spec_success()}
+    return {"fail": dropped, "rotation": rotation, "palm_dist": dist}
 
 
 def compute_dense_reward(env, obs, action, info):

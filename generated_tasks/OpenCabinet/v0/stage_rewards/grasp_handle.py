@@ -1,4 +1,4 @@
-"""OpenCabinet, stage grasp_handle: success = at least three fingers pressing on the handle link, curled round the bar.
+"""OpenCabinet, stage grasp_handle: goal = at least three fingers pressing on the handle link, curled round the bar.
 
 Contact alone also holds for a hand flat on the door, so the fingertips must be curled in: mean tip-to-grip-point
 distance <= 0.07 m. The executor's hook ends with ff/mf/rf/lf at 12-14 / 11-13 / 5-8 / 1.5 N and the tips 0.047 m
@@ -11,7 +11,6 @@ from gendex_envs import reward_terms as rt
 
 REWARD_MAX = 3.0
 MIN_FORCE_N = 0.3
-TIPS_MAX_M = 0.07
 
 
 def evaluate(env):
@@ -19,8 +18,7 @@ def evaluate(env):
     force = env.agent.get_hand_group_obj_mean_force(env.handle_link("cabinet"))  # [N, 6, 1] th ff mf rf lf palm
     fingers = (force[:, 1:5, 0] > MIN_FORCE_N).float().sum(dim=1)  # a hook needs no thumb
     tips_dist = torch.linalg.norm(env.tip_positions - handle[:, None, :], dim=-1).mean(dim=1)
-    success = (fingers >= 3) & (tips_dist <= TIPS_MAX_M)
-    return {"success": success, "fingers": fingers, "tips_dist": tips_dist}
+    return {"fingers": fingers, "tips_dist": tips_dist}
 
 
 def compute_dense_reward(env, obs, action, info):

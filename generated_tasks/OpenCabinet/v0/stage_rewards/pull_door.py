@@ -1,4 +1,4 @@
-"""OpenCabinet, stage pull_door: success = the door open to at least 80 % of its open angle (the task's success).
+"""OpenCabinet, stage pull_door: goal = the door open to at least 80 % of its open angle (the task's success).
 
 The executor's pull ends at 0.92-0.93 of the open angle with four fingers still hooked; it starts at 0.
 """
@@ -16,7 +16,7 @@ def evaluate(env):
     opened = env.joint_open_fraction("cabinet")
     force = env.agent.get_hand_group_obj_mean_force(env.handle_link("cabinet"))
     fingers = (force[:, 1:5, 0] > MIN_FORCE_N).float().sum(dim=1)
-    return {"success": opened >= OPEN_FRACTION, "open_fraction": opened, "fingers": fingers}
+    return {"open_fraction": opened, "fingers": fingers}
 
 
 def compute_dense_reward(env, obs, action, info):

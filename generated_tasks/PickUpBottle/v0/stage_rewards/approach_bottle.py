@@ -1,4 +1,4 @@
-"""PickUpBottle, stage approach_bottle: success = the open palm at the pre-grasp point beside the bottle.
+"""PickUpBottle, stage approach_bottle: goal = the open palm at the pre-grasp point beside the bottle.
 
 The pre-grasp point is where the stage executor ends this stage: palm origin 0.11 m from the bottle's axis and
 0.12 m above its origin (measured 0.109 / 0.123 on 5 seeds), on whichever side the palm comes from, fingertips
@@ -12,8 +12,6 @@ from gendex_envs import reward_terms as rt
 REWARD_MAX = 4.0
 PRE_R_M = 0.11
 PRE_DZ_M = 0.12
-TOL_M = 0.03
-TIPS_MAX_M = 0.17
 OPEN_M = 0.16
 
 
@@ -34,9 +32,7 @@ def evaluate(env):
     tips = env.tip_positions
     tips_dist = torch.linalg.norm(tips - pose.p[:, None, :], dim=-1).mean(dim=1)
     openness = torch.linalg.norm(tips - palm[:, None, :], dim=-1).mean(dim=1)
-    success = (pre_dist <= TOL_M) & (tips_dist <= TIPS_MAX_M) & (openness >= OPEN_M) & ~toppled
-    return {"success": success, "fail": toppled, "pregrasp_dist": pre_dist, "tips_dist": tips_dist,
-            "openness": openness}
+    return {"fail": toppled, "pregrasp_dist": pre_dist, "tips_dist": tips_dist, "openness": openness}
 
 
 def compute_dense_reward(env, obs, action, info):

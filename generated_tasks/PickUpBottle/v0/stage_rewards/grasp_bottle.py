@@ -1,4 +1,4 @@
-"""PickUpBottle, stage grasp_bottle: success = thumb and at least two fingers pressing on the upright bottle.
+"""PickUpBottle, stage grasp_bottle: goal = thumb and at least two fingers pressing on the upright bottle.
 
 Contact is a hand group's mean force on the bottle above 0.3 N; at the executor's end of this stage the thumb
 pushes 6-10 N and every finger 0.7-8 N, at its start nothing touches.
@@ -18,9 +18,7 @@ def evaluate(env):
     up_z = 1.0 - 2.0 * (pose.q[:, 1] ** 2 + pose.q[:, 2] ** 2)
     toppled = (up_z < 0.5) & (height < 0.02)  # lying on the table: the hand alone cannot stand it up
     force = env.agent.get_hand_group_obj_mean_force(env.obj("bottle"))  # [N, 6, 1] th ff mf rf lf palm
-    touching = force[..., 0] > MIN_FORCE_N
-    held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 2)  # thumb opposing two fingers
-    return {"success": held & ~toppled, "fail": toppled, "contact": rt.contact(force, MIN_FORCE_N)}
+    return {"fail": toppled, "contact": rt.contact(force, MIN_FORCE_N)}
 
 
 def compute_dense_reward(env, obs, action, info):

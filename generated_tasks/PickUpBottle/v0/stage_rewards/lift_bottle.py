@@ -1,4 +1,4 @@
-"""PickUpBottle, stage lift_bottle: success = the bottle, still held, at least 10 cm above its start height.
+"""PickUpBottle, stage lift_bottle: goal = the bottle, still held, at least 10 cm above its start height.
 
 10 cm is the task's success height; the executor ends its grasp with the bottle 0.145-0.149 m up, thumb and
 fingers all in contact (above 0.3 N).
@@ -21,8 +21,7 @@ def evaluate(env):
     force = env.agent.get_hand_group_obj_mean_force(env.obj("bottle"))
     touching = force[..., 0] > MIN_FORCE_N
     held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 2)
-    return {"success": held & (height >= LIFT_M) & ~toppled, "fail": toppled, "height": height,
-            "held": held, "contact": rt.contact(force, MIN_FORCE_N)}
+    return {"fail": toppled, "height": height, "held": held, "contact": rt.contact(force, MIN_FORCE_N)}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -1,4 +1,4 @@
-"""PutAppleBowl, stage grasp_apple: success = a finger grasp that can carry the apple: the thumb and at least three
+"""PutAppleBowl, stage grasp_apple: goal = a finger grasp that can carry the apple: the thumb and at least three
 fingers pressing on it, and the palm not pushing it into the table.
 
 The stage drives the hand only, so the lift is left to move_to_bowl's arm. Contact is a hand group's mean force on
@@ -20,10 +20,7 @@ PALM_MAX_N = 10.0
 def evaluate(env):
     fell = env.obj_pose("apple").p[:, 2] < env.table_height - 0.05  # rolled off the table
     force = env.agent.get_hand_group_obj_mean_force(env.obj("apple"))[..., 0]  # [N, 6] th ff mf rf lf palm
-    touching = force > MIN_FORCE_N
-    pressing = force[:, 5] > PALM_MAX_N
-    held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 3) & ~pressing  # thumb opposing three fingers
-    return {"success": held & ~fell, "fail": fell, "contact": rt.contact(force[..., None], MIN_FORCE_N),
+    return {"fail": fell, "contact": rt.contact(force[..., None], MIN_FORCE_N),
             "palm_press": (force[:, 5] / (4.0 * PALM_MAX_N)).clamp(0.0, 1.0)}
 
 

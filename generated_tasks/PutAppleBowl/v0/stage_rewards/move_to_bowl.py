@@ -1,4 +1,4 @@
-"""PutAppleBowl, stage move_to_bowl: success = the held apple above the bowl's footprint, ready to drop.
+"""PutAppleBowl, stage move_to_bowl: goal = the held apple above the bowl's footprint, ready to drop.
 
 Above the footprint: apple centre within 0.075 m (the bowl's half width) of the bowl's axis and 0.08-0.22 m above
 the bowl's origin (rim at 0.063 m). The executor ends this stage at 0.046-0.054 m / 0.149-0.154 m, thumb and
@@ -10,9 +10,7 @@ import torch
 from gendex_envs import reward_terms as rt
 
 REWARD_MAX = 4.0
-OVER_R_M = 0.075
 DZ_MIN_M = 0.08
-DZ_MAX_M = 0.22
 MIN_FORCE_N = 0.3
 
 
@@ -25,9 +23,7 @@ def evaluate(env):
     held = touching[:, 0] & (touching[:, 1:5].sum(dim=1) >= 2)
     xy = torch.linalg.norm((apple - bowl)[:, :2], dim=-1)
     dz = apple[:, 2] - bowl[:, 2]
-    over = (xy <= OVER_R_M) & (dz >= DZ_MIN_M) & (dz <= DZ_MAX_M)
-    return {"success": held & over & ~fell, "fail": fell, "held": held, "bowl_xy": xy, "bowl_dz": dz,
-            "contact": rt.contact(force, MIN_FORCE_N)}
+    return {"fail": fell, "held": held, "bowl_xy": xy, "bowl_dz": dz, "contact": rt.contact(force, MIN_FORCE_N)}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -1,4 +1,4 @@
-"""PutAppleBowl, stage reach_apple: success = the open palm at the pre-grasp point above and beside the apple.
+"""PutAppleBowl, stage reach_apple: goal = the open palm at the pre-grasp point above and beside the apple.
 
 The pre-grasp point is where the stage executor ends this stage: palm origin 0.076 m from the apple's vertical
 axis and 0.084 m above its centre (measured on 5 seeds), fingertips within 0.16 m of the apple (0.136; 0.30 at
@@ -12,8 +12,6 @@ from gendex_envs import reward_terms as rt
 REWARD_MAX = 4.0
 PRE_R_M = 0.076
 PRE_DZ_M = 0.084
-TOL_M = 0.03
-TIPS_MAX_M = 0.16
 OPEN_M = 0.16
 
 
@@ -32,9 +30,7 @@ def evaluate(env):
     tips = env.tip_positions
     tips_dist = torch.linalg.norm(tips - apple[:, None, :], dim=-1).mean(dim=1)
     openness = torch.linalg.norm(tips - palm[:, None, :], dim=-1).mean(dim=1)
-    success = (pre_dist <= TOL_M) & (tips_dist <= TIPS_MAX_M) & (openness >= OPEN_M) & ~fell
-    return {"success": success, "fail": fell, "pregrasp_dist": pre_dist, "tips_dist": tips_dist,
-            "openness": openness}
+    return {"fail": fell, "pregrasp_dist": pre_dist, "tips_dist": tips_dist, "openness": openness}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -1,4 +1,4 @@
-"""PutAppleBowl, stage release_apple: success = the apple inside the bowl and no part of the hand touching it.
+"""PutAppleBowl, stage release_apple: goal = the apple inside the bowl and no part of the hand touching it.
 
 Inside is the task's own condition (env.spec_success()); contact is a hand group's mean force above 0.3 N. The
 executor's release ends with the apple 0.028-0.046 m from the bowl's axis and no contact; at its start the apple
@@ -21,10 +21,8 @@ def evaluate(env):
     # down on the table beside the bowl (or off it): a hand-only stage cannot pick it up again
     fail = (apple[:, 2] < env.table_height - 0.05) | ((env.obj_height("apple") < 0.01) & (xy > OVER_R_M))
     force = env.agent.get_hand_group_obj_mean_force(env.obj("apple"))
-    free = (force[..., 0] <= MIN_FORCE_N).all(dim=1)
     inside = env.spec_success()
-    return {"success": inside & free & ~fail, "fail": fail, "inside": inside, "bowl_xy": xy,
-            "contact": rt.contact(force, MIN_FORCE_N)}
+    return {"fail": fail, "inside": inside, "bowl_xy": xy, "contact": rt.contact(force, MIN_FORCE_N)}
 
 
 def compute_dense_reward(env, obs, action, info):

@@ -1,0 +1,268 @@
+"""Collect successful episodes of a task with a solver and export them (LeRobot v3.0 and/or HDF5 + JSON).
+
+Only successful episodes are kept. Attempt ``k`` resets with seed ``base_seed + k``; GenDex envs are deterministic,
+so a collection is reproducible and resumable:
+
+* each exporter appends an episode atomically (see :mod:`~gendex.data.lerobot_v3` and
+  :mod:`~gendex.data.trajectory_h5`), then progress (attempts, env steps, kept seeds) is committed to
+  ``collect_state.json``;
+* on restart the collector continues after the last committed attempt. If it was killed after some exporter had
+  taken the next successful episode but before the commit, that attempt is re-run (same seed, same episode) and
+  given to the exporters that lack it, so every format ends with the same episodes.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import gymnasium as gym
+import numpy as np
+
+from gendex.data.episode import Episode, EpisodeError
+from gendex.data.rollout import EpisodeRecorder, env_info
+from gendex_envs.atomic_io import write_json
+from gendex_envs.errors import ExecutionError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gendex.solve import Solver
+
+log = logging.getLogger(__name__)
+
+STATE_FILE = "collect_state.json"
+FORMATS = ("lerobot", "h5")
+
+
+@dataclass(frozen=True)
+class CollectConfig:
+    task_id: str
+    num_success: int
+    out: Path
+    formats: tuple[str, ...] = ("lerobot",)
+    cameras: tuple[str, ...] = ()
+    seed: int = 0
+    max_attempts: int | None = None
+    """Stop after this many attempts even if ``num_success`` is not reached (default: 20 x num_success)."""
+    control_mode: str = "pd_joint_pos"
+    """Action space of the solver's actions (``gendex.solve.SOLVER_ENV_KWARGS``); recorded with the data."""
+    control_joint: str = "both"
+
+    def env_kwargs(self) -> dict:
+        """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""
+        return {"control_mode": self.control_mode, "control_joint": self.control_joint,
+                "obs_mode": "rgb" if self.cameras else "state"}
+
+
+@dataclass
+class CollectState:
+    """Committed progress of a collection."""
+
+    task_id: str
+    seed: int
+    attempts: int = 0
+    env_steps: int = 0
+    kept_seeds: list[int] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def successes(self) -> int:
+        return len(self.kept_seeds)
+
+    @property
+    def env_steps_per_success(self) -> float:
+        return self.env_steps / self.successes if self.successes else float("inf")
+
+
+def _load_state(cfg: CollectConfig) -> CollectState:
+    path = cfg.out / STATE_FILE
+    if not path.is_file():
+        return CollectState(task_id=cfg.task_id, seed=cfg.seed)
+    raw = json.loads(path.read_text())
+    state = CollectState(**raw)
+    if (state.task_id, state.seed) != (cfg.task_id, cfg.seed):
+        raise EpisodeError(f"{path} belongs to a collection of {state.task_id} with seed {state.seed}; asked for "
+                           f"{cfg.task_id} with seed {cfg.seed} (use another --out or the same task and seed)")
+    return state
+
+
+def _open_exporters(cfg: CollectConfig, env: gym.Env) -> dict[str, object]:
+    from gendex.data.lerobot_v3 import LeRobotV3Writer
+    from gendex.data.trajectory_h5 import TrajectoryWriter
+
+    unknown = [f for f in cfg.formats if f not in FORMATS]
+    if unknown:
+        raise EpisodeError(f"unknown formats {unknown}; allowed: {list(FORMATS)}")
+    u = env.unwrapped
+    names = [j.name for j in u.agent.robot.get_active_joints()]
+    writers: dict[str, object] = {}
+    if "lerobot" in cfg.formats:
+        action_names = list(u.agent.controller.free_joint_names)
+        res = u.sensor_resolution
+        writers["lerobot"] = LeRobotV3Writer(
+            cfg.out / "lerobot", fps=int(u.control_freq), robot_type="ur10e_shadowhand",
+            state_names=[f"{n}.pos" for n in names] + [f"{n}.vel" for n in names], action_names=action_names,
+            cameras={c: (res, res) for c in cfg.cameras} or None)
+    if "h5" in cfg.formats:
+        writers["h5"] = TrajectoryWriter(cfg.out / "trajectories", **env_info(env))
+    return writers
+
+
+@dataclass
+class AttemptResult:
+    """What one attempt produced (picklable, so worker processes can return it)."""
+
+    seed: int
+    episode: Episode | None
+    """The recorded episode when it succeeded, else None."""
+    steps: int
+    seconds: float
+
+
+def _make_env(cfg: CollectConfig) -> gym.Env:
+    return gym.make(cfg.task_id, **cfg.env_kwargs())
+
+
+class _Attempter:
+    """Runs attempts by seed with its own env and solver (in this process or in a worker)."""
+
+    def __init__(self, cfg: CollectConfig, make_solver: Callable[[], Solver]):
+        self.cfg = cfg
+        self.env = _make_env(cfg)
+        self.recorder = EpisodeRecorder(self.env)
+        self.solver = make_solver()
+
+    def __call__(self, seed: int) -> AttemptResult:
+        t0 = time.perf_counter()
+        episode, images = _attempt(self.env, self.recorder, self.solver, seed, self.cfg.cameras)
+        kept = None
+        if episode is not None and episode.succeeded:
+            episode.images.update(images)
+            episode.info.update(solver=self.solver.name)
+            kept = episode
+        return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0)
+
+
+_WORKER: _Attempter | None = None
+
+
+def _worker_init(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> None:
+    global _WORKER
+    import torch
+
+    import gendex_envs  # noqa: F401
+    from gendex_envs.registry import register_tasks
+
+    torch.set_num_threads(1)  # one process per core
+    if cfg.task_id not in gym.registry:  # a task registered at run time in the parent (e.g. a scratch root)
+        register_tasks([Path(task_root)])
+    _WORKER = _Attempter(cfg, make_solver)
+
+
+def _worker_attempt(seed: int) -> AttemptResult:
+    return _WORKER(seed)
+
+
+def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
+            progress: Callable[[CollectState], None] | None = None, workers: int = 1) -> CollectState:
+    """Run attempts until ``cfg.num_success`` episodes succeeded (or ``max_attempts``); returns the final state.
+
+    With ``workers > 1`` attempts run in that many processes (one env each); results are still committed in attempt
+    order, so the dataset is the same as with one worker.
+    """
+    from gendex_envs.registry import resolve_task
+
+    if workers < 1:
+        raise EpisodeError(f"workers={workers}; allowed: 1 or more")
+    cfg.out.mkdir(parents=True, exist_ok=True)
+    state = _load_state(cfg)
+    limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
+    local = _Attempter(cfg, make_solver)
+    writers = _open_exporters(cfg, local.env)
+    pool = None
+    try:
+        pending = {name: _exported(w) - state.successes for name, w in writers.items()}
+        if any(n < 0 or n > 1 for n in pending.values()):
+            counts = {k: _exported(w) for k, w in writers.items()}
+            raise EpisodeError(f"{cfg.out}: exported episode counts {counts} do not match the {state.successes} "
+                               f"committed in {STATE_FILE}")
+        seeds = (cfg.seed + k for k in range(state.attempts, limit))
+        if workers == 1:
+            results = map(local, seeds)
+        else:
+            import multiprocessing
+
+            root = str(resolve_task(cfg.task_id).tasks_root)
+            pool = multiprocessing.get_context("spawn").Pool(workers, _worker_init, (cfg, make_solver, root))
+            results = pool.imap(_worker_attempt, seeds)  # in order, computed ahead in parallel
+        for result in results if state.successes < cfg.num_success else ():
+            if result.episode is not None:
+                result.episode.info.update(attempt=state.attempts)
+                for name, writer in writers.items():
+                    if pending.get(name, 0) > 0:  # this writer already took it before an interruption
+                        log.info("attempt %d (seed %d) was already exported to %s", state.attempts, result.seed, name)
+                        continue
+                    writer.add_episode(result.episode)
+                state.kept_seeds.append(result.seed)
+            elif any(pending.values()):
+                raise EpisodeError(f"attempt {state.attempts} (seed {result.seed}) was exported before an "
+                                   "interruption but did not succeed when re-run: the solver or env is not "
+                                   "deterministic")
+            pending = {}
+            state.attempts += 1
+            state.env_steps += result.steps
+            state.seconds += result.seconds
+            write_json(cfg.out / STATE_FILE, asdict(state), indent=1)
+            if progress is not None:
+                progress(state)
+            if state.successes >= cfg.num_success:
+                break
+    finally:
+        if pool is not None:
+            pool.terminate()
+        for writer in writers.values():
+            writer.close()
+        local.env.close()
+    return state
+
+
+def _exported(writer) -> int:
+    """Episodes an exporter holds."""
+    from gendex.data.lerobot_v3 import LeRobotV3Writer
+
+    return writer.total_episodes if isinstance(writer, LeRobotV3Writer) else len(writer)
+
+
+def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int, cameras: tuple[str, ...]
+             ) -> tuple[Episode | None, dict[str, np.ndarray]]:
+    obs, _ = recorder.begin(seed)
+    solver.reset(env, obs)
+    frames = {c: [_image(obs, c)] for c in cameras}
+    while True:
+        try:
+            action = solver.act(env, obs)
+        except ExecutionError as exc:  # the solver gave up on this attempt: a failed attempt, not a crash
+            log.warning("attempt with seed %d: %s", seed, exc)
+            break
+        if action is None:
+            break
+        obs, _, terminated, truncated, _ = recorder.step(action)
+        for c in cameras:
+            frames[c].append(_image(obs, c))
+        if terminated or truncated:
+            break
+    if recorder.steps == 0:
+        return None, {}
+    return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}
+
+
+def _image(obs, camera: str) -> np.ndarray:
+    try:
+        return np.asarray(obs["sensor_data"][camera]["rgb"])
+    except (KeyError, TypeError) as exc:
+        raise EpisodeError(f"camera {camera!r} is not in the observation; cameras: "
+                           f"{sorted(obs.get('sensor_data', {})) if isinstance(obs, dict) else []}") from exc

@@ -1,0 +1,468 @@
+"""Write :class:`~gendex.data.episode.Episode` records as a LeRobot **v3.0** dataset with pyarrow only.
+
+Layout (as lerobot's ``LeRobotDataset`` reads it)::
+
+    meta/info.json                               codebase_version "v3.0", totals, features, path templates
+    meta/stats.json                              per feature min/max/mean/std/count (images: per channel, [3,1,1])
+    meta/tasks.parquet                           task_index column; the task string is the pandas index
+    meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``)
+    data/chunk-CCC/file-FFF.parquet              one row per action (frame); images as struct<bytes PNG, path>
+
+Frame ``t`` of an episode holds ``observation.state = state[t]``, ``action = action[t]``, the images of step ``t``,
+``next.reward/next.success = reward[t]/success[t]`` and ``next.done`` (True on the last frame), as lerobot's
+``pusht``-style datasets do. The final observation ``state[T]`` is not stored (there is no action for it).
+
+Durability: each :meth:`LeRobotV3Writer.add_episode` rewrites the current data file (episodes are appended to it in
+memory, and a new file -- then a new chunk after ``chunks_size`` files -- is started when the size limit would be
+passed) and all meta files. Every file is first written to a hidden temp sibling (``.<name>.tmp``); then a journal
+``meta/.commit.json`` listing the renames is itself renamed into place (the commit point) and the renames are made,
+data first and ``info.json`` last. A process killed before the commit point leaves only temp files, which the next
+writer removes; one killed after it is rolled forward by the next writer. Since the data file is renamed before the
+meta files, meta never claims rows that are missing. One writer per root at a time.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+from PIL import Image
+
+from gendex.data.episode import Episode, EpisodeError
+
+log = logging.getLogger(__name__)
+
+CODEBASE_VERSION = "v3.0"
+DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+INFO_PATH, STATS_PATH, TASKS_PATH, JOURNAL_PATH = ("meta/info.json", "meta/stats.json", "meta/tasks.parquet",
+                                                   "meta/.commit.json")
+DEFAULT_VIDEO_FILE_SIZE_IN_MB = 500
+# lerobot's DEFAULT_FEATURES (the index columns every dataset has)
+INDEX_FEATURES = {k: {"dtype": d, "shape": [1], "names": None} for k, d in
+                  [("timestamp", "float32"), ("frame_index", "int64"), ("episode_index", "int64"),
+                   ("index", "int64"), ("task_index", "int64")]}
+STEP_FEATURES = {"next.reward": "float32", "next.success": "bool", "next.done": "bool"}
+STAT_NAMES = ("min", "max", "mean", "std", "count")
+_ARROW = {"float32": pa.float32(), "int64": pa.int64(), "bool": pa.bool_()}
+
+
+class LeRobotDatasetError(EpisodeError):
+    """A dataset root cannot be written as asked: it holds an incompatible or inconsistent dataset."""
+
+
+# --------------------------------------------------------------------------------------------- atomic files
+def _tmp(path: Path) -> Path:
+    return path.with_name(f".{path.name}.tmp")
+
+
+def _write_json(obj, path: Path) -> None:
+    path.write_text(json.dumps(obj, indent=4, ensure_ascii=False) + "\n", encoding="utf-8")
+
+
+def _roll_forward(root: Path) -> bool:
+    """Finish the renames of a committed journal left by a killed writer; True when there was one."""
+    journal = root / JOURNAL_PATH
+    if not journal.exists():
+        return False
+    for tmp_rel, final_rel in json.loads(journal.read_text())["renames"]:
+        if (root / tmp_rel).exists():
+            os.replace(root / tmp_rel, root / final_rel)
+    journal.unlink()
+    return True
+
+
+def _commit(root: Path, files: list[tuple[Path, Callable[[Path], None]]]) -> None:
+    """Write each ``(final path, writer)`` to a temp sibling, then make them all visible through the journal."""
+    staged: list[tuple[Path, Path]] = []
+    try:
+        for final, write in files:
+            final.parent.mkdir(parents=True, exist_ok=True)
+            write(_tmp(final))
+            staged.append((_tmp(final), final))
+    except BaseException:
+        for tmp, _ in staged:
+            tmp.unlink(missing_ok=True)
+        raise
+    journal = root / JOURNAL_PATH
+    journal.parent.mkdir(parents=True, exist_ok=True)
+    _write_json({"renames": [[str(t.relative_to(root)), str(f.relative_to(root))] for t, f in staged]},
+                _tmp(journal))
+    os.replace(_tmp(journal), journal)  # the commit point
+    _roll_forward(root)
+
+
+def _recover(root: Path) -> None:
+    if _roll_forward(root):
+        log.warning("%s: finished an interrupted commit left by a killed writer", root)
+    for stray in root.rglob(".*.tmp"):
+        log.warning("%s: removing incomplete temp file %s", root, stray.relative_to(root))
+        stray.unlink()
+
+
+# --------------------------------------------------------------------------------------------- stats
+def _array_stats(x: np.ndarray) -> dict[str, np.ndarray]:
+    x = np.asarray(x, dtype=np.float64)
+    x = x[:, None] if x.ndim == 1 else x
+    return {"min": x.min(0), "max": x.max(0), "mean": x.mean(0), "std": x.std(0), "count": np.array([len(x)])}
+
+
+def _image_stats(images: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-channel stats of uint8 [T, H, W, 3] images scaled to [0, 1], shaped [3, 1, 1] as lerobot's."""
+    flat = images.reshape(-1, 3)
+    out = {"min": flat.min(0) / 255.0, "max": flat.max(0) / 255.0,
+           "mean": flat.mean(0, dtype=np.float64) / 255.0, "std": flat.std(0, dtype=np.float64) / 255.0}
+    return {**{k: v.astype(np.float64).reshape(3, 1, 1) for k, v in out.items()}, "count": np.array([len(images)])}
+
+
+def _aggregate(stats_list: list[dict[str, dict[str, np.ndarray]]]) -> dict[str, dict[str, np.ndarray]]:
+    """Merge per-episode stats: min/max over episodes, count-weighted mean and (parallel-algorithm) variance."""
+    out = {}
+    for key in stats_list[0]:
+        ss = [s[key] for s in stats_list]
+        counts = np.array([float(s["count"][0]) for s in ss])
+        means = np.stack([np.asarray(s["mean"], np.float64) for s in ss])
+        var = np.stack([np.asarray(s["std"], np.float64) ** 2 for s in ss])
+        w = counts.reshape(-1, *[1] * (means.ndim - 1))
+        total = counts.sum()
+        mean = (means * w).sum(0) / total
+        variance = ((var + (means - mean) ** 2) * w).sum(0) / total
+        out[key] = {"min": np.min(np.stack([np.asarray(s["min"], np.float64) for s in ss]), 0),
+                    "max": np.max(np.stack([np.asarray(s["max"], np.float64) for s in ss]), 0),
+                    "mean": mean, "std": np.sqrt(np.maximum(variance, 0.0)), "count": np.array([int(total)])}
+    return out
+
+
+def _jsonable(stats: dict[str, dict[str, np.ndarray]]) -> dict:
+    return {k: {s: np.asarray(v).tolist() for s, v in d.items()} for k, d in stats.items()}
+
+
+# --------------------------------------------------------------------------------------------- tables
+def _vectors(x: np.ndarray) -> pa.Array:
+    x = np.ascontiguousarray(x, dtype=np.float32)
+    return pa.FixedSizeListArray.from_arrays(pa.array(x.reshape(-1)), x.shape[1])
+
+
+def _png_column(images: np.ndarray) -> pa.Array:
+    blobs = []
+    for img in images:
+        buf = io.BytesIO()
+        Image.fromarray(img).save(buf, format="PNG")
+        blobs.append(buf.getvalue())
+    return pa.StructArray.from_arrays([pa.array(blobs, pa.binary()), pa.array([None] * len(blobs), pa.string())],
+                                      names=["bytes", "path"])
+
+
+def _tasks_table(tasks: dict[str, int]) -> pa.Table:
+    """``tasks.parquet`` as pandas writes ``DataFrame({"task_index": ...}, index=Index(tasks, name="task"))``."""
+    names = list(tasks)
+    table = pa.table({"task_index": pa.array([tasks[t] for t in names], pa.int64()),
+                      "task": pa.array(names, pa.string())})
+    pandas_meta = {
+        "index_columns": ["task"],
+        "column_indexes": [{"name": None, "field_name": None, "pandas_type": "unicode", "numpy_type": "object",
+                            "metadata": {"encoding": "UTF-8"}}],
+        "columns": [{"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
+                     "numpy_type": "int64", "metadata": None},
+                    {"name": "task", "field_name": "task", "pandas_type": "unicode", "numpy_type": "object",
+                     "metadata": None}],
+        "creator": {"library": "pyarrow", "version": pa.__version__},
+        "pandas_version": "2.2.3",
+    }
+    return table.replace_schema_metadata({b"pandas": json.dumps(pandas_meta).encode()})
+
+
+def read_episode_frames(root: Path | str) -> pa.Table:
+    """All frames of the dataset at ``root``, in order (every ``data/chunk-*/file-*.parquet`` concatenated)."""
+    paths = sorted(Path(root).glob("data/chunk-*/file-*.parquet"))
+    if not paths:
+        raise LeRobotDatasetError(f"{root} holds no data/chunk-*/file-*.parquet files; write episodes first")
+    return pa.concat_tables([pq.read_table(p) for p in paths])
+
+
+# --------------------------------------------------------------------------------------------- writer
+class LeRobotV3Writer:
+    """Append :class:`Episode` records to a LeRobot v3.0 dataset at ``root`` (created, or resumed when it exists).
+
+    ``cameras`` maps camera name -> (height, width); those images are stored as ``observation.images.<name>``.
+    ``data_files_size_in_mb`` is the size at which a new data file is started (lerobot's default 100 MB).
+    """
+
+    def __init__(self, root: Path | str, *, fps: int, robot_type: str, state_names: list[str],
+                 action_names: list[str], cameras: dict[str, tuple[int, int]] | None = None,
+                 chunks_size: int = 1000, data_files_size_in_mb: float = 100,
+                 codebase_version: str = CODEBASE_VERSION):
+        if codebase_version != CODEBASE_VERSION:
+            raise LeRobotDatasetError(f"codebase_version {codebase_version!r} is not supported; only "
+                                      f"{CODEBASE_VERSION!r} is")
+        if fps <= 0 or chunks_size <= 0 or data_files_size_in_mb <= 0:
+            raise LeRobotDatasetError(f"fps ({fps}), chunks_size ({chunks_size}) and data_files_size_in_mb "
+                                      f"({data_files_size_in_mb}) must be positive")
+        self.root = Path(root)
+        self.fps, self.robot_type = int(fps), robot_type
+        self.state_names, self.action_names = list(state_names), list(action_names)
+        self.cameras = {k: (int(h), int(w)) for k, (h, w) in (cameras or {}).items()}
+        self.chunks_size, self.data_files_size_in_mb = int(chunks_size), data_files_size_in_mb
+        self.features = self._declared_features()
+        self._rows: list[dict] = []  # episodes parquet rows
+        self._tasks: dict[str, int] = {}
+        self._stats: dict | None = None
+        self._n_frames, self._chunk, self._file = 0, 0, 0
+        self._current: pa.Table | None = None  # content of the current data file
+        self._closed = False
+        self.root.mkdir(parents=True, exist_ok=True)
+        _recover(self.root)
+        if (self.root / INFO_PATH).exists():
+            self._resume()
+        else:
+            if any(self.root.glob("data/*/*.parquet")):
+                raise LeRobotDatasetError(f"{self.root} has data files but no {INFO_PATH}; use an empty or "
+                                          f"complete LeRobot v3.0 root")
+            _commit(self.root, [(self.root / INFO_PATH, lambda p: _write_json(self._info(0, 0, {}), p))])
+            log.info("created LeRobot v3.0 dataset at %s", self.root)
+
+    # -- context manager
+    def __enter__(self) -> LeRobotV3Writer:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    @property
+    def total_episodes(self) -> int:
+        return len(self._rows)
+
+    @property
+    def total_frames(self) -> int:
+        return self._n_frames
+
+    def _declared_features(self) -> dict[str, dict]:
+        feats = {"observation.state": {"dtype": "float32", "shape": [len(self.state_names)],
+                                       "names": self.state_names},
+                 "action": {"dtype": "float32", "shape": [len(self.action_names)], "names": self.action_names}}
+        for cam, (h, w) in self.cameras.items():
+            feats[f"observation.images.{cam}"] = {"dtype": "image", "shape": [h, w, 3],
+                                                  "names": ["height", "width", "channels"]}
+        feats.update({k: {"dtype": d, "shape": [1], "names": None} for k, d in STEP_FEATURES.items()})
+        feats.update({k: dict(v) for k, v in INDEX_FEATURES.items()})
+        return feats
+
+    def _info(self, n_episodes: int, n_frames: int, tasks: dict[str, int]) -> dict:
+        return {"codebase_version": CODEBASE_VERSION, "robot_type": self.robot_type,
+                "total_episodes": n_episodes, "total_frames": n_frames, "total_tasks": len(tasks),
+                "chunks_size": self.chunks_size, "data_files_size_in_mb": self.data_files_size_in_mb,
+                "video_files_size_in_mb": DEFAULT_VIDEO_FILE_SIZE_IN_MB, "fps": self.fps,
+                "splits": {"train": f"0:{n_episodes}"} if n_episodes else {},
+                "data_path": DATA_PATH, "video_path": None, "features": self.features}
+
+    def _resume(self) -> None:
+        info = json.loads((self.root / INFO_PATH).read_text())
+        if info.get("codebase_version") != CODEBASE_VERSION:
+            raise LeRobotDatasetError(f"{self.root} is a LeRobot {info.get('codebase_version')} dataset; only "
+                                      f"{CODEBASE_VERSION} datasets can be appended to")
+        if info["fps"] != self.fps or info["features"] != self.features:
+            theirs, ours = info["features"], self.features
+            diff = sorted(k for k in set(theirs) | set(ours) if theirs.get(k) != ours.get(k))
+            raise LeRobotDatasetError(f"{self.root} holds a dataset at {info['fps']} fps whose features differ from "
+                                      f"this writer's (fps {self.fps}) in {diff}; append only with the same fps, "
+                                      f"state/action names and cameras, or write to a new root")
+        self.chunks_size, self.data_files_size_in_mb = info["chunks_size"], info["data_files_size_in_mb"]
+        for path in sorted(self.root.glob("meta/episodes/chunk-*/file-*.parquet")):
+            self._rows.extend(pq.read_table(path).to_pylist())
+        if (self.root / TASKS_PATH).exists():
+            t = pq.read_table(self.root / TASKS_PATH)
+            self._tasks = dict(zip(t["task"].to_pylist(), t["task_index"].to_pylist(), strict=True))
+        self._n_frames = self._rows[-1]["dataset_to_index"] if self._rows else 0
+        n_rows = sum(pq.read_metadata(p).num_rows for p in self.root.glob("data/chunk-*/file-*.parquet"))
+        if (len(self._rows), self._n_frames) != (info["total_episodes"], info["total_frames"]) \
+                or n_rows != self._n_frames:
+            raise LeRobotDatasetError(
+                f"{self.root} is inconsistent: info.json claims {info['total_episodes']} episodes / "
+                f"{info['total_frames']} frames, the episodes parquet {len(self._rows)} / {self._n_frames}, the "
+                f"data files hold {n_rows} rows; they must agree before episodes can be appended")
+        if self._rows:
+            last = self._rows[-1]
+            self._chunk, self._file = last["data/chunk_index"], last["data/file_index"]
+            self._current = pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
+                                                                       file_index=self._file))
+            self._stats = _aggregate([self._row_stats(r) for r in self._rows])
+        log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
+                 len(self._tasks))
+
+    def _row_stats(self, row: dict) -> dict[str, dict[str, np.ndarray]]:
+        return {k: {s: np.asarray(row[f"stats/{k}/{s}"]) for s in STAT_NAMES} for k in self.features}
+
+    def _validate(self, ep: Episode) -> None:
+        who = f"episode of {ep.task_id} (seed {ep.seed})"
+        if ep.fps != self.fps:
+            raise EpisodeError(f"{who} was recorded at {ep.fps} fps; this dataset is {self.fps} fps (only equal "
+                               f"fps is allowed)")
+        t = ep.length
+        for key, arr, rows, names in (("state", ep.state, t + 1, self.state_names),
+                                      ("action", ep.action, t, self.action_names)):
+            arr = np.asarray(arr)
+            if arr.shape != (rows, len(names)):
+                raise EpisodeError(f"{who}: {key} has shape {arr.shape}; this dataset declares {len(names)} "
+                                   f"{key} values ({', '.join(names[:4])}{', ...' if len(names) > 4 else ''}), "
+                                   f"so only shape ({rows}, {len(names)}) is allowed")
+            if not np.all(np.isfinite(arr)):
+                raise EpisodeError(f"{who}: {key} contains NaN or inf; only finite values are allowed")
+        if not isinstance(ep.instruction, str) or not ep.instruction.strip():
+            raise EpisodeError(f"{who}: instruction {ep.instruction!r} is empty; a non-empty task string is needed")
+        for cam, (h, w) in self.cameras.items():
+            if cam not in ep.images:
+                raise EpisodeError(f"{who} has no images for camera {cam!r}; it has {sorted(ep.images)} and the "
+                                   f"dataset declares {sorted(self.cameras)}")
+            img = ep.images[cam]
+            if img.dtype != np.uint8 or img.shape != (t + 1, h, w, 3):
+                raise EpisodeError(f"{who}: images[{cam!r}] is {img.dtype} {img.shape}; only uint8 "
+                                   f"({t + 1}, {h}, {w}, 3) is allowed")
+        extra = sorted(set(ep.images) - set(self.cameras))
+        if extra:
+            log.debug("%s: cameras %s are not declared and are not exported", who, extra)
+
+    def add_episode(self, ep: Episode) -> int:
+        """Append ``ep`` (its ``T`` actions become ``T`` frames) and rewrite the meta; returns its episode_index."""
+        if self._closed:
+            raise LeRobotDatasetError(f"the writer of {self.root} is closed; open a new LeRobotV3Writer to append")
+        self._validate(ep)
+        t, e, start = ep.length, len(self._rows), self._n_frames
+        tasks = dict(self._tasks)
+        task_index = tasks.setdefault(ep.instruction, len(tasks))
+        done = np.zeros(t, bool)
+        done[-1] = True
+        numeric = {"observation.state": np.asarray(ep.state[:t], np.float32),
+                   "action": np.asarray(ep.action, np.float32),
+                   "next.reward": np.asarray(ep.reward, np.float32), "next.success": np.asarray(ep.success, bool),
+                   "next.done": done, "timestamp": (np.arange(t) / self.fps).astype(np.float32),
+                   "frame_index": np.arange(t, dtype=np.int64), "episode_index": np.full(t, e, np.int64),
+                   "index": np.arange(start, start + t, dtype=np.int64),
+                   "task_index": np.full(t, task_index, np.int64)}
+        columns, ep_stats = {}, {}
+        for key, ft in self.features.items():
+            if ft["dtype"] == "image":
+                images = ep.images[key.removeprefix("observation.images.")][:t]
+                columns[key], ep_stats[key] = _png_column(images), _image_stats(images)
+            else:
+                arr = numeric[key]
+                columns[key] = _vectors(arr) if arr.ndim == 2 else pa.array(arr, _ARROW[ft["dtype"]])
+                ep_stats[key] = _array_stats(arr)
+        table = pa.table(columns)
+
+        chunk, file, current = self._chunk, self._file, self._current
+        if current is not None and current.num_rows and self._file_full(chunk, file, current.num_rows, t):
+            chunk, file = (chunk + 1, 0) if file + 1 >= self.chunks_size else (chunk, file + 1)
+            current = None
+        current = table if current is None else pa.concat_tables([current, table])
+        row = {"episode_index": e, "tasks": [ep.instruction], "length": t, "data/chunk_index": chunk,
+               "data/file_index": file, "dataset_from_index": start, "dataset_to_index": start + t,
+               "meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0}
+        row.update({f"stats/{k}/{s}": (np.asarray(v).astype(np.int64) if s == "count" else v).tolist()
+                    for k, d in ep_stats.items() for s, v in d.items()})
+        rows = [*self._rows, row]
+        stats = ep_stats if self._stats is None else _aggregate([self._stats, ep_stats])
+        info = self._info(len(rows), start + t, tasks)
+        r = self.root
+        try:
+            self._commit_episode(r, chunk, file, current, tasks, rows, stats, info)
+        except BaseException:
+            if (r / JOURNAL_PATH).exists():  # committed but not fully applied: only a new writer may go on
+                self._closed = True
+                log.error("%s: commit of episode %d was interrupted; open a new writer to finish it", r, e)
+            raise
+        self._rows, self._tasks, self._stats, self._n_frames = rows, tasks, stats, start + t
+        self._chunk, self._file, self._current = chunk, file, current
+        log.debug("%s: wrote episode %d (%d frames) to data chunk %d file %d", r, e, t, chunk, file)
+        return e
+
+    @staticmethod
+    def _commit_episode(r: Path, chunk, file, current, tasks, rows, stats, info) -> None:
+        _commit(r, [(r / DATA_PATH.format(chunk_index=chunk, file_index=file), lambda p: pq.write_table(current, p)),
+                    (r / TASKS_PATH, lambda p: pq.write_table(_tasks_table(tasks), p)),
+                    (r / EPISODES_PATH.format(chunk_index=0, file_index=0),
+                     lambda p: pq.write_table(pa.Table.from_pylist(rows), p)),
+                    (r / STATS_PATH, lambda p: _write_json(_jsonable(stats), p)),
+                    (r / INFO_PATH, lambda p: _write_json(info, p))])
+
+    def _file_full(self, chunk: int, file: int, n_rows: int, n_new: int) -> bool:
+        """True when adding ``n_new`` rows (at the current file's bytes per row) reaches the size limit."""
+        size = (self.root / DATA_PATH.format(chunk_index=chunk, file_index=file)).stat().st_size
+        return size * (1 + n_new / n_rows) >= self.data_files_size_in_mb * 1024 * 1024
+
+    def close(self) -> None:
+        """Stop writing. Everything is already on disk and consistent after each ``add_episode``."""
+        if not self._closed:
+            self._closed = True
+            self._current = None
+            log.info("closed %s: %d episodes, %d frames", self.root, len(self._rows), self._n_frames)
+
+    finalize = close
+
+
+def write_dataset_card(root: Path | str, *, task_id: str, instruction: str, robot: str, env_kwargs: dict,
+                       n_episodes: int, n_frames: int, how_made: str) -> Path:
+    """Write a LeRobot-style ``README.md`` (YAML front matter + description) at ``root``; returns its path.
+
+    ``env_kwargs`` are the exact ``gym.make`` keyword arguments the episodes were recorded with: the card shows the
+    call, so a policy learned from the data acts in the same action space."""
+    root = Path(root)
+    make = ", ".join([repr(task_id)] + [f"{k}={v!r}" for k, v in env_kwargs.items()])
+    info_path = root / INFO_PATH
+    structure = ("[meta/info.json](meta/info.json):\n\n```json\n" + info_path.read_text().strip() + "\n```\n"
+                 if info_path.exists() else "")
+    text = f"""---
+license: apache-2.0
+task_categories:
+- robotics
+tags:
+- LeRobot
+- gendex
+- shadowhand
+configs:
+- config_name: default
+  data_files: data/*/*.parquet
+---
+
+# {task_id}
+
+This dataset was created with GenDex and follows the [LeRobot](https://github.com/huggingface/lerobot)
+v3.0 dataset format.
+
+- **Task**: `{task_id}`
+- **Instruction**: {instruction}
+- **Robot**: {robot}
+- **Control mode**: `{env_kwargs.get("control_mode", "pd_joint_pos")}`
+- **Episodes**: {n_episodes}
+- **Frames**: {n_frames}
+
+## The environment the data comes from
+
+```python
+import gymnasium as gym
+import gendex_envs  # registers the GenDex task ids
+
+env = gym.make({make})
+```
+
+Every `action` row is an action of this env (its `action_space`), and `observation.state` lists the robot's joint
+positions then velocities, named in `meta/info.json`.
+
+## How it was made
+
+{how_made}
+
+## Dataset structure
+
+{structure}"""
+    root.mkdir(parents=True, exist_ok=True)
+    path = root / "README.md"
+    _tmp(path).write_text(text, encoding="utf-8")
+    os.replace(_tmp(path), path)
+    return path

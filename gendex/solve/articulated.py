@@ -1,0 +1,367 @@
+"""Scripted primitives for articulated targets: open a hinged door (or lid) by hooking its handle bar and pulling.
+
+Three primitives, run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is an
+articulated object (skills ``reach``, ``grasp`` and ``open``):
+
+- ``approach_handle`` — reads the main joint of the target from the live articulation (hinge point and axis from
+  the joint's world frame, joint position, the handle link's pose; the object's pose is randomized, so nothing is
+  taken from the nominal layout) and synthesizes *hook grasps* of the handle bar: palm parallel to the door's
+  front, facing it :data:`PALM_STANDOFF_M` from the bar's axis, fingers straight and crossing the bar, which lies
+  :data:`BAR_ALONG_M` along the fingers from the palm origin (under the proximal phalanges). Candidates differ by
+  the finger direction (towards the hinge first: then the forearm stays beyond the door's free edge for the whole
+  swing). A candidate is kept only if the arm reaches the pre-pose (:data:`PRE_M` out from the door) without
+  collision *and* can follow the handle along the whole arc to the opening goal (IK chained along sampled door
+  angles, collision-checked against the cabinet body). The arm is planned to the pre-pose and moves straight in.
+- ``hook`` — guarded closing of the four fingers (each control step at most ``GUARD_RAD`` beyond the measured
+  angles): the proximal phalanges stop on the bar and the middle and distal phalanges curl behind it, into the gap
+  between bar and door.
+- ``pull`` — closed loop: every control step it re-reads the door angle ``q``, places the palm where the grasp
+  (fixed in the handle link's frame) will be at ``q + lead`` on the arc about the hinge axis, position *and*
+  orientation (the palm yaws with the door), and solves IK from the current arm target. It stops once the door
+  is :data:`GOAL_MARGIN` past the success fraction of its opening. If the door stalls (the hook slipped), the
+  attempt ends with ``ExecutionError``.
+
+Geometric conventions used (those of :mod:`gendex_envs.assets.articulated`, the catalog's articulated assets): a
+door's front faces -x of its link frame, and its handle is a bar parallel to the hinge axis, ``handle_point_m``
+(the grip centre) on the bar's axis. :class:`JointFrame` is the arc computation: where a point fixed to the moving
+link is at any joint position.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+import sapien
+
+from gendex.solve.collision import Box
+from gendex.solve.grasp import palm_rotation
+from gendex_envs.errors import ExecutionError
+from gendex_envs.physx import px_objects
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gendex.solve.motion import ArmHandMotion
+    from gendex_envs.task_env import TaskEnv
+
+log = logging.getLogger(__name__)
+
+DOOR_FRONT_LOCAL = np.array([-1.0, 0.0, 0.0])
+"""Outward normal of a door's front in its link frame (catalog convention: fronts face -x)."""
+PALM_STANDOFF_M = 0.03
+"""Palm origin to bar axis along the door normal: palm skin (0.011) + bar radius (0.011) + 8 mm gap."""
+BAR_ALONG_M = 0.125
+"""Bar axis distance from the palm origin along the fingers (knuckles at 0.095: the bar lies under the proximal
+phalanges, so closing wraps the middle and distal phalanges behind it)."""
+PRE_M = 0.08
+"""Pre-pose: the grasp pose moved this far out from the door along its normal."""
+INSERT_CHECKS = 4
+"""IK checks along the straight move from the pre-pose in to the grasp."""
+GOAL_MARGIN = 0.12
+"""The pull's goal: this fraction of the opening beyond the success condition's fraction."""
+TILTS_RAD = (0.0, 0.25, 0.5)
+"""Palm tilts about the bar tried (0: palm parallel to the door, the best hook; more brings the forearm closer to
+the robot)."""
+WRIST_POSTURES = ({"WRJ0": -0.5}, {"WRJ0": 0.0})
+"""Hand wrist postures tried with each tilt (``WRJ0`` < 0 bends the back of the hand towards the forearm)."""
+ARC_CHECK_RAD = 0.05
+"""Door-angle spacing of the reachability check along the arc."""
+MAX_ARC_JUMP_RAD = 0.35
+"""Largest arm-joint change between neighbouring arc samples: more means IK jumped to another branch."""
+
+HOOK_OPEN = {"THJ4": 0.0, "THJ3": 0.0, "THJ2": 0.0, "THJ1": 0.0, "THJ0": 0.0} | {
+    f + j: 0.0 for f in ("FF", "MF", "RF", "LF") for j in ("J3", "J2", "J1", "J0")} | {"LFJ4": 0.0}
+"""Hand while approaching the bar: fingers straight and together, thumb in the palm plane (away from the door)."""
+HOOK_CLOSED = {f + j: v for f in ("FF", "MF", "RF", "LF") for j, v in (("J2", 1.3), ("J1", 1.5), ("J0", 1.5))}
+"""Finger closing target of the hook (beyond contact with the bar: the guard stops the fingers on it)."""
+
+
+# ------------------------------------------------------------------------------------------------------- geometry
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation matrix [3, 3] of ``angle`` rad right-handed about unit ``axis`` (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * k @ k
+
+
+def _matrix(pose: sapien.Pose) -> np.ndarray:
+    return np.asarray(pose.to_transformation_matrix(), dtype=np.float64)
+
+
+def _pose(m: np.ndarray) -> sapien.Pose:
+    return sapien.Pose(np.asarray(m, dtype=np.float32))
+
+
+@dataclass(frozen=True)
+class JointFrame:
+    """Snapshot of one revolute joint (one env): where its child link is at any joint position.
+
+    Positive joint motion turns the child right-handed about ``axis`` through ``point`` (PhysX: the x axis of the
+    joint frame).
+    """
+
+    point: np.ndarray
+    """[3] a point on the hinge axis, world."""
+    axis: np.ndarray
+    """[3] unit hinge axis, world."""
+    q: float
+    """Joint position when read."""
+    link: np.ndarray
+    """[4, 4] child link pose (world) when read."""
+
+    def link_at(self, q: float) -> np.ndarray:
+        """[4, 4] world pose of the child link at joint position ``q``."""
+        m = np.eye(4)
+        m[:3, :3] = _rotation(self.axis, q - self.q)
+        m[:3, 3] = self.point - m[:3, :3] @ self.point
+        return m @ self.link
+
+    def point_at(self, local: np.ndarray, q: float) -> np.ndarray:
+        """[3] world position at joint position ``q`` of a point fixed at ``local`` in the child link's frame."""
+        m = self.link_at(q)
+        return m[:3, :3] @ np.asarray(local, dtype=np.float64) + m[:3, 3]
+
+
+def read_joint(env: TaskEnv, name: str, env_idx: int = 0) -> JointFrame:
+    """The main joint of articulated object ``name`` in env ``env_idx``, as simulated now."""
+    art = env.articulations[name]
+    joint = art.get_active_joints()[env.joint_index(name)]
+    px = px_objects(joint)[env_idx]  # PhysX's own joint pose
+    if px.type not in ("revolute", "revolute_unwrapped"):
+        raise ExecutionError(f"{name!r}: joint {joint.name!r} is {px.type}; the articulated primitives open "
+                             f"revolute joints (doors, lids) only")
+    frame = _matrix(px.get_global_pose())
+    pose = env.handle_link(name).pose
+    link = _matrix(sapien.Pose(pose.p[env_idx].cpu().numpy(), pose.q[env_idx].cpu().numpy()))
+    return JointFrame(point=frame[:3, 3].copy(), axis=frame[:3, 0] / np.linalg.norm(frame[:3, 0]),
+                      q=float(env.joint_qpos(name)[env_idx]), link=link)
+
+
+def handle_local(env: TaskEnv, name: str) -> np.ndarray:
+    """[3] grip point of ``name``'s handle in its link frame (scaled)."""
+    jr = env.joint_record(name)
+    return np.asarray(jr.handle_point_m, dtype=np.float64) * env.task_spec.object(name).scale
+
+
+@dataclass(frozen=True)
+class HookGrasp:
+    """Palm pose fixed in the handle link's frame; it follows the door along its arc."""
+
+    offset: np.ndarray
+    """[4, 4] palm pose in the handle link frame."""
+    normal_local: np.ndarray
+    """[3] door's outward normal in the link frame (the pre-pose backs off along it)."""
+    to_hinge: bool
+    """Fingers point towards the hinge (else towards the free edge)."""
+    tilt_rad: float = 0.0
+    """Palm turned about the bar's axis away from parallel to the door (fingers into the door, forearm out)."""
+    wrist: dict[str, float] = field(default_factory=dict)
+    """Hand wrist joint targets held during the grasp (extension lets the forearm come from the front)."""
+
+    def __str__(self) -> str:
+        side = "hinge" if self.to_hinge else "free edge"
+        return f"hook grasp (fingers towards the {side}, tilt {self.tilt_rad:.2f} rad, wrist {self.wrist})"
+
+    def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
+        """World palm pose at door angle ``q``, ``out_m`` further out along the door's normal."""
+        m = joint.link_at(q) @ self.offset
+        m[:3, 3] += out_m * (joint.link_at(q)[:3, :3] @ self.normal_local)
+        return _pose(m)
+
+
+def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
+    """Hook grasps of a bar parallel to the hinge axis through ``handle`` (link frame), in order of preference:
+    fingers towards the hinge first, then towards the free edge; for each, every tilt of :data:`TILTS_RAD` with
+    every wrist posture of :data:`WRIST_POSTURES`."""
+    link = joint.link
+    rot_t = link[:3, :3].T
+    axis = rot_t @ joint.axis
+    hinge = rot_t @ (joint.point - link[:3, 3])
+    n = DOOR_FRONT_LOCAL
+    radial = handle - hinge
+    radial -= np.dot(radial, axis) * axis  # from the hinge axis to the bar, perpendicular to it
+    out = []
+    for to_hinge in (True, False):
+        f = -radial if to_hinge else radial
+        f = f - np.dot(f, n) * n - np.dot(f, axis) * axis  # along the door's front, across the bar
+        f /= np.linalg.norm(f)
+        m = np.eye(4)
+        m[:3, :3] = palm_rotation(f, -n)
+        m[:3, 3] = handle + PALM_STANDOFF_M * n - BAR_ALONG_M * f
+        # turning about the bar keeps the bar where it is in the palm frame; the sign turns the fingers into the door
+        sign = 1.0 if np.dot(_rotation(axis, 0.1) @ f, n) < 0 else -1.0
+        for tilt in TILTS_RAD:
+            r = np.eye(4)
+            r[:3, :3] = _rotation(axis, sign * tilt)
+            r[:3, 3] = handle - r[:3, :3] @ handle
+            for wrist in WRIST_POSTURES:
+                out.append(HookGrasp(r @ m, n.copy(), to_hinge, tilt, dict(wrist)))
+    return out
+
+
+def opening_goal(env: TaskEnv, name: str) -> float:
+    """Joint position the pull aims for: the success condition's open fraction plus :data:`GOAL_MARGIN`."""
+    fractions = [c.min_fraction for c in env.task_spec.success.conditions
+                 if c.type == "joint_open" and c.object == name and c.min_fraction is not None]
+    frac = max(fractions) if fractions else 1.0
+    closed, opened = env.closed_qpos(name), env.open_qpos(name)
+    goal = closed + (frac + GOAL_MARGIN) * (opened - closed)
+    lo, hi = env.articulations[name].get_qlimits()[0, env.joint_index(name)].tolist()
+    return float(np.clip(goal, lo + 0.02, hi - 0.02))
+
+
+# ------------------------------------------------------------------------------------------------------ primitives
+@dataclass
+class HandleConfig:
+    """Speeds and checks of the articulated primitives (control steps at 20 Hz)."""
+
+    rate_rad: float = 0.04
+    """Door angle the palm target advances per control step (0.8 rad/s: the door never outruns the hand)."""
+    lead_rad: float = 0.1
+    """The palm target runs at most this far ahead of the measured door angle."""
+    max_steps: int = 90
+    stall_steps: int = 12
+    """The door moving less than ``stall_rad`` over this many steps ends the pull (hook slipped)."""
+    stall_rad: float = 0.01
+    close_steps: int = 10
+    squeeze_steps: int = 4
+    insert_m_per_step: float = 0.012
+
+
+class HandlePrimitives:
+    """The articulated primitives of one episode, built on the executor's :class:`ArmHandMotion`."""
+
+    def __init__(self, motion: ArmHandMotion, config: HandleConfig | None = None):
+        self.motion = motion
+        self.config = config or HandleConfig()
+        self.grasp: HookGrasp | None = None
+        self.hooked = False
+        self.target: str | None = None
+
+    def run(self, prim: str, stage) -> Iterator[np.ndarray]:
+        """The actions of primitive ``prim`` (``approach_handle``, ``hook`` or ``pull``) for ``stage``."""
+        if prim not in ("approach_handle", "hook", "pull"):
+            raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull")
+        return getattr(self, prim)(stage)
+
+    def mark_hooked(self, target: str) -> None:
+        """Record that the fingers hold ``target``'s handle (a trained grasp policy hooked it)."""
+        self.hooked, self.target = True, target
+
+    # ------------------------------------------------------------------ helpers
+    def _boxes(self, name: str, moving: bool) -> list[Box]:
+        """World boxes of the object's links (without the handle link when ``moving``), inflated 1 cm."""
+        u = self.motion.env
+        handle = u.handle_link(name).name
+        boxes = []
+        for link in u.articulations[name].get_links():
+            if moving and link.name == handle:
+                continue
+            aabb = px_objects(link)[0].compute_global_aabb_tight()  # PhysX's tight box
+            lo, hi = np.asarray(aabb, dtype=np.float64)
+            boxes.append(Box(lo - 0.01, hi + 0.01, f"{name}/{link.name}"))
+        return boxes
+
+    def _chain(self, poses: list[sapien.Pose], q: np.ndarray) -> np.ndarray | None:
+        """IK chained through ``poses`` from ``q`` (each solve seeded with the last); None when a pose has no
+        solution, the arm jumps branches (:data:`MAX_ARC_JUMP_RAD`) or a configuration collides."""
+        ex = self.motion
+        for pose in poses:
+            nq = ex.ik.solve(pose, q, restarts=0)
+            if nq is None or np.max(np.abs(nq[ex.ik.arm] - q[ex.ik.arm])) > MAX_ARC_JUMP_RAD \
+                    or not ex.collision.is_free(nq):
+                return None
+            q = nq
+        return q
+
+    def _arc(self, grasp: HookGrasp, joint: JointFrame, goal: float) -> list[sapien.Pose]:
+        """Palm poses along the door's arc from its angle now to ``goal``, :data:`ARC_CHECK_RAD` apart."""
+        n = max(1, int(np.ceil((goal - joint.q) / ARC_CHECK_RAD)))
+        return [grasp.palm_at(joint, joint.q + (goal - joint.q) * k / n) for k in range(1, n + 1)]
+
+    # ------------------------------------------------------------------ primitives
+    def approach_handle(self, stage) -> Iterator[np.ndarray]:
+        ex, name = self.motion, stage.target
+        u = ex.env
+        joint = read_joint(u, name)
+        handle = handle_local(u, name)
+        goal = opening_goal(u, name)
+        chosen = None
+        for grasp in hook_grasps(joint, handle):
+            q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
+            ex.collision.set_obstacles(self._boxes(name, moving=False))
+            q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20, valid=ex.collision.is_free)
+            if q_pre is None:
+                log.debug("%s: pre-pose unreachable", grasp)
+                continue
+            n = INSERT_CHECKS
+            q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)], q_pre)
+            if q_in is None:
+                log.debug("%s: no straight motion in", grasp)
+                continue
+            ex.collision.set_obstacles(self._boxes(name, moving=True))
+            if self._chain(self._arc(grasp, joint, goal), q_in) is None:
+                log.debug("%s: arm cannot follow the arc", grasp)
+                continue
+            chosen = (grasp, q_pre, q0)
+            break
+        if chosen is None:
+            raise ExecutionError(f"no hook grasp of {name!r}'s handle that the arm can reach and pull along the "
+                                 f"door's arc")
+        grasp, q_pre, q0 = chosen
+        log.info("%r: %s", name, grasp)
+        self.grasp, self.target, self.hooked = grasp, name, False
+        ex.collision.set_obstacles(self._boxes(name, moving=False))
+        yield from ex.move_arm(q_pre, hand=q0)
+        normal = joint.link[:3, :3] @ grasp.normal_local
+        yield from ex.cartesian(-PRE_M * normal, self.config.insert_m_per_step)
+        yield from ex.settle()
+
+    def hook(self, stage) -> Iterator[np.ndarray]:
+        ex, c = self.motion, self.config
+        if self.grasp is None or self.target != stage.target:
+            yield from self.approach_handle(stage)
+        closed = ex.with_hand(ex.target(), HOOK_CLOSED)
+        yield from ex.ramp(closed, c.close_steps, guard=True)
+        for _ in range(c.squeeze_steps):
+            yield ex.emit(closed, guard=True)
+        self.hooked = True
+
+    def pull(self, stage) -> Iterator[np.ndarray]:
+        ex, c, name = self.motion, self.config, stage.target
+        if not self.hooked or self.target != name:
+            yield from self.hook(stage)
+        u = ex.env
+        goal = opening_goal(u, name)
+        closed = ex.with_hand(ex.target(), HOOK_CLOSED)
+        history: list[float] = []
+        q_cmd = read_joint(u, name).q
+        for _ in range(c.max_steps):
+            joint = read_joint(u, name)
+            history.append(joint.q)
+            if joint.q >= goal:
+                log.info("door of %r at %.3f rad (goal %.3f)", name, joint.q, goal)
+                return
+            if len(history) > c.stall_steps and history[-1] - history[-1 - c.stall_steps] < c.stall_rad:
+                raise ExecutionError(f"the door of {name!r} stalled at {joint.q:.3f} rad (goal {goal:.3f}): the "
+                                     f"hook slipped off the handle")
+            target = ex.target()
+            q_next = min(q_cmd + c.rate_rad, joint.q + c.lead_rad, goal + 0.05)
+            q = ex.ik.solve(self.grasp.palm_at(joint, q_next), target, restarts=0)
+            if q is None:
+                raise ExecutionError(f"no IK for the palm on {name!r}'s door arc at {q_next:.3f} rad")
+            # where the arm must turn fast for the palm to keep up, the door command slows down instead (a uniform
+            # scale of the joint step keeps the palm on the arc; a per-joint clip would not)
+            delta = q[ex.ik.arm] - target[ex.ik.arm]
+            scale = min(1.0, ex.max_arm_step_rad / max(float(np.max(np.abs(delta))), 1e-9))
+            q_cmd += (q_next - q_cmd) * scale
+            t = closed.copy()
+            t[ex.ik.arm] = target[ex.ik.arm] + scale * delta
+            yield ex.emit(t, guard=True)
+        raise ExecutionError(f"the door of {name!r} reached {read_joint(u, name).q:.3f} rad of {goal:.3f} in "
+                             f"{c.max_steps} pull steps")
+
+
+__all__ = ["HOOK_CLOSED", "HOOK_OPEN", "HandleConfig", "HandlePrimitives", "HookGrasp", "JointFrame",
+           "handle_local", "hook_grasps", "opening_goal", "read_joint"]

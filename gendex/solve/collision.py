@@ -1,0 +1,99 @@
+"""Cheap, conservative collision model of the arm for planning: spheres along its capsules against the table and boxes.
+
+The simulator knows the exact geometry, but a planner asks thousands of "is this configuration free?" questions, so
+it gets a model that costs one forward-kinematics pass: every UR10e capsule of :data:`UR10E_LINKS` (and the Shadow
+forearm housing) is covered by spheres; a configuration is free when every sphere stays ``margin_m`` above the table
+top and outside every obstacle box. Fingers and palm are left out on purpose: they are meant to touch things.
+
+A held object is attached (:meth:`ArmCollisionModel.attach`) as spheres fixed in the palm frame, so a carry is
+planned with the object moving with the hand: it must clear the table, the other objects and the container's rim.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gendex.solve.ik import ArmIK
+from gendex_envs.agents.robot_model import UR10E_LINKS
+
+HOUSING_RADIUS_M = 0.055
+"""Radius of the sphere chain covering the Shadow forearm housing (link ``forearm`` to link ``wrist``)."""
+
+
+@dataclass(frozen=True)
+class Box:
+    """Axis-aligned obstacle box in the world frame, already inflated by whatever margin the caller wants."""
+
+    lo: np.ndarray  # [3]
+    hi: np.ndarray  # [3]
+    name: str = ""
+
+
+class ArmCollisionModel:
+    """Sphere cover of the arm; :meth:`clearance` is the signed free distance (m) of one joint vector."""
+
+    def __init__(self, ik: ArmIK, table_z: float = 0.0, margin_m: float = 0.02, per_capsule: int = 4):
+        self.ik = ik
+        self.table_z = table_z
+        self.margin_m = margin_m
+        self.boxes: list[Box] = []
+        t = np.linspace(0.0, 1.0, per_capsule)[:, None]
+        self._spheres: list[tuple[str, np.ndarray, np.ndarray]] = []  # (link, local centres [k, 3], radii [k])
+        for link in UR10E_LINKS[1:]:  # the shoulder never moves relative to the table
+            for p0, p1, r in link.capsules:
+                centres = np.asarray(p0, float) + t * (np.asarray(p1, float) - np.asarray(p0, float))
+                self._spheres.append((link.name, centres, np.full(len(centres), r)))
+        self._housing = t
+        self._attached: tuple[np.ndarray, np.ndarray] | None = None  # palm-frame centres [k, 3], radii [k]
+        self._palm = ik.link_names.index("palm")
+
+    def attach(self, world_centres: np.ndarray, radii: np.ndarray, q: np.ndarray) -> None:
+        """Fix spheres (world centres at joint vector ``q``) to the palm: they move with the hand from now on."""
+        palm = self.ik.fk(q).to_transformation_matrix()
+        inv = np.linalg.inv(palm)
+        local = np.asarray(world_centres, float) @ inv[:3, :3].T + inv[:3, 3]
+        self._attached = (local, np.asarray(radii, float))
+
+    def detach(self) -> None:
+        self._attached = None
+
+    @property
+    def attached(self) -> bool:
+        return self._attached is not None
+
+    def set_obstacles(self, boxes: list[Box]) -> None:
+        self.boxes = list(boxes)
+
+    def sphere_centres(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """World sphere centres [S, 3] and radii [S] at joint vector ``q``."""
+        ik = self.ik
+        ik.model.compute_forward_kinematics(np.asarray(q, dtype=np.float64))
+        base = ik.base.to_transformation_matrix()
+        centres, radii = [], []
+        for link, local, r in self._spheres:
+            m = base @ ik.model.get_link_pose(ik.link_names.index(link)).to_transformation_matrix()
+            centres.append(local @ m[:3, :3].T + m[:3, 3])
+            radii.append(r)
+        a = (base @ ik.model.get_link_pose(ik.link_names.index("forearm")).to_transformation_matrix())[:3, 3]
+        b = (base @ ik.model.get_link_pose(ik.link_names.index("wrist")).to_transformation_matrix())[:3, 3]
+        centres.append(a + self._housing * (b - a))
+        radii.append(np.full(len(self._housing), HOUSING_RADIUS_M))
+        if self._attached is not None:
+            m = base @ ik.model.get_link_pose(self._palm).to_transformation_matrix()
+            centres.append(self._attached[0] @ m[:3, :3].T + m[:3, 3])
+            radii.append(self._attached[1])
+        return np.concatenate(centres), np.concatenate(radii)
+
+    def clearance(self, q: np.ndarray) -> float:
+        """Smallest distance (m) between a sphere and the table top or a box, minus the margin; >= 0 means free."""
+        c, r = self.sphere_centres(q)
+        d = float(np.min(c[:, 2] - r - self.table_z))
+        for box in self.boxes:
+            gap = np.maximum(np.maximum(box.lo - c, c - box.hi), 0.0)
+            d = min(d, float(np.min(np.linalg.norm(gap, axis=1) - r)))
+        return d - self.margin_m
+
+    def is_free(self, q: np.ndarray) -> bool:
+        return self.clearance(q) >= 0.0

@@ -1,0 +1,113 @@
+"""Collision-aware joint-space motion planning for the UR10e (OMPL RRT-Connect over :class:`ArmCollisionModel`).
+
+A motion is asked for as start and goal arm configurations (the goal usually from :class:`ArmIK`). The straight
+joint-space segment is tried first (most table-top motions are free); otherwise RRT-Connect searches the 6-D joint
+space and the path is shortcut-simplified. Either way the result is densified into per-control-step waypoints no
+more than ``max_step_rad`` apart, so a position-controlled arm tracks it closely.
+"""
+
+from __future__ import annotations
+
+import logging
+from itertools import pairwise
+
+import numpy as np
+
+from gendex.solve.collision import ArmCollisionModel
+from gendex_envs.errors import GenDexError
+
+log = logging.getLogger(__name__)
+
+
+class PlanningError(GenDexError):
+    """No collision-free arm motion was found (start or goal in collision, or the search ran out of time)."""
+
+
+class ArmPlanner:
+    """Plans arm motions for one env; joint vectors are full [dof] vectors, only the arm entries move."""
+
+    def __init__(self, collision: ArmCollisionModel, max_step_rad: float = 0.04, check_step_rad: float = 0.02,
+                 time_limit_s: float = 2.0, seed: int = 0):
+        self.collision = collision
+        self.ik = collision.ik
+        self.max_step_rad = max_step_rad
+        self.check_step_rad = check_step_rad
+        self.time_limit_s = time_limit_s
+        self.seed = seed
+
+    def segment_free(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """True when every configuration on the straight joint-space segment a→b (arm entries) is free."""
+        n = max(2, int(np.ceil(np.max(np.abs(b - a)) / self.check_step_rad)) + 1)
+        return all(self.collision.is_free(a + (b - a) * t) for t in np.linspace(0.0, 1.0, n))
+
+    def plan(self, q_start: np.ndarray, q_goal: np.ndarray) -> np.ndarray:
+        """Waypoints [T, dof] from ``q_start`` (excluded) to ``q_goal`` (included); hand entries copy ``q_goal``.
+
+        Raises :class:`PlanningError` when the goal is in collision or no path is found within the time limit.
+        A start in collision (e.g. fingers already touching an object lifted a little into the margin) is allowed:
+        the search leaves it along the straight segment toward the goal when it can.
+        """
+        q_start = np.asarray(q_start, dtype=np.float64)
+        q_goal = np.asarray(q_goal, dtype=np.float64)
+        arm = self.ik.arm
+        start = q_goal.copy()
+        start[arm] = q_start[arm]
+        if not self.collision.is_free(q_goal):
+            raise PlanningError(f"goal configuration in collision (clearance "
+                                f"{self.collision.clearance(q_goal):+.3f} m)")
+        if self.segment_free(start, q_goal) or not self.collision.is_free(start):
+            path = [start, q_goal]
+        else:
+            path = self._rrt(start, q_goal)
+        return self._densify(path)
+
+    def _densify(self, path: list[np.ndarray]) -> np.ndarray:
+        out = []
+        for a, b in pairwise(path):
+            n = max(1, int(np.ceil(np.max(np.abs(b - a)) / self.max_step_rad)))
+            out.extend(a + (b - a) * k / n for k in range(1, n + 1))
+        return np.asarray(out)
+
+    def _rrt(self, start: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
+        try:
+            from ompl import base as ob
+            from ompl import geometric as og
+            from ompl import util as ou
+        except ImportError as e:  # pragma: no cover - ompl is a dependency
+            raise PlanningError("the straight motion is blocked and OMPL is not importable "
+                                "(pip install ompl)") from e
+        ou.setLogLevel(ou.LOG_WARN)
+        arm = self.ik.arm
+        lo, hi = self.ik.limits[arm, 0], self.ik.limits[arm, 1]
+        space = ob.RealVectorStateSpace(len(arm))
+        bounds = ob.RealVectorBounds(len(arm))
+        for i in range(len(arm)):
+            # the search stays within ±π of the straight path's span: no full wrist turns
+            bounds.setLow(i, float(max(lo[i], min(start[arm[i]], goal[arm[i]]) - np.pi)))
+            bounds.setHigh(i, float(min(hi[i], max(start[arm[i]], goal[arm[i]]) + np.pi)))
+        space.setBounds(bounds)
+        ss = og.SimpleSetup(space)
+        template = goal.copy()
+
+        def full(state) -> np.ndarray:
+            q = template.copy()
+            q[arm] = [state[i] for i in range(len(arm))]
+            return q
+
+        ss.setStateValidityChecker(lambda s: self.collision.is_free(full(s)))
+        si = ss.getSpaceInformation()
+        span = float(np.max(hi - lo))
+        si.setStateValidityCheckingResolution(self.check_step_rad / span)
+        s0, s1 = space.allocState(), space.allocState()
+        for i in range(len(arm)):
+            s0[i], s1[i] = float(start[arm[i]]), float(goal[arm[i]])
+        ss.setStartAndGoalStates(s0, s1)
+        ss.setPlanner(og.RRTConnect(si))
+        solved = ss.solve(self.time_limit_s)
+        if not solved or not ss.haveExactSolutionPath():
+            raise PlanningError(f"RRT-Connect found no collision-free arm path in {self.time_limit_s:.1f} s")
+        ss.simplifySolution()
+        states = ss.getSolutionPath().getStates()
+        path = [full(s) for s in states]
+        log.debug("RRT-Connect path with %d waypoints", len(path))
+        return path

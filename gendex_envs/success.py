@@ -1,0 +1,159 @@
+"""Success: the one authority that decides whether a task, or one of its stages, has succeeded.
+
+Success is declared in the spec (``success.conditions`` for the task, ``stages[k].success`` for a stage) and
+evaluated here, batched over ``num_envs``. Reward code cannot grant success: a reward module's ``evaluate`` returns
+``fail`` (an episode-ending failure, e.g. the object fell off the table) and diagnostics for its dense reward and
+observations, and ``fail`` vetoes success. So for every env and step::
+
+    success = all conditions hold  and  not fail
+    fail    = the reward module's fail
+
+The task's ``hold_steps`` (conditions held that many consecutive steps) is applied by the env, which owns the
+per-episode counters. Every consumer reads success through a :class:`Judge`: the env's ``evaluate`` (and so
+training, data collection, replay and evaluation), the stage executor when a stage policy runs, start-state
+collection, and the generator's critic (which reads the declared conditions for what the task asks of a scene).
+
+The condition types and their fields are listed in :data:`gendex_envs.spec.CONDITION_FIELDS`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import torch
+
+from gendex_envs.errors import RewardModuleError, TaskSpecError
+from gendex_envs.geometry import xy_distance, z_twist
+from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, TaskSpec
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gendex_envs.reward_module import RewardModule
+    from gendex_envs.task_env import TaskEnv
+
+INSIDE_FLOOR_TOL_M = 0.01
+"""An object counts as inside a container from this far below the container's origin (a seated object may sink
+into a thin floor) up to the container's height."""
+THUMB, PALM = 0, 5
+"""Rows of the hand's contact-force groups (thumb, index, middle, ring, little, palm)."""
+
+
+def _param(c: ConditionSpec, name: str):
+    value = getattr(c, name)
+    return CONDITION_DEFAULTS[name] if value is None else value
+
+
+def _anchor(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
+    """[N, 3] the point a hand condition refers to: the object's origin, or its handle's grip point."""
+    return env.handle_pos(c.object, c.joint) if c.part == "handle" else env.obj_pose(c.object).p
+
+
+def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
+    t = c.type
+    if t == "lifted":
+        return env.obj_height(c.object) >= c.min_height_m
+    if t == "joint_open":
+        return env.joint_open_fraction(c.object, c.joint) >= c.min_fraction
+    if t == "near":
+        target = env.goal_pos if c.target == GOAL_TARGET else env.obj_pose(c.target).p
+        return torch.linalg.norm(env.obj_pose(c.object).p - target, dim=-1) <= c.max_dist_m
+    if t == "inside":
+        inner_r, top = env.container_extent(c.target)
+        box, p = env.obj_pose(c.target).p, env.obj_pose(c.object).p
+        dz = p[:, 2] - box[:, 2]
+        return (xy_distance(p, box) <= inner_r) & (dz >= -INSIDE_FLOOR_TOL_M) & (dz <= top)
+    if t == "rotated":
+        twist = z_twist(env.obj_pose(c.object).q, env.init_obj_quat(c.object))
+        goal = math.radians(c.min_deg)
+        return twist >= goal if goal > 0 else twist <= goal
+    if t == "over":
+        p, q = env.obj_pose(c.object).p, env.obj_pose(c.target).p
+        dz = p[:, 2] - q[:, 2]
+        return (xy_distance(p, q) <= c.max_xy_m) & (dz >= c.min_dz_m) & (dz <= c.max_dz_m)
+    if t in ("grasped", "released"):
+        force = env.hand_forces(c.object, part=c.part, joint=c.joint)  # [N, 6]
+        if t == "released":
+            return (force <= _param(c, "max_force_n")).all(dim=1)
+        touching = force > _param(c, "min_force_n")
+        ok = touching[:, THUMB + 1:PALM].sum(dim=1) >= _param(c, "min_fingers")
+        if _param(c, "thumb"):
+            ok = ok & touching[:, THUMB]
+        if c.max_palm_force_n is not None:
+            ok = ok & (force[:, PALM] <= c.max_palm_force_n)
+        return ok
+    if t == "hand_at":
+        point, palm = _anchor(env, c), env.palm_pose.p
+        ring = _param(c, "ring_radius_m")
+        if ring > 0:  # the nearest point of the ring about the vertical axis: any side will do
+            d = palm[:, :2] - point[:, :2]
+            side = d / torch.linalg.norm(d, dim=-1, keepdim=True).clamp_min(1e-6)
+            goal = torch.cat([point[:, :2] + ring * side, point[:, 2:] + _param(c, "above_m")], dim=-1)
+        else:
+            goal = point.clone()
+            goal[:, 2] += _param(c, "above_m")
+        return torch.linalg.norm(palm - goal, dim=-1) <= c.max_dist_m
+    if t == "fingertips_near":
+        point = _anchor(env, c)
+        return torch.linalg.norm(env.tip_positions - point[:, None, :], dim=-1).mean(dim=1) <= c.max_dist_m
+    if t == "hand_open":
+        spread = torch.linalg.norm(env.tip_positions - env.palm_pose.p[:, None, :], dim=-1).mean(dim=1)
+        return spread >= c.min_spread_m
+    raise TaskSpecError(f"unknown condition type {t!r}")
+
+
+def condition_holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
+    """[N] bool: condition ``c`` holds now in each env."""
+    ok = _holds(env, c)
+    return ~ok if c.negate else ok
+
+
+def conditions_hold(env: TaskEnv, conditions: tuple[ConditionSpec, ...]) -> torch.Tensor:
+    """[N] bool: every condition holds now."""
+    ok = torch.ones(env.num_envs, dtype=torch.bool, device=env.device)
+    for c in conditions:
+        ok = ok & condition_holds(env, c)
+    return ok
+
+
+@dataclass(frozen=True)
+class Judge:
+    """Decides success of the task or of one stage: the declared conditions, vetoed by the reward module's fail."""
+
+    label: str
+    """What is judged, for messages ("task PutAppleBowl", "stage grasp_apple of PutAppleBowl")."""
+    conditions: tuple[ConditionSpec, ...]
+    module: RewardModule
+    """The reward module whose ``evaluate`` gives ``fail`` and the diagnostics its reward and observations use."""
+    stage: str | None = None
+    """The stage judged (None: the whole task)."""
+
+    @classmethod
+    def of_task(cls, spec: TaskSpec, module: RewardModule) -> Judge:
+        return cls(f"task {spec.name}", spec.success.conditions, module)
+
+    @classmethod
+    def of_stage(cls, spec: TaskSpec, stage: StageSpec, module: RewardModule) -> Judge:
+        return cls(f"stage {stage.name} of {spec.name}", spec.stage_conditions(stage), module, stage.name)
+
+    def evaluate(self, env: TaskEnv) -> dict[str, torch.Tensor]:
+        """The module's diagnostics with ``success`` and ``fail`` ([N] bool) decided as the module doc says."""
+        info = self.module.evaluate(env)
+        n = env.num_envs
+        if not isinstance(info, dict):
+            raise RewardModuleError(f"{self.module.path}: evaluate() must return a dict of [num_envs] tensors, got "
+                                    f"{type(info).__name__}")
+        if "success" in info:
+            raise RewardModuleError(f"{self.module.path}: evaluate() returned 'success', but success is declared in "
+                                    "the task spec (success.conditions, stages[].success); evaluate returns 'fail' "
+                                    "and diagnostics only")
+        info = dict(info)
+        fail = info.get("fail")
+        if fail is None:
+            fail = torch.zeros(n, dtype=torch.bool, device=env.device)
+        elif not isinstance(fail, torch.Tensor) or fail.shape != (n,) or fail.dtype != torch.bool:
+            raise RewardModuleError(f"{self.module.path}: evaluate()['fail'] must be a bool tensor of shape [{n}], got "
+                                    f"{getattr(fail, 'dtype', type(fail))} {tuple(getattr(fail, 'shape', ()))}")
+        info["success"] = conditions_hold(env, self.conditions) & ~fail
+        info["fail"] = fail
+        return info

@@ -1,0 +1,44 @@
+"""Standard success conditions of a stage, by its skill: what the plan step declares when the model gives none.
+
+A stage's success is data in the spec (``stages[k].success``, :mod:`gendex_envs.success`). The templates below
+follow the reference tasks: a grasp holds the target with the thumb against two fingers (a hook on a handle: three
+fingers, no thumb), a lift holds it at the task's lift height, a release leaves the task's success met with the hand
+let go, an open or close moves the joint past the task's fraction. Skills without a template (reach, carry, place,
+push, turn, reorient) declare nothing, so the stage succeeds with the task.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+LIFT_M = 0.1
+"""Lift height when the task states none (a ``lifted`` success condition states it)."""
+OPEN_FRACTION = 0.8
+"""Joint opening when the task states none (a ``joint_open`` success condition states it)."""
+
+
+def _task_value(task_conditions: list[dict], kind: str, obj: str, key: str, default: float) -> float:
+    for c in task_conditions:
+        if c.get("type") == kind and c.get("object") == obj and c.get(key) is not None:
+            return float(c[key])
+    return default
+
+
+def stage_goal(skill: str, target: str | None, task_conditions: list[dict], articulated: bool) -> list[dict] | None:
+    """The standard ``success`` of a stage (a list of condition mappings), or None when the skill has none."""
+    if target is None:
+        return None
+    if skill == "grasp":
+        if articulated:
+            return [{"type": "grasped", "object": target, "part": "handle", "min_fingers": 3, "thumb": False}]
+        return [{"type": "grasped", "object": target}]
+    if skill == "lift":
+        h = _task_value(task_conditions, "lifted", target, "min_height_m", LIFT_M)
+        return [{"type": "grasped", "object": target}, {"type": "lifted", "object": target, "min_height_m": h}]
+    if skill == "release":
+        return [*(dict(c) for c in task_conditions), {"type": "grasped", "object": target, "negate": True}]
+    if skill in ("open", "close"):
+        frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
+        cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
+        return [cond | {"negate": True}] if skill == "close" else [cond]
+    return None

@@ -1,0 +1,427 @@
+"""Child process of the reward probe (internal to :mod:`generator.steps.validate`).
+
+``python -m generator.steps.probe_child JOB.json`` builds the task's env once, then for each candidate reward module
+swaps it in (wrapped so that every call is checked), resets with the job's seed and steps seeded random actions.
+It reports JSON lines to the job's ``progress`` file, one object per line (``ev`` says which):
+
+* ``{"ev": "ready", "rss_kb": int}``: the env is built.
+* ``{"ev": "module", "i": int}``: module ``i`` starts (the parent's per-module time limit starts here).
+* ``{"ev": "call", "i": int, "fn": str, "step": int}``: a reward function is about to run (step 0 is the reset).
+* ``{"ev": "result", "i": int, "ok": true, "report": {...}}`` or ``{..., "ok": false, "error": {...}}`` where
+  ``error`` is ``{"kind", "fn", "step", "message"}``; ``kind`` is ``violation`` (wrong output), ``exception``,
+  ``import``, ``audit`` (file/process/network access) or ``env`` (the env failed outside reward code).
+* ``{"ev": "setup_error", "type": str, "message": str}``: the env could not be built.
+* ``{"ev": "done"}``.
+
+The checks are batched tensor operations (no per-env Python loops), so they work on the GPU backend as well.
+Time, memory and crash limits are the parent's job: it kills this process group; ``SIGUSR1`` makes
+:mod:`faulthandler` dump the stack first, so the parent can name the line that hung.
+"""
+
+from __future__ import annotations
+
+import faulthandler
+import json
+import logging
+import math
+import resource
+import signal
+import sys
+import time
+import traceback
+import warnings
+from pathlib import Path
+from typing import ClassVar
+
+log = logging.getLogger(__name__)
+
+EXCEPTION_TEXT_LIMIT = 600
+_BLOCKED_EVENT_PREFIXES = (
+    "open", "os.", "subprocess.", "socket.", "shutil.", "ctypes.", "builtins.input", "pty.", "urllib.",
+    "webbrowser.", "glob.", "tempfile.", "sys.addaudithook", "marshal.", "pickle.", "winreg.", "msvcrt.", "sqlite3.",
+    "ftplib.", "smtplib.", "poplib.", "imaplib.", "nntplib.", "telnetlib.", "http.client.",
+)
+"""Audit events refused while reward code runs (a second fence behind the static check; PEP 578 hooks)."""
+
+
+class _Audit:
+    """Refuses file, process and network events while ``active``; remembers the first one for the report."""
+
+    active: ClassVar[bool] = False
+    events: ClassVar[list[str]] = []
+
+    @classmethod
+    def hook(cls, event: str, args: tuple) -> None:
+        if not cls.active or not event.startswith(_BLOCKED_EVENT_PREFIXES):
+            return
+        detail = ", ".join(repr(a)[:80] for a in args[:2])
+        cls.events.append(f"{event}({detail})")
+        raise PermissionError(f"blocked by the reward probe: {event}")
+
+
+class _Violation(Exception):
+    """A reward function broke the interface; carries the JSON error record."""
+
+    def __init__(self, kind: str, fn: str | None, step: int, message: str):
+        super().__init__(message)
+        self.record = {"kind": kind, "fn": fn, "step": step, "message": message}
+
+
+def _when(step: int) -> str:
+    return "right after reset (step 0)" if step == 0 else f"at step {step}"
+
+
+def _describe(value) -> str:
+    """Short description of a returned value for error messages: type, dtype, shape, device."""
+    import torch
+
+    if isinstance(value, torch.Tensor):
+        return f"a {value.dtype} tensor of shape {tuple(value.shape)} on {value.device}"
+    if isinstance(value, bool | int | float):
+        return f"a Python {type(value).__name__} ({value!r})"
+    if value is None:
+        return "None"
+    return f"a {type(value).__module__}.{type(value).__qualname__}"
+
+
+def _exception_text(exc: BaseException, module_path: Path, fn: str | None = None) -> str:
+    """``Type: message at line N (`code`)``; the line is the deepest frame inside the reward module."""
+    text = f"{type(exc).__name__}: {exc}".strip()
+    if len(text) > EXCEPTION_TEXT_LIMIT:
+        text = text[: EXCEPTION_TEXT_LIMIT - 3] + "..."
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if Path(f.filename).resolve() == module_path]
+    if frames:
+        f = frames[-1]
+        code = f" (`{f.line.strip()}`)" if f.line and f.line.strip() else ""
+        text += f" at line {f.lineno}{code}" + (f" in {f.name}" if f.name != fn else "")
+    return text
+
+
+class _CheckedModule:
+    """Wraps one reward module: runs each function under the audit hook and checks what it returns."""
+
+    def __init__(self, env, module, progress, index: int):
+        import torch
+
+        self.torch = torch
+        self.env = env
+        self.module = module
+        self.progress = progress
+        self.index = index
+        self.n = env.num_envs
+        self.device = torch.device(env.device)
+        self.step = 0
+        self.rewards: list = []
+        self.successes: list = []
+        self.fails: list = []
+        self.obs_shapes: dict[str, tuple[int, ...]] = {}
+        self.reserved_obs_keys: frozenset[str] = frozenset()
+        self.warnings: list[str] = []
+
+    # -------------------------------------------------------------- running untrusted calls
+    def call(self, fn_name: str, fn, *args):
+        self.progress.emit(ev="call", i=self.index, fn=fn_name, step=self.step)
+        _Audit.events.clear()
+        with warnings.catch_warnings(record=True) as caught:  # no linecache file reads for warnings
+            warnings.simplefilter("always")
+            _Audit.active = True
+            try:
+                out = fn(*args)
+            except BaseException as exc:
+                _Audit.active = False
+                if _Audit.events:
+                    raise self._audit_violation(fn_name) from None
+                raise _Violation("exception", fn_name, self.step,
+                                 f"{_when(self.step)}, {fn_name} raised "
+                                 f"{_exception_text(exc, self.module.path, fn_name)}") from None
+            finally:
+                _Audit.active = False
+        if _Audit.events:
+            raise self._audit_violation(fn_name)
+        for w in caught:
+            text = f"{fn_name} warned {_when(self.step)}: {w.category.__name__}: {w.message}"
+            if text not in self.warnings and len(self.warnings) < 10:
+                self.warnings.append(text)
+        return out
+
+    def _audit_violation(self, fn_name: str) -> _Violation:
+        return _Violation("audit", fn_name, self.step,
+                          f"{_when(self.step)}, {fn_name} tried to reach outside the simulator "
+                          f"({_Audit.events[0]}); reward code may not touch files, processes or the network")
+
+    def fail(self, fn_name: str, message: str) -> _Violation:
+        return _Violation("violation", fn_name, self.step, f"{_when(self.step)}, {fn_name} {message}")
+
+    # -------------------------------------------------------------- checks (batched; no per-env loops)
+    def _check_device(self, fn: str, what: str, value) -> None:
+        dev = value.device
+        if dev.type != self.device.type or (self.device.index is not None and dev.index != self.device.index):
+            raise self.fail(fn, f"returned {what} on {dev}; expected the env's device {self.device} "
+                            "(create tensors with device=env.device)")
+
+    def _check_finite(self, fn: str, what: str, value) -> None:
+        if value.is_floating_point() or value.is_complex():
+            bad = ~self.torch.isfinite(value)
+            if bool(bad.any()):
+                kinds = []
+                if bool(self.torch.isnan(value).any()):
+                    kinds.append("NaN")
+                if bool(self.torch.isinf(value).any()):
+                    kinds.append("inf")
+                envs = bad.reshape(bad.shape[0], -1).any(dim=1).nonzero().flatten()[:8].tolist() \
+                    if bad.dim() else []
+                raise self.fail(fn, f"returned non-finite values ({'/'.join(kinds)}) in {what} for env(s) {envs}; "
+                                "guard divisions, logs and square roots (e.g. clamp denominators with "
+                                ".clamp(min=1e-6))")
+
+    def _check_flag(self, info: dict, key: str) -> None:
+        n = self.n
+        value = info[key]
+        torch = self.torch
+        expected = f"a torch.bool tensor of shape ({n},) on {self.device}"
+        if not isinstance(value, torch.Tensor):
+            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected {expected}")
+        if value.dtype != torch.bool:
+            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected {expected} (use a "
+                            "comparison such as `dist < 0.05`, or `.bool()`)")
+        if tuple(value.shape) != (n,):
+            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected shape ({n},), one "
+                            "flag per env ([num_envs])")
+        self._check_device("evaluate", repr(key), value)
+
+    def evaluate(self, env) -> dict:
+        torch = self.torch
+        info = self.call("evaluate", self.module.evaluate, env)
+        if not isinstance(info, dict):
+            raise self.fail("evaluate", f"returned {_describe(info)}; expected a dict with 'fail' ([{self.n}] bool "
+                            "tensor) and diagnostics")
+        bad_keys = [k for k in info if not isinstance(k, str)]
+        if bad_keys:
+            raise self.fail("evaluate", f"returned non-string keys {bad_keys[:5]!r}; info keys must be strings")
+        if "success" in info:
+            raise self.fail("evaluate", "returned 'success', but success is declared in the task spec "
+                            "(success.conditions, stages[].success) and decided by the env; return 'fail' and "
+                            "diagnostics only")
+        if "fail" not in info:
+            raise self.fail("evaluate", f"returned keys {sorted(info)} without 'fail'; generated reward modules "
+                            "must return 'fail' as a [num_envs] bool tensor (all False when nothing counts as "
+                            "failure, e.g. `torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)`)")
+        if "elapsed_steps" in info:
+            raise self.fail("evaluate", "returned the key 'elapsed_steps', which the env sets itself; rename it")
+        self._check_flag(info, "fail")
+        for key, value in info.items():
+            if key == "fail":
+                continue
+            if not isinstance(value, torch.Tensor) or value.dim() == 0 or value.shape[0] != self.n:
+                raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; every info entry must be a "
+                                f"tensor with leading dimension num_envs={self.n} ([num_envs, ...])")
+            self._check_device("evaluate", repr(key), value)
+            self._check_finite("evaluate", repr(key), value)
+        return info
+
+    def compute_dense_reward(self, env, obs, action, info):
+        torch = self.torch
+        self.successes.append(info["success"].detach().clone())  # as the env decided it (conditions, fail)
+        self.fails.append(info["fail"].detach().clone())
+        reward = self.call("compute_dense_reward", self.module.compute_dense_reward, env, obs, action, info)
+        expected = f"a float tensor of shape ({self.n},) on {self.device}"
+        if not isinstance(reward, torch.Tensor):
+            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected {expected}, one reward "
+                            "per env")
+        if not reward.is_floating_point():
+            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected {expected} "
+                            "(convert with `.float()`)")
+        if tuple(reward.shape) != (self.n,):
+            hint = " (drop the trailing dimension, e.g. `.squeeze(-1)`)" if reward.dim() == 2 and \
+                reward.shape[0] == self.n and reward.shape[1] == 1 else ""
+            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected shape ({self.n},) "
+                            f"([num_envs]){hint}")
+        self._check_device("compute_dense_reward", "the reward", reward)
+        self._check_finite("compute_dense_reward", "the reward", reward)
+        self.rewards.append(reward.detach().float().clone())
+        return reward
+
+    def get_obs_extra(self, env, info) -> dict:
+        torch = self.torch
+        fn = "_get_obs_extra"
+        extra = self.call(fn, self.module.get_obs_extra, env, info)
+        if not isinstance(extra, dict):
+            raise self.fail(fn, f"returned {_describe(extra)}; expected a dict of [num_envs, ...] tensors")
+        for key, value in extra.items():
+            if not isinstance(key, str):
+                raise self.fail(fn, f"returned the non-string key {key!r}; observation keys must be strings")
+            if key in self.reserved_obs_keys:
+                raise self.fail(fn, f"returned the key {key!r}, which would replace the env's own observation "
+                                f"of that name (taken: {sorted(self.reserved_obs_keys)}); rename it")
+            if not isinstance(value, torch.Tensor) or value.dim() == 0 or value.shape[0] != self.n:
+                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; expected a tensor with leading "
+                                f"dimension num_envs={self.n} ([num_envs] or [num_envs, k])")
+            if value.dim() > 2:
+                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; state observations are flattened "
+                                "per env, so use at most 2 dimensions (e.g. `.flatten(1)`)")
+            if value.is_complex() or not (value.is_floating_point() or value.dtype in (torch.bool, torch.int32,
+                                                                                        torch.int64)):
+                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; expected a float tensor")
+            self._check_device(fn, repr(key), value)
+            self._check_finite(fn, repr(key), value)
+            shape = tuple(value.shape)
+            first = self.obs_shapes.setdefault(key, shape)
+            if first != shape:
+                raise self.fail(fn, f"returned {key!r} with shape {shape}, but it had shape {first} before; "
+                                "observation shapes must not change between steps")
+        missing = sorted(set(self.obs_shapes) - set(extra))
+        if missing:
+            raise self.fail(fn, f"stopped returning the keys {missing}; every step must return the same keys")
+        return extra
+
+    # -------------------------------------------------------------- summary
+    def report(self, display: str, wall_s: float) -> dict:
+        torch = self.torch
+        rewards = torch.cat(self.rewards) if self.rewards else torch.zeros(0)
+        successes = torch.stack(self.successes).float() if self.successes else torch.zeros(0)
+        fails = torch.stack(self.fails).float() if self.fails else torch.zeros(0)
+        warns = list(self.warnings)
+        if rewards.numel():
+            r_max = float(rewards.max())
+            if r_max > self.module.reward_max * (1 + 1e-5):
+                warns.append(f"compute_dense_reward returned {r_max:.4g} > REWARD_MAX={self.module.reward_max:g}; "
+                             "the normalised reward will exceed 1")
+            if rewards.numel() > 1 and float(rewards.max() - rewards.min()) == 0.0:
+                warns.append(f"compute_dense_reward returned the same value ({r_max:.4g}) at every step: no "
+                             "learning signal under random actions")
+        if successes.numel() and bool(successes[0].all()):
+            warns.append("success is already True at the first step")
+        if fails.numel() and bool(fails[0].all()):
+            warns.append("fail is already True at the first step: every episode would end at once")
+        return {
+            "module": display,
+            "path": str(self.module.path),
+            "steps": self.step,
+            "num_envs": self.n,
+            "reward_min": float(rewards.min()) if rewards.numel() else math.nan,
+            "reward_max": float(rewards.max()) if rewards.numel() else math.nan,
+            "reward_mean": float(rewards.mean()) if rewards.numel() else math.nan,
+            "success_rate": float(successes.mean()) if successes.numel() else 0.0,
+            "fail_rate": float(fails.mean()) if fails.numel() else 0.0,
+            "obs_extra": {k: list(v[1:]) for k, v in self.obs_shapes.items()},
+            "wall_s": round(wall_s, 3),
+            "warnings": warns,
+        }
+
+
+class _Progress:
+    def __init__(self, path: str):
+        self.f = open(path, "a", buffering=1, encoding="utf-8")
+
+    def emit(self, **record) -> None:
+        self.f.write(json.dumps(record, default=str) + "\n")
+        self.f.flush()
+
+
+def _vm_kb(field: str) -> int:
+    with open("/proc/self/status", encoding="ascii") as f:
+        for line in f:
+            if line.startswith(field + ":"):
+                return int(line.split()[1])
+    return 0
+
+
+def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
+    """Probe one module; returns the result record."""
+    import torch
+
+    from gendex_envs.reward_module import RewardModule, load_reward_module
+    from gendex_envs.spec import resolve_stage
+    from gendex_envs.success import Judge
+
+    path = Path(job["modules"][index]).resolve()
+    display = job["displays"][index]
+    t0 = time.monotonic()
+    progress.emit(ev="module", i=index)
+    try:
+        module = load_reward_module(path)
+    except Exception as exc:
+        cause = exc.__cause__ or exc
+        text = _exception_text(cause, path) if exc.__cause__ else f"{type(exc).__name__}: {exc}"
+        return {"ev": "result", "i": index, "ok": False,
+                "error": {"kind": "import", "fn": None, "step": 0, "message": f"importing it failed: {text}"}}
+    checked = _CheckedModule(env, module, progress, index)
+    checked.reserved_obs_keys = job["_reserved_obs_keys"]
+    wrapped = RewardModule(path=module.path, evaluate=checked.evaluate,
+                           compute_dense_reward=checked.compute_dense_reward,
+                           get_obs_extra=checked.get_obs_extra if module.get_obs_extra else None,
+                           reward_max=module.reward_max)
+    stage = job["stages"][index]
+    spec = env.task_spec
+    # judged as the env will judge it: a stage module by its stage's conditions, the task's by the task's
+    if stage is not None and stage in {s.name for s in spec.stages}:
+        env.judge = Judge.of_stage(spec, resolve_stage(spec, stage)[1], wrapped)
+    else:
+        env.judge = Judge.of_task(spec, wrapped)
+    gen = torch.Generator().manual_seed(job["seed"])
+    try:
+        env.reset(seed=job["seed"])
+        low = torch.as_tensor(env.action_space.low, dtype=torch.float32)
+        high = torch.as_tensor(env.action_space.high, dtype=torch.float32)
+        for step in range(1, job["steps"] + 1):
+            checked.step = step
+            action = low + (high - low) * torch.rand(low.shape, generator=gen)
+            env.step(action.to(env.device))
+    except _Violation as v:
+        return {"ev": "result", "i": index, "ok": False, "error": v.record}
+    except Exception as exc:
+        tb = "".join(traceback.format_exception(exc, limit=-4)).strip()
+        return {"ev": "result", "i": index, "ok": False,
+                "error": {"kind": "env", "fn": None, "step": checked.step,
+                          "message": f"{_when(checked.step)}, the env failed outside the reward functions: "
+                                     f"{type(exc).__name__}: {exc}\n{tb}"}}
+    finally:
+        env.judge = job["_default_judge"]
+    return {"ev": "result", "i": index, "ok": True, "report": checked.report(display, time.monotonic() - t0)}
+
+
+def main(argv: list[str]) -> int:
+    job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
+    progress = _Progress(job["progress"])
+    faulthandler.enable(file=sys.stderr, all_threads=True)
+    faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
+    logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
+    try:
+        import torch
+
+        from gendex_envs.assets.catalog import asset_ids
+        from gendex_envs.spec import load_task_spec
+        from gendex_envs.task_env import TaskEnv
+
+        torch.set_num_threads(1)
+        spec = load_task_spec(job["spec"], known_assets=asset_ids())
+        # built with the default reward module (in-memory spec): candidates are swapped in one after the other
+        env = TaskEnv(task_spec=spec, num_envs=job["num_envs"], obs_mode="state", reward_mode="dense",
+                      sim_backend=job["sim_backend"], render_backend="none")
+        env.reset(seed=job["seed"])
+        job["_default_judge"] = env.judge
+        job["_reserved_obs_keys"] = env.own_obs_keys()
+    except Exception as exc:
+        progress.emit(ev="setup_error", type=type(exc).__name__, message=str(exc),
+                      traceback="".join(traceback.format_exception(exc, limit=-6)))
+        return 2
+    if env.device.type == "cpu" and job.get("memory_limit_mb"):
+        # allocations beyond the budget fail inside the reward code (MemoryError / torch RuntimeError with a line)
+        limit = (_vm_kb("VmData") + int(job["memory_limit_mb"]) * 1024) * 1024
+        _soft, hard = resource.getrlimit(resource.RLIMIT_DATA)
+        resource.setrlimit(resource.RLIMIT_DATA, (limit if hard == resource.RLIM_INFINITY else min(limit, hard),
+                                                  hard))
+    sys.addaudithook(_Audit.hook)
+    progress.emit(ev="ready", rss_kb=_vm_kb("VmRSS"))
+    for index in range(len(job["modules"])):
+        result = _probe_module(env, job, index, progress)
+        progress.emit(**result)
+        if not result["ok"] and job.get("stop_on_error"):
+            break
+    env.close()
+    progress.emit(ev="done")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

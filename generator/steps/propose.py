@@ -1,0 +1,126 @@
+"""Step 1, propose: a task grounded in the catalog (autonomous, or from a human instruction).
+
+The answer is parsed into a :class:`~generator.records.Proposal` and checked: every asset id exists, names are
+snake_case and unique, steps use the skills and control modes GenDex has and name listed objects, and the success
+condition is one GenDex can evaluate. A failed check is fed back to the backend, a bounded number of times.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from gendex_envs.errors import suggest
+from gendex_envs.spec import CONTROL_JOINT_MODES, SKILL_MEANINGS, SKILLS, SNAKE_NAME_RE, TASK_NAME_RE
+from generator.backends.base import Backend
+from generator.catalog_view import asset_dicts, guidance
+from generator.errors import ProposalError, RetriesExhaustedError
+from generator.records import PROPOSAL_CONDITION_TYPES, ROLES, Proposal, ProposedObject, ProposedStep
+from generator.steps.common import ask, parse_json_block
+
+log = logging.getLogger(__name__)
+
+MAX_OBJECTS = 3
+
+
+def skill_list() -> str:
+    """The skills with what each does, one per line (for prompts)."""
+    return "\n".join(f"  - {k}: {v}" for k, v in SKILL_MEANINGS.items())
+
+
+def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
+    """Parse and check a proposal answer; :class:`ProposalError` names the first problem and what is allowed."""
+    raw = parse_json_block(text, "proposal", ProposalError)
+    if not isinstance(raw, dict):
+        raise ProposalError(f"the proposal must be a JSON object, got {type(raw).__name__}")
+    need = ("name", "description", "objects", "steps", "success", "success_text")
+    missing = [k for k in need if k not in raw]
+    if missing:
+        raise ProposalError(f"the proposal lacks {missing}; required keys: {list(need)}")
+    name = str(raw["name"])
+    if not TASK_NAME_RE.match(name):
+        raise ProposalError(f"task name {name!r} must be CamelCase ({TASK_NAME_RE.pattern})")
+    assets = {a["id"]: a for a in asset_dicts()}
+    objects = []
+    for i, o in enumerate(raw["objects"] or []):
+        if not isinstance(o, dict) or not {"name", "asset", "role"} <= set(o):
+            raise ProposalError(f"objects[{i}] must have name, asset and role; got {o!r}")
+        if o["asset"] not in assets:
+            raise ProposalError(f"objects[{i}]: asset {o['asset']!r} is not in the catalog."
+                                f"{suggest(str(o['asset']), assets)} Use an id from the object library exactly.")
+        if not SNAKE_NAME_RE.match(str(o["name"])):
+            raise ProposalError(f"objects[{i}]: name {o['name']!r} must be snake_case ({SNAKE_NAME_RE.pattern})")
+        if o["role"] not in ROLES:
+            raise ProposalError(f"objects[{i}]: role {o['role']!r} is not one of {list(ROLES)}")
+        if (o["role"] == "articulated") != bool(assets[o["asset"]]["joints"]):
+            kind = "is" if assets[o["asset"]]["joints"] else "is not"
+            raise ProposalError(f"objects[{i}]: asset {o['asset']!r} {kind} articulated but has role {o['role']!r}")
+        objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"])))
+    if not 1 <= len(objects) <= MAX_OBJECTS:
+        raise ProposalError(f"a task uses 1 to {MAX_OBJECTS} objects, the proposal has {len(objects)}")
+    names = [o.name for o in objects]
+    if len(set(names)) != len(names):
+        raise ProposalError(f"object names must be unique: {names}")
+    steps = []
+    for i, s in enumerate(raw["steps"] or []):
+        if not isinstance(s, dict):
+            raise ProposalError(f"steps[{i}] must be an object with skill, target, control_joint, instruction")
+        if s.get("skill") not in SKILLS:
+            raise ProposalError(f"steps[{i}]: skill {s.get('skill')!r} is not one of {list(SKILLS)}."
+                                f"{suggest(str(s.get('skill')), SKILLS)}")
+        if s.get("target") not in names:
+            raise ProposalError(f"steps[{i}]: target {s.get('target')!r} is not a proposed object; objects: {names}."
+                                f"{suggest(str(s.get('target')), names)}")
+        if s.get("control_joint") not in CONTROL_JOINT_MODES:
+            raise ProposalError(f"steps[{i}]: control_joint {s.get('control_joint')!r} is not one of "
+                                f"{list(CONTROL_JOINT_MODES)}")
+        steps.append(ProposedStep(s["skill"], s["target"], s["control_joint"],
+                                  str(s.get("instruction") or f"{s['skill']} the {s['target']}")))
+    if not 1 <= len(steps) <= 5:
+        raise ProposalError(f"a task has 1 to 5 steps, the proposal has {len(steps)}")
+    succ = raw["success"]
+    if not isinstance(succ, dict) or succ.get("type") not in PROPOSAL_CONDITION_TYPES:
+        raise ProposalError(f"success.type {succ.get('type') if isinstance(succ, dict) else succ!r} is not one of "
+                            f"{list(PROPOSAL_CONDITION_TYPES)}")
+    if succ.get("object") not in names:
+        raise ProposalError(f"success.object {succ.get('object')!r} is not a proposed object; objects: {names}")
+    if succ["type"] in ("inside", "near") and succ.get("target") not in names:
+        raise ProposalError(f"success.target {succ.get('target')!r} must name a proposed object for a "
+                            f"{succ['type']!r} condition; objects: {names}")
+    if succ["type"] == "joint_open" and not assets[objects[names.index(succ["object"])].asset]["joints"]:
+        raise ProposalError(f"success: joint_open needs an articulated object, {succ['object']!r} is rigid")
+    subs = raw.get("substitutions") or {}
+    return Proposal(name=name, description=str(raw["description"]), objects=tuple(objects), steps=tuple(steps),
+                    success={k: v for k, v in succ.items() if k in ("type", "object", "target", "min_height_m",
+                                                                      "min_fraction", "max_dist_m")},
+                    success_text=str(raw["success_text"]), instruction=instruction,
+                    substitutions={str(k): str(v) for k, v in subs.items()} if isinstance(subs, dict) else {})
+
+
+def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (), instruction: str | None = None,
+            max_attempts: int = 3) -> tuple[Proposal, list[str]]:
+    """Ask for a proposal until one passes :func:`parse_proposal`; returns it and the rejection reasons on the way."""
+    prompt = "propose" if instruction is None else "propose_guided"
+    variables = dict(asset_guidance=guidance(), existing_tasks="\n".join(f"- {n}" for n in existing) or "- (none)",
+                     skills=skill_list(), condition_types=", ".join(PROPOSAL_CONDITION_TYPES),
+                     control_joints=", ".join(CONTROL_JOINT_MODES))
+    if instruction is not None:
+        variables["instruction"] = instruction
+    reasons: list[str] = []
+    for attempt in range(max_attempts):
+        context = {"assets": list(asset_dicts()), "existing_tasks": list(existing), "index": index,
+                   "attempt": attempt}
+        if instruction is not None:
+            context["instruction"] = instruction
+        answer = ask(backend, prompt, context=context, feedback=reasons[-1] if reasons else "", **variables)
+        try:
+            proposal = parse_proposal(answer, instruction)
+        except ProposalError as exc:
+            log.info("proposal attempt %d rejected: %s", attempt + 1, exc)
+            reasons.append(str(exc))
+            continue
+        if proposal.name in existing:
+            reasons.append(f"task name {proposal.name!r} already exists; choose a new task or name")
+            continue
+        return proposal, reasons
+    raise RetriesExhaustedError(f"no valid proposal after {max_attempts} attempts; last reason: {reasons[-1]}")
+

@@ -1,0 +1,118 @@
+"""Step 2, scene: several candidate scene YAMLs for a proposal; sizes adjusted to the hand; the best one kept.
+
+Each candidate is parsed with the task schema (strict: unknown keys, wrong types and unknown assets are errors),
+checked to use exactly the proposal's objects, resized to the hand by arithmetic on catalog sizes, and scored by
+the critic's static checks (fewer violations is better). A candidate that does not parse scores worst and its
+error is recorded; if none parses, the errors are fed back and the stage retries (bounded).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+
+from gendex_envs.errors import TaskSpecError
+from gendex_envs.spec import SCALE_RANGE, RobotSpec, TableSpec, TaskSpec, dump_task_spec, parse_task_spec
+from generator.backends.base import Backend
+from generator.backends.offline import HAND_SPAN_M
+from generator.catalog_view import asset_dict, asset_dicts, guidance
+from generator.critic.physical import REACH_MAX_M
+from generator.errors import RetriesExhaustedError, SceneError
+from generator.prompts import PROMPTS_DIR
+from generator.records import Proposal, SceneCandidate
+from generator.steps.common import ask, parse_yaml_block
+
+log = logging.getLogger(__name__)
+
+N_CANDIDATES = 3
+MAX_ARTICULATED_HEIGHT_M = 0.6
+"""Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach."""
+CONTAINER_MARGIN = 1 / 0.7
+"""A container's smallest horizontal extent must be this many times the held object's largest one."""
+
+
+def _clamp_scale(s: float) -> float:
+    return round(min(max(s, SCALE_RANGE[0]), SCALE_RANGE[1]), 3)
+
+
+def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
+    """Scale objects to the hand by arithmetic on catalog metric sizes (see the module constants)."""
+    roles = {o.name: o.role for o in proposal.objects}
+    scales = {o.name: o.scale for o in spec.objects}
+    size = {o.name: asset_dict(o.asset)["size_m"] for o in spec.objects}
+    for o in spec.objects:
+        role = roles.get(o.name)
+        s = scales[o.name]
+        if role == "graspable" and min(size[o.name][:2]) * s > HAND_SPAN_M:
+            scales[o.name] = _clamp_scale(HAND_SPAN_M / min(size[o.name][:2]))
+        elif role == "articulated" and size[o.name][2] * s > MAX_ARTICULATED_HEIGHT_M:
+            scales[o.name] = _clamp_scale(MAX_ARTICULATED_HEIGHT_M / size[o.name][2])
+    held = [n for n, r in roles.items() if r == "graspable" and n in scales]
+    for o in spec.objects:
+        if roles.get(o.name) == "container" and held:
+            need = max(max(size[h][:2]) * scales[h] for h in held) * CONTAINER_MARGIN
+            have = min(size[o.name][:2]) * scales[o.name]
+            if have < need:
+                scales[o.name] = _clamp_scale(scales[o.name] * need / have)
+    objects = tuple(dataclasses.replace(o, scale=scales[o.name]) for o in spec.objects)
+    return dataclasses.replace(spec, objects=objects)
+
+
+def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
+    """Parse a scene answer into a TaskSpec using exactly the proposal's objects; :class:`SceneError` otherwise."""
+    raw = parse_yaml_block(text, "scene file", SceneError)
+    if not isinstance(raw, dict):
+        raise SceneError(f"the scene file must be a YAML mapping, got {type(raw).__name__}")
+    try:
+        spec = parse_task_spec(raw, source="scene answer", known_assets=[a["id"] for a in asset_dicts()])
+    except TaskSpecError as exc:
+        raise SceneError(str(exc)) from None
+    want = {(o.name, o.asset) for o in proposal.objects}
+    got = {(o.name, o.asset) for o in spec.objects}
+    if want != got:
+        raise SceneError(f"the scene must use exactly the proposal's objects {sorted(want)}; it has {sorted(got)}")
+    if spec.name != proposal.name:
+        spec = dataclasses.replace(spec, name=proposal.name)
+    return spec
+
+
+def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:
+    from generator.critic.physical import check_scene_static
+
+    report = check_scene_static(spec)
+    return float(len(report.errors)), tuple(f"{v.check}: {v.message}" for v in report.errors)
+
+
+def write_scene(backend: Backend, proposal: Proposal, *, index: int = 0, n_candidates: int = N_CANDIDATES,
+                max_attempts: int = 2) -> tuple[TaskSpec, list[SceneCandidate]]:
+    """Ask for ``n_candidates`` scene files and keep the best; returns it and every candidate's record."""
+    reference = (PROMPTS_DIR / "reference_spec.yaml").read_text()
+    proposal_json = json.dumps(dataclasses.asdict(proposal), indent=2)
+    ids = {o.asset for o in proposal.objects}
+    candidates: list[SceneCandidate] = []
+    feedback = ""
+    for attempt in range(max_attempts):
+        best: tuple[float, TaskSpec] | None = None
+        for k in range(n_candidates):
+            context = {"proposal": dataclasses.asdict(proposal), "assets": [a for a in asset_dicts() if a["id"] in ids],
+                       "candidate_index": k, "index": index, "attempt": attempt}
+            answer = ask(backend, "scene", context=context, feedback=feedback, proposal_json=proposal_json,
+                         reference_yaml=reference, asset_guidance=guidance(), table_size_m=list(TableSpec().size_m),
+                         robot_base_m=list(RobotSpec().base_pos_m), reach_m=REACH_MAX_M, scale_range=list(SCALE_RANGE),
+                         candidate_index=k + 1, hand_span_m=HAND_SPAN_M)
+            try:
+                spec = adjust_sizes(parse_scene(answer, proposal), proposal)
+            except SceneError as exc:
+                candidates.append(SceneCandidate(len(candidates), answer, 100.0, (str(exc),)))
+                feedback = str(exc)
+                continue
+            score, problems = score_scene(spec)
+            candidates.append(SceneCandidate(len(candidates), dump_task_spec(spec), score, problems))
+            if best is None or score < best[0]:
+                best = (score, spec)
+        if best is not None:
+            log.info("scene: kept a candidate with %d static violations (of %d candidates)", best[0], n_candidates)
+            return best[1], candidates
+    raise RetriesExhaustedError(f"no scene candidate parsed after {max_attempts} rounds; last error: {feedback}")
+
