@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gendex_envs.errors import StageError, TaskNotFoundError, TaskSpecError
-from gendex_envs.spec import StageSpec, TaskSpec, load_task_spec, resolve_stage
+from gendex_envs.spec import TASK_NAME_RE, StageSpec, TaskSpec, load_task_spec, resolve_stage
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.reward_module import RewardModule
@@ -52,7 +52,6 @@ NAMESPACE = "GenDex"
 DRAFTS = ".drafts"
 """Hidden folder of a task root where versions are assembled before they are published (never registered)."""
 VERSION_DIR = re.compile(r"^v(\d+)$")
-TASK_NAME = re.compile(r"^[A-Z][A-Za-z0-9]*$")
 RECORDS = ("generation", "proposal", "scene_candidates", "critique", "reward_attempts", "promotion", "run")
 """JSON records a folder may hold (how it was generated, promoted or trained)."""
 
@@ -338,7 +337,7 @@ def versions_in(root: str | Path) -> list[TaskVersion]:
     found = []
     for spec in sorted(root.glob("*/v*/" + TaskLayout(".").spec.name)):
         folder = spec.parent
-        if not VERSION_DIR.match(folder.name) or not TASK_NAME.match(folder.parent.name):
+        if not VERSION_DIR.match(folder.name) or not TASK_NAME_RE.match(folder.parent.name):
             log.warning("ignoring %s: a task version folder is <Name>/v<N> with a CamelCase name", folder)
             continue
         found.append(TaskVersion.at(folder))
@@ -384,7 +383,7 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
     it. ``required``: files (inside ``draft``) that must exist; :class:`PublishError` otherwise, nothing published.
     """
     root = Path(root)
-    if not TASK_NAME.match(name):
+    if not TASK_NAME_RE.match(name):
         raise PublishError(f"task name {name!r} is not CamelCase (^[A-Z][A-Za-z0-9]*$)")
     missing = [p.name for p in required if not p.is_file()]
     if missing:

@@ -4,10 +4,9 @@ Two entry points:
 
 * :func:`check_scene_static` needs no simulator (milliseconds): reach, off_table, scale, joint_state, unsupported
   and penetration estimated from bounding boxes.
-* :func:`check_scene` builds the scene in SAPIEN (CPU, randomization off, the robot at the spec's initial keyframe:
-  ``rest`` unless the spec says otherwise; both keyframes share the same arm pose), and replaces the bounding-box
-  penetration estimate with PhysX's own contacts at reset, then lets the scene settle and measures what fell or
-  still moves. About 0.3 s per scene once SAPIEN is loaded (the first env of a process costs ~3 s of imports).
+* :func:`~generator.critic.physical_sim.check_scene` (:mod:`generator.critic.physical_sim`) builds the scene in
+  SAPIEN and replaces the bounding-box penetration estimate with PhysX's own contacts, then lets the scene settle
+  and measures what fell or still moves.
 
 Each :class:`Violation` names its check, object, measured value and limit, and carries a suggested fix: directives
 (:mod:`generator.critic.directives`) where arithmetic can fix it, or a joint-state edit (``joint_fix``, applied with
@@ -66,7 +65,6 @@ How each check is measured (the thresholds are the module constants below):
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import logging
 import math
@@ -78,11 +76,9 @@ from typing import Any, Literal
 import numpy as np
 
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
-from gendex_envs.physx import px_objects
 from gendex_envs.spec import (
     SCALE_RANGE,
     ObjectSpec,
-    RandomizeSpec,
     TaskSpec,
     parse_task_spec,
     spec_to_dict,
@@ -99,7 +95,7 @@ CHECKS: tuple[str, ...] = ("penetration", "floating", "unsupported", "out_of_rea
 # ----------------------------------------------------------------------------------------------- thresholds
 PENETRATION_TOL_M = 0.003
 """Deepest tolerated interpenetration at reset (m). Objects placed by the spec rest at separation ~0 (measured
-0.0 on the seed tasks); an apple placed at the centre of the bowl sits 6 mm into its floor."""
+0.0 on the reference tasks); an apple placed at the centre of the bowl sits 6 mm into its floor."""
 PENETRATION_FIX_MARGIN_M = 0.01
 """Gap left between two bounding boxes moved apart by a penetration fix (m)."""
 SUPPORT_TOL_M = 0.005
@@ -121,7 +117,7 @@ The issue's "> 0.8 m from the base" comes from the seed paper, whose base stood 
 workspace; it does not describe this robot. GenDex's UR10e stands at x = -0.8, and its published reach is 1.30 m
 (base axis to wrist flange) plus ~0.2 m of ShadowHand (wrist to fingertips). Reaching down to a table that is level
 with the base, with the palm above or beside the object, costs part of that, so 1.25 m to the object's nearest point
-is kept as the limit. The seed tasks place objects 1.0-1.4 m from the base; their nearest points lie within
+is kept as the limit. The reference tasks place objects 1.0-1.4 m from the base; their nearest points lie within
 0.89-1.16 m even with their randomization added (the cabinet, 1.4 m away at its centre, has its front 1.13 m away)."""
 REACH_MIN_M = 0.35
 """Closest horizontal distance (m) from the base to an object's footprint centre: nearer than this the hand cannot
@@ -177,7 +173,7 @@ class Violation:
 
     def to_dict(self) -> dict[str, Any]:
         return {"check": self.check, "object": self.object, "message": self.message,
-                "measured": _r(self.measured), "limit": _r(self.limit), "fix": [str(d) for d in self.fix],
+                "measured": rounded(self.measured), "limit": rounded(self.limit), "fix": [str(d) for d in self.fix],
                 "joint_fix": self.joint_fix, "severity": self.severity, "other": self.other}
 
 
@@ -236,7 +232,7 @@ class PhysicalReport:
         return "\n".join(lines)
 
 
-def _r(x: float | None, nd: int = 4) -> float | None:
+def rounded(x: float | None, nd: int = 4) -> float | None:
     return None if x is None else round(float(x), nd)
 
 
@@ -249,7 +245,7 @@ def _rotation(q_wxyz: Iterable[float]) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class _Placed:
+class Placed:
     """An object as the spec places it: catalog record and world corners of its rotated, scaled bounding box."""
 
     spec: ObjectSpec
@@ -278,12 +274,12 @@ class _Placed:
         return "container" in self.record.tags
 
 
-def _place(obj: ObjectSpec) -> _Placed:
+def _place(obj: ObjectSpec) -> Placed:
     rec = get_asset(obj.asset)
     lo, hi = np.asarray(rec.bbox_min_m) * obj.scale, np.asarray(rec.bbox_max_m) * obj.scale
     local = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     origin = np.array([obj.pos_m[0], obj.pos_m[1], obj.pos_m[2] - lowest_point_z(rec, obj.scale, obj.quat_wxyz)])
-    return _Placed(obj, rec, local @ _rotation(obj.quat_wxyz).T + origin)
+    return Placed(obj, rec, local @ _rotation(obj.quat_wxyz).T + origin)
 
 
 def _min_width_xy(points: np.ndarray) -> float:
@@ -298,7 +294,7 @@ def _footprint_inside(inner_lo, inner_hi, outer_lo, outer_hi) -> bool:
     return bool(np.all(inner_lo[:2] >= outer_lo[:2] - 1e-9) and np.all(inner_hi[:2] <= outer_hi[:2] + 1e-9))
 
 
-def _separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
+def separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
                      jitter_xy: Iterable[float] = (0.0, 0.0)) -> np.ndarray:
     """xy translation of ``mover`` along the line between the box centres that separates the boxes in x or y.
 
@@ -323,7 +319,7 @@ def _separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
     return u * t
 
 
-def _moves(obj: str, dxy: Iterable[float]) -> tuple[Directive, ...]:
+def moves(obj: str, dxy: Iterable[float]) -> tuple[Directive, ...]:
     """move_x / move_y directives for an xy translation, rounded to mm away from zero (components < 0.5 mm dropped)."""
     out = []
     for axis, d in zip("xy", dxy, strict=True):
@@ -361,7 +357,7 @@ def _grasped(spec: TaskSpec, name: str) -> bool:
     return any(c.object == name and c.type in ("lifted", "inside") for c in spec.success.conditions)
 
 
-def _position_fixes(spec: TaskSpec, placed: dict[str, _Placed], meas_reach: dict, meas_table: dict,
+def _position_fixes(spec: TaskSpec, placed: dict[str, Placed], meas_reach: dict, meas_table: dict,
                     violations: list[Violation]) -> None:
     bx, by = spec.robot.base_pos_m[:2]
     base = np.array([bx, by])
@@ -375,10 +371,10 @@ def _position_fixes(spec: TaskSpec, placed: dict[str, _Placed], meas_reach: dict
         near = float(np.linalg.norm(gap))
         centre = p.centre_xy
         d_centre = float(np.linalg.norm(centre - base))
-        meas_reach[name] = {"nearest_m": _r(near), "centre_m": _r(d_centre), "randomize_m": _r(jitter),
+        meas_reach[name] = {"nearest_m": rounded(near), "centre_m": rounded(d_centre), "randomize_m": rounded(jitter),
                             "checked": name in checked}
         on_table = abs(centre[0]) <= sx / 2 and abs(centre[1]) <= sy / 2
-        meas_table[name] = {"centre_xy_m": [_r(centre[0]), _r(centre[1])], "on_table": bool(on_table)}
+        meas_table[name] = {"centre_xy_m": [rounded(centre[0]), rounded(centre[1])], "on_table": bool(on_table)}
         too_far = name in checked and near + jitter > REACH_MAX_M
         too_close = name in checked and d_centre - jitter < REACH_MIN_M
         if on_table and not too_far and not too_close:
@@ -399,7 +395,7 @@ def _position_fixes(spec: TaskSpec, placed: dict[str, _Placed], meas_reach: dict
             target = target - u * (near_t + jitter - (REACH_MAX_M - REACH_MARGIN_M))
         if name in checked and float(np.linalg.norm(target - base)) - jitter < REACH_MIN_M:
             target = base + u * (REACH_MIN_M + REACH_MARGIN_M + jitter)
-        fix = _moves(name, target - centre)
+        fix = moves(name, target - centre)
         if not on_table:
             violations.append(Violation(
                 "off_table", name, f"{name!r} has its footprint centre at ({centre[0]:.3f}, {centre[1]:.3f}) m, "
@@ -417,7 +413,7 @@ def _position_fixes(spec: TaskSpec, placed: dict[str, _Placed], meas_reach: dict
                 measured=d_centre - jitter, limit=REACH_MIN_M, fix=fix))
 
 
-def _support(p: _Placed, placed: dict[str, _Placed]) -> tuple[bool, float]:
+def _support(p: Placed, placed: dict[str, Placed]) -> tuple[bool, float]:
     """(supported, clearance it could rest at): resting on the table or over another object reaching up to it."""
     bottom = float(p.lo[2])
     if bottom <= SUPPORT_TOL_M:
@@ -438,12 +434,12 @@ def _support(p: _Placed, placed: dict[str, _Placed]) -> tuple[bool, float]:
     return False, rest
 
 
-def _unsupported(placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> dict[str, tuple]:
+def _unsupported(placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> dict[str, tuple]:
     fixes: dict[str, tuple[Directive, ...]] = {}
     for name, p in placed.items():
         ok, rest = _support(p, placed)
         bottom = float(p.lo[2])
-        meas[name] = {"clearance_m": _r(bottom), "supported": ok}
+        meas[name] = {"clearance_m": rounded(bottom), "supported": ok}
         if ok:
             continue
         drop = bottom - rest
@@ -456,7 +452,7 @@ def _unsupported(placed: dict[str, _Placed], meas: dict, violations: list[Violat
     return fixes
 
 
-def _overlaps(placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+def _overlaps(placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
     names = list(placed)
     meas["_method"] = "catalog bounding boxes placed by the spec"
     for i, a in enumerate(names):
@@ -470,34 +466,35 @@ def _overlaps(placed: dict[str, _Placed], meas: dict, violations: list[Violation
             if inside:
                 meas.setdefault(inside[0][0].spec.name, {})["inside_container"] = inside[0][1].spec.name
                 continue
-            mover, other = _pick_mover(pa, pb)
-            fix = _moves(mover.spec.name, _separating_move(mover.lo, mover.hi, other.lo, other.hi,
-                                                           float(other.centre_xy[1]), _jitter(pa, pb)))
-            meas.setdefault(a, {})[b] = _r(depth)
+            mover, other = pick_mover(pa, pb)
+            fix = moves(mover.spec.name, separating_move(mover.lo, mover.hi, other.lo, other.hi,
+                                                           float(other.centre_xy[1]), randomization_xy(pa, pb)))
+            meas.setdefault(a, {})[b] = rounded(depth)
             violations.append(Violation(
                 "penetration", mover.spec.name, f"{a!r} and {b!r} overlap by {depth:.3f} m (bounding boxes as placed)",
                 measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=other.spec.name))
 
 
-def _jitter(*placed: _Placed) -> np.ndarray:
+def randomization_xy(*placed: Placed) -> np.ndarray:
     """Sum of the objects' xy randomization half-ranges, per axis."""
     return np.sum([p.spec.randomize.xy_m for p in placed], axis=0)
 
 
-def _pick_mover(pa: _Placed, pb: _Placed) -> tuple[_Placed, _Placed]:
+def pick_mover(pa: Placed, pb: Placed) -> tuple[Placed, Placed]:
     """(the one to move, the other): a movable one before a fixed one, then the smaller footprint."""
     key = [(p.spec.fixed, p.area) for p in (pa, pb)]
     return (pa, pb) if key[0] <= key[1] else (pb, pa)
 
 
-def _scale_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+def _scale_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
     rlo, rhi = REALISTIC_SCALE_RANGE
     for name, p in placed.items():
         o, rec = p.spec, p.record
         width = _min_width_xy(p.corners)
         size = max(rec.size_m) * o.scale
         grasped = _grasped(spec, name) and "graspable" in rec.tags and not rec.articulated
-        meas[name] = {"scale": o.scale, "min_width_m": _r(width), "max_extent_m": _r(size), "grasped": grasped}
+        meas[name] = {"scale": o.scale, "min_width_m": rounded(width), "max_extent_m": rounded(size),
+                      "grasped": grasped}
         if grasped and width > GRASP_MAX_WIDTH_M:
             f = _scale_factor(o.scale, o.scale * GRASP_MAX_WIDTH_M * GRASP_FIX_FILL / width)
             enough = width * f <= GRASP_MAX_WIDTH_M
@@ -520,7 +517,7 @@ def _scale_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violat
                 limit=rlo if o.scale < rlo else rhi, fix=(Directive.scale(name, f),), severity="warning"))
 
 
-def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violations: list[Violation]) -> None:
+def _joint_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
     for name, p in placed.items():
         rec = p.record
         if not rec.articulated or not rec.joints:
@@ -541,7 +538,7 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violat
         q = p.spec.joint_state.get(joint.name, joint.closed_qpos)
         span = joint.open_qpos - joint.closed_qpos
         frac = (q - joint.closed_qpos) / span if span else 0.0
-        meas[name] = {"joint": joint.name, "qpos": _r(q), "open_fraction": _r(frac), "intent": intent}
+        meas[name] = {"joint": joint.name, "qpos": rounded(q), "open_fraction": rounded(frac), "intent": intent}
         if intent == "open" and frac >= JOINT_OPEN_FRACTION:
             violations.append(Violation(
                 "joint_state", name, f"{name!r} starts {frac:.0%} open ({joint.name} = {q:g}) but {source} "
@@ -554,7 +551,7 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, _Placed], meas: dict, violat
                 joint_fix={"object": name, "joint": joint.name, "value": joint.open_qpos}))
 
 
-def _static(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dict[str, dict], dict[str, _Placed], dict]:
+def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dict[str, dict], dict[str, Placed], dict]:
     placed = {o.name: _place(o) for o in spec.objects}
     violations: list[Violation] = []
     meas: dict[str, dict] = {c: {} for c in CHECKS}
@@ -570,9 +567,9 @@ def _static(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dict[str, d
 def check_scene_static(spec: TaskSpec) -> PhysicalReport:
     """The checks that need no simulator (module docstring): a quick pre-screen of a scene."""
     t0 = time.perf_counter()
-    violations, meas, _, _ = _static(spec, overlap=True)
+    violations, meas, _, _ = static_findings(spec, overlap=True)
     meas["floating"]["_method"] = "not measured (needs the simulator)"
-    report = PhysicalReport(spec.name, "static", _ordered(violations), meas, time.perf_counter() - t0)
+    report = PhysicalReport(spec.name, "static", ordered(violations), meas, time.perf_counter() - t0)
     log.info("static physical check of %s: %d violations", spec.name, len(report.violations))
     return report
 
@@ -622,147 +619,5 @@ def apply_joint_fix(spec: TaskSpec, fixes: Mapping | Iterable[Mapping]) -> TaskS
     return parse_task_spec(raw, source=f"<{spec.name} after {len(fixes)} joint fixes>")
 
 
-def _ordered(violations: list[Violation]) -> list[Violation]:
+def ordered(violations: list[Violation]) -> list[Violation]:
     return sorted(violations, key=lambda v: (CHECKS.index(v.check), v.severity != "error"))
-
-
-# ------------------------------------------------------------------------------------------- simulator
-def _without_randomization(spec: TaskSpec) -> TaskSpec:
-    objects = tuple(dataclasses.replace(o, randomize=RandomizeSpec()) for o in spec.objects)
-    return dataclasses.replace(spec, objects=objects)
-
-
-def _entity_ids(entity) -> list[int]:
-    from mani_skill.utils.structs import Articulation
-
-    if isinstance(entity, Articulation):
-        return [px_objects(link)[0].entity.per_scene_id for link in entity.get_links()]
-    return [obj.per_scene_id for obj in px_objects(entity)]
-
-
-def _contact_penetrations(env, placed: dict[str, _Placed], boxes: dict[str, tuple], start: dict[str, np.ndarray],
-                          meas: dict) -> list[Violation]:
-    """Penetrations in PhysX's contact list (one per object pair; one per object for the table and the robot)."""
-    from gendex_envs.assets.bounds import body_points
-
-    owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in _entity_ids(entity)}
-    robot_links = {px_objects(link)[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
-    table_id = px_objects(env.table)[0].per_scene_id
-    pairs: dict[tuple[str, str], float] = {}  # (object, object) sorted, or (object, "table")
-    robot: dict[str, dict[str, float]] = {}  # object -> robot link -> depth
-    for c in env.scene.px.get_contacts():
-        ids = [b.entity.per_scene_id for b in c.bodies]
-        a, b = (owner.get(i) for i in ids)
-        if a == b:  # inside one articulation, or neither is an object
-            continue
-        if a is None:  # keep the object first
-            a, b, ids = b, a, ids[::-1]
-        depth = -min(p.separation for p in c.points)
-        if b is None and ids[1] in robot_links:
-            links = robot.setdefault(a, {})
-            name = robot_links[ids[1]].name
-            links[name] = max(links.get(name, 0.0), depth)
-            continue
-        if b is None and ids[1] != table_id:
-            continue  # the ground, the goal site
-        key = (a, "table") if b is None else tuple(sorted((a, b)))
-        pairs[key] = max(pairs.get(key, 0.0), depth)
-    meas["_method"] = "PhysX contact separations after one physics step from the reset state"
-    violations: list[Violation] = []
-    for (a, b), depth in sorted(pairs.items()):
-        meas.setdefault(a, {})[b] = _r(depth)
-        if depth <= PENETRATION_TOL_M:
-            continue
-        if b == "table":
-            violations.append(Violation(
-                "penetration", a, f"{a!r} sinks {depth:.3f} m into the table at reset", measured=depth,
-                limit=PENETRATION_TOL_M, fix=(Directive.move(a, "z", math.ceil((depth + 0.002) * 1000) / 1000),),
-                other="table"))
-            continue
-        pm, po = _pick_mover(placed[a], placed[b])
-        (mlo, mhi), (olo, ohi) = boxes[pm.spec.name], boxes[po.spec.name]
-        fix = _moves(pm.spec.name, _separating_move(mlo, mhi, olo, ohi, float((olo[1] + ohi[1]) / 2),
-                                                    _jitter(pm, po)))
-        violations.append(Violation(
-            "penetration", pm.spec.name, f"{a!r} and {b!r} interpenetrate by {depth:.3f} m at reset",
-            measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=po.spec.name))
-    for a, links in sorted(robot.items()):
-        meas.setdefault(a, {}).update({f"robot:{k}": _r(v) for k, v in links.items()})
-        deep = {k: v for k, v in links.items() if v > PENETRATION_TOL_M}
-        if not deep:
-            continue
-        # one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the
-        # object's top (moving away from one finger would push it into the next)
-        lo, hi = boxes[a]
-        bodies = [px_objects(link)[0] for link in robot_links.values()]
-        pts = [body_points(b.entity_pose, b.collision_shapes) for b in bodies]
-        low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
-        obstacle = np.concatenate(low)
-        fix = _moves(a, _separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), float(start[a][1]),
-                                         _jitter(placed[a])))
-        worst = max(deep, key=deep.get)
-        violations.append(Violation(
-            "penetration", a, f"{a!r} and the robot interpenetrate at reset, by {deep[worst]:.3f} m at its "
-            f"{worst} ({len(deep)} link{'s' if len(deep) > 1 else ''}: {', '.join(sorted(deep))}); the robot stands "
-            "at its initial keyframe",
-            measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}"))
-    return violations
-
-
-def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, _Placed],
-                unsupported_fix: dict[str, tuple], off_table: set[str], meas: dict) -> list[Violation]:
-    from gendex_envs.assets.bounds import entity_aabb
-    from gendex_envs.task_env import TaskEnv
-
-    env = TaskEnv(task_spec=_without_randomization(spec), render_backend="none", control_mode="pd_joint_delta_pos")
-    try:
-        env.reset(seed=seed)
-        start = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
-        boxes = {n: entity_aabb(e) for n, e in env.objects.items()}
-
-        env.scene.step()  # one physics step: PhysX lists the contacts of the reset state
-        violations = _contact_penetrations(env, placed, boxes, start, meas["penetration"])
-
-        zero = np.zeros(env.action_space.shape, dtype=np.float32)
-        for _ in range(max(settle_steps - 1, 0)):
-            env.step(zero)
-        before = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
-        env.step(zero)
-        dt = 1.0 / env.control_freq
-        flo = meas["floating"]
-        flo["_method"] = (f"pose change over {settle_steps} control steps ({settle_steps * dt:.2f} s), "
-                          "robot holding still")
-        for name, entity in env.objects.items():
-            end = entity.pose.p[0].numpy()
-            drop = float(start[name][2] - end[2])
-            speed = float(np.linalg.norm(end - before[name]) / dt)
-            flo[name] = {"drop_m": _r(drop), "speed_mps": _r(speed),
-                         "moved_m": _r(float(np.linalg.norm(end - start[name])))}
-            if spec.object(name).fixed or name in off_table:
-                continue
-            if drop > FALL_TOL_M:
-                fix = unsupported_fix.get(name) or (Directive.move(name, "z", -math.floor((drop - 0.002) * 1000)
-                                                                   / 1000),)
-                violations.append(Violation(
-                    "floating", name, f"{name!r} fell {drop:.3f} m while the scene settled: it was placed above "
-                    f"what supports it", measured=drop, limit=FALL_TOL_M, fix=fix))
-            elif speed > MOVING_TOL_MPS:
-                violations.append(Violation(
-                    "floating", name, f"{name!r} still moves at {speed:.3f} m/s after the scene settled for "
-                    f"{settle_steps * dt:.2f} s: it does not rest stably", measured=speed, limit=MOVING_TOL_MPS))
-        return violations
-    finally:
-        env.close()
-
-
-def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STEPS) -> PhysicalReport:
-    """All checks, penetration and floating measured in the simulator (module docstring)."""
-    if settle_steps < 1:
-        raise ValueError(f"settle_steps={settle_steps} must be >= 1")
-    t0 = time.perf_counter()
-    violations, meas, placed, unsupported_fix = _static(spec, overlap=False)
-    off = {v.object for v in violations if v.check == "off_table"}
-    violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
-    report = PhysicalReport(spec.name, "sim", _ordered(violations), meas, time.perf_counter() - t0)
-    log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
-    return report

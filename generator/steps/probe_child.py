@@ -1,4 +1,4 @@
-"""Child process of the reward probe (internal to :mod:`generator.steps.validate`).
+"""Child process of the reward probe (internal to :mod:`generator.steps.probe`).
 
 ``python -m generator.steps.probe_child JOB.json`` builds the task's env once, then for each candidate reward module
 swaps it in (wrapped so that every call is checked), resets with the job's seed and steps seeded random actions.

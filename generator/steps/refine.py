@@ -70,7 +70,7 @@ def refine(backend: Backend, spec: TaskSpec, *, max_rounds: int = MAX_ROUNDS, se
 
     ``renders``: the views of ``spec`` when the caller has them already (the first vision round reuses them).
     """
-    from generator.critic.physical import check_scene
+    from generator.critic.physical_sim import check_scene
 
     rounds: list[CritiqueRound] = []
     before: int | None = None

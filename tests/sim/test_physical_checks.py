@@ -1,4 +1,4 @@
-"""The critic's physical checks in the simulator (generator.critic.physical.check_scene): each check can fail, and
+"""The critic's physical checks in the simulator (generator.critic.physical_sim.check_scene): each check can fail, and
 applying the suggested fixes makes the scene pass. One SAPIEN env per scene (~0.7 s each once SAPIEN is loaded)."""
 
 from __future__ import annotations
@@ -9,12 +9,8 @@ import pytest
 
 from gendex_envs.spec import TaskSpec, parse_task_spec, spec_to_dict
 from generator.critic.directives import apply_directives
-from generator.critic.physical import (
-    FALL_TOL_M,
-    PENETRATION_TOL_M,
-    apply_joint_fix,
-    check_scene,
-)
+from generator.critic.physical import FALL_TOL_M, PENETRATION_TOL_M, apply_joint_fix
+from generator.critic.physical_sim import check_scene
 
 REFERENCE_TASKS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
 

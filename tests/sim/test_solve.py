@@ -173,21 +173,26 @@ def test_stage_executor_solves_put_apple_bowl(apple_env):
     assert all(wins)
 
 
-def test_stage_executor_refuses_a_stage_it_cannot_script(task_version):
-    """A stage without a target object has no primitive: the attempt ends with the named error."""
+@pytest.mark.parametrize(("edit", "message"), [
+    ({"target": None}, "no target object"),
+    ({"skill": "push"}, r"no primitive for skill 'push' on a rigid target \('apple'\); skills it runs there: "
+                        r"\['carry', 'grasp', 'lift', 'reach', 'release'\]"),
+])
+def test_stage_executor_refuses_a_stage_it_cannot_script(task_version, edit, message):
+    """A stage without a target, or whose skill has no primitive for its target, ends the attempt with the named
+    error (the executor dispatches on the declared skill, never on names)."""
     from gendex_envs.spec import parse_task_spec, spec_to_dict
     from gendex_envs.task_env import TaskEnv
 
     raw = spec_to_dict(task_version("PutAppleBowl", 0).spec)
-    raw["stages"][0]["target"] = None
-    raw["stages"][0]["success"] = None
+    raw["stages"][0].update(edit, success=None)
     env = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_pos", control_joint="both",
                   render_backend="none")
     try:
         obs, _ = env.reset(seed=0)
         executor = StageExecutor()
         executor.reset(env, obs)
-        with pytest.raises(ExecutionError, match="no target object"):
+        with pytest.raises(ExecutionError, match=message):
             executor.act(env, obs)
     finally:
         env.close()

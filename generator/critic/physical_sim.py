@@ -1,0 +1,180 @@
+"""The critic's physical checks in the simulator: :func:`check_scene`.
+
+It builds the scene in SAPIEN (CPU, randomization off, the robot at the spec's initial keyframe: ``rest`` unless
+the spec says otherwise; both keyframes share the same arm pose), replaces the bounding-box penetration estimate of
+:func:`~generator.critic.physical.check_scene_static` with PhysX's own contacts at reset, then lets the scene
+settle and measures what fell or still moves (the ``penetration`` and ``floating`` checks described in
+:mod:`generator.critic.physical`). About 0.3 s per scene once SAPIEN is loaded (the first env of a process costs
+~3 s of imports).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+import numpy as np
+
+from gendex_envs.physx import px_objects
+from gendex_envs.spec import RandomizeSpec, TaskSpec
+from generator.critic.directives import Directive
+from generator.critic.physical import (
+    FALL_TOL_M,
+    MOVING_TOL_MPS,
+    PENETRATION_FIX_MARGIN_M,
+    PENETRATION_TOL_M,
+    SETTLE_STEPS,
+    PhysicalReport,
+    Placed,
+    Violation,
+    log,
+    moves,
+    ordered,
+    pick_mover,
+    randomization_xy,
+    rounded,
+    separating_move,
+    static_findings,
+)
+
+
+def _without_randomization(spec: TaskSpec) -> TaskSpec:
+    objects = tuple(dataclasses.replace(o, randomize=RandomizeSpec()) for o in spec.objects)
+    return dataclasses.replace(spec, objects=objects)
+
+
+def _entity_ids(entity) -> list[int]:
+    from mani_skill.utils.structs import Articulation
+
+    if isinstance(entity, Articulation):
+        return [px_objects(link)[0].entity.per_scene_id for link in entity.get_links()]
+    return [obj.per_scene_id for obj in px_objects(entity)]
+
+
+def _contact_penetrations(env, placed: dict[str, Placed], boxes: dict[str, tuple], start: dict[str, np.ndarray],
+                          meas: dict) -> list[Violation]:
+    """Penetrations in PhysX's contact list (one per object pair; one per object for the table and the robot)."""
+    from gendex_envs.assets.bounds import body_points
+
+    owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in _entity_ids(entity)}
+    robot_links = {px_objects(link)[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
+    table_id = px_objects(env.table)[0].per_scene_id
+    pairs: dict[tuple[str, str], float] = {}  # (object, object) sorted, or (object, "table")
+    robot: dict[str, dict[str, float]] = {}  # object -> robot link -> depth
+    for c in env.scene.px.get_contacts():
+        ids = [b.entity.per_scene_id for b in c.bodies]
+        a, b = (owner.get(i) for i in ids)
+        if a == b:  # inside one articulation, or neither is an object
+            continue
+        if a is None:  # keep the object first
+            a, b, ids = b, a, ids[::-1]
+        depth = -min(p.separation for p in c.points)
+        if b is None and ids[1] in robot_links:
+            links = robot.setdefault(a, {})
+            name = robot_links[ids[1]].name
+            links[name] = max(links.get(name, 0.0), depth)
+            continue
+        if b is None and ids[1] != table_id:
+            continue  # the ground, the goal site
+        key = (a, "table") if b is None else tuple(sorted((a, b)))
+        pairs[key] = max(pairs.get(key, 0.0), depth)
+    meas["_method"] = "PhysX contact separations after one physics step from the reset state"
+    violations: list[Violation] = []
+    for (a, b), depth in sorted(pairs.items()):
+        meas.setdefault(a, {})[b] = rounded(depth)
+        if depth <= PENETRATION_TOL_M:
+            continue
+        if b == "table":
+            violations.append(Violation(
+                "penetration", a, f"{a!r} sinks {depth:.3f} m into the table at reset", measured=depth,
+                limit=PENETRATION_TOL_M, fix=(Directive.move(a, "z", math.ceil((depth + 0.002) * 1000) / 1000),),
+                other="table"))
+            continue
+        pm, po = pick_mover(placed[a], placed[b])
+        (mlo, mhi), (olo, ohi) = boxes[pm.spec.name], boxes[po.spec.name]
+        fix = moves(pm.spec.name, separating_move(mlo, mhi, olo, ohi, float((olo[1] + ohi[1]) / 2),
+                                                    randomization_xy(pm, po)))
+        violations.append(Violation(
+            "penetration", pm.spec.name, f"{a!r} and {b!r} interpenetrate by {depth:.3f} m at reset",
+            measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=po.spec.name))
+    for a, links in sorted(robot.items()):
+        meas.setdefault(a, {}).update({f"robot:{k}": rounded(v) for k, v in links.items()})
+        deep = {k: v for k, v in links.items() if v > PENETRATION_TOL_M}
+        if not deep:
+            continue
+        # one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the
+        # object's top (moving away from one finger would push it into the next)
+        lo, hi = boxes[a]
+        bodies = [px_objects(link)[0] for link in robot_links.values()]
+        pts = [body_points(b.entity_pose, b.collision_shapes) for b in bodies]
+        low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
+        obstacle = np.concatenate(low)
+        fix = moves(a, separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), float(start[a][1]),
+                                         randomization_xy(placed[a])))
+        worst = max(deep, key=deep.get)
+        violations.append(Violation(
+            "penetration", a, f"{a!r} and the robot interpenetrate at reset, by {deep[worst]:.3f} m at its "
+            f"{worst} ({len(deep)} link{'s' if len(deep) > 1 else ''}: {', '.join(sorted(deep))}); the robot stands "
+            "at its initial keyframe",
+            measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}"))
+    return violations
+
+
+def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, Placed],
+                unsupported_fix: dict[str, tuple], off_table: set[str], meas: dict) -> list[Violation]:
+    from gendex_envs.assets.bounds import entity_aabb
+    from gendex_envs.task_env import TaskEnv
+
+    env = TaskEnv(task_spec=_without_randomization(spec), render_backend="none", control_mode="pd_joint_delta_pos")
+    try:
+        env.reset(seed=seed)
+        start = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
+        boxes = {n: entity_aabb(e) for n, e in env.objects.items()}
+
+        env.scene.step()  # one physics step: PhysX lists the contacts of the reset state
+        violations = _contact_penetrations(env, placed, boxes, start, meas["penetration"])
+
+        zero = np.zeros(env.action_space.shape, dtype=np.float32)
+        for _ in range(max(settle_steps - 1, 0)):
+            env.step(zero)
+        before = {n: e.pose.p[0].numpy().copy() for n, e in env.objects.items()}
+        env.step(zero)
+        dt = 1.0 / env.control_freq
+        flo = meas["floating"]
+        flo["_method"] = (f"pose change over {settle_steps} control steps ({settle_steps * dt:.2f} s), "
+                          "robot holding still")
+        for name, entity in env.objects.items():
+            end = entity.pose.p[0].numpy()
+            drop = float(start[name][2] - end[2])
+            speed = float(np.linalg.norm(end - before[name]) / dt)
+            flo[name] = {"drop_m": rounded(drop), "speed_mps": rounded(speed),
+                         "moved_m": rounded(float(np.linalg.norm(end - start[name])))}
+            if spec.object(name).fixed or name in off_table:
+                continue
+            if drop > FALL_TOL_M:
+                fix = unsupported_fix.get(name) or (Directive.move(name, "z", -math.floor((drop - 0.002) * 1000)
+                                                                   / 1000),)
+                violations.append(Violation(
+                    "floating", name, f"{name!r} fell {drop:.3f} m while the scene settled: it was placed above "
+                    f"what supports it", measured=drop, limit=FALL_TOL_M, fix=fix))
+            elif speed > MOVING_TOL_MPS:
+                violations.append(Violation(
+                    "floating", name, f"{name!r} still moves at {speed:.3f} m/s after the scene settled for "
+                    f"{settle_steps * dt:.2f} s: it does not rest stably", measured=speed, limit=MOVING_TOL_MPS))
+        return violations
+    finally:
+        env.close()
+
+
+def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STEPS) -> PhysicalReport:
+    """All checks, penetration and floating measured in the simulator (module docstring)."""
+    if settle_steps < 1:
+        raise ValueError(f"settle_steps={settle_steps} must be >= 1")
+    t0 = time.perf_counter()
+    violations, meas, placed, unsupported_fix = static_findings(spec, overlap=False)
+    off = {v.object for v in violations if v.check == "off_table"}
+    violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
+    report = PhysicalReport(spec.name, "sim", ordered(violations), meas, time.perf_counter() - t0)
+    log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
+    return report

@@ -1,0 +1,121 @@
+"""The layering of docs/architecture.md holds in the source: imports go down only, the diagram matches them, only
+TaskVersion spells a task folder's file names, and no module grows past about 600 lines."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+from gendex_envs.task_version import RECORDS, TaskLayout
+
+PACKAGES = ("gendex_envs", "gendex", "generator")
+UNITS = {"gendex_envs": "runtime", "gendex.solve": "solve", "gendex.data": "data", "gendex.train": "train",
+         "gendex.cli": "cli", "gendex.gallery": "gallery", "generator": "generator"}
+"""Import prefix -> the unit the architecture diagram draws (the longest matching prefix wins)."""
+ALLOWED = {
+    "runtime": set(),
+    "solve": {"runtime"},
+    "data": {"runtime", "solve"},
+    "train": {"runtime", "solve"},
+    "generator": {"runtime", "solve"},
+    "gallery": {"runtime", "solve"},
+    "cli": {"runtime", "solve", "data", "train", "generator", "gallery"},
+}
+MAX_MODULE_LINES = 650
+"""'No module over about 600 lines' (docs/architecture.md); split a module before it gets here."""
+
+
+def _unit(module: str) -> str | None:
+    best = max((p for p in UNITS if module == p or module.startswith(p + ".")), key=len, default=None)
+    return UNITS[best] if best else None
+
+
+def _sources(root: Path, folders=PACKAGES) -> list[Path]:
+    return sorted(p for folder in folders for p in (root / folder).rglob("*.py"))
+
+
+def _module_name(root: Path, path: Path) -> str:
+    return ".".join(path.relative_to(root).with_suffix("").parts).removesuffix(".__init__")
+
+
+def import_edges(root: Path) -> dict[tuple[str, str], list[str]]:
+    """(unit, imported unit) -> the files importing it, over every import (lazy and type-only ones included)."""
+    edges: dict[tuple[str, str], list[str]] = {}
+    for path in _sources(root):
+        src = _unit(_module_name(root, path))
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = ([node.module] if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module
+                     else [a.name for a in node.names] if isinstance(node, ast.Import) else [])
+            for name in names:
+                dst = _unit(name)
+                if dst and dst != src:
+                    edges.setdefault((src, dst), []).append(str(path.relative_to(root)))
+    return edges
+
+
+def diagram_edges(root: Path) -> set[tuple[str, str]]:
+    doc = (root / "docs" / "architecture.md").read_text()
+    block = re.search(r"```mermaid\n(.*?)```", doc, re.S)
+    assert block is not None, "docs/architecture.md has no mermaid diagram"
+    return set(re.findall(r"^\s*(\w+)\s*-->\s*(\w+)\s*$", block.group(1), re.M))
+
+
+def test_imports_only_go_down_the_layers(repo_root):
+    bad = {edge: files for edge, files in import_edges(repo_root).items() if edge[1] not in ALLOWED[edge[0]]}
+    assert not bad, f"imports against the layering rule: {bad}"
+
+
+def test_the_architecture_diagram_is_the_import_graph(repo_root):
+    actual = set(import_edges(repo_root))
+    drawn = diagram_edges(repo_root)
+    assert drawn == actual, f"drawn but not imported: {drawn - actual}; imported but not drawn: {actual - drawn}"
+
+
+def _layout_patterns() -> dict[str, re.Pattern]:
+    """How each name of the task layout would appear in code: file names anywhere, folder names as path parts."""
+    files = TaskLayout(".")
+    names = [files.spec.name, files.reward.name, files.transcript.name, *(files.record(k).name for k in RECORDS)]
+    folders = [files.stage_rewards.name, files.start_states_dir.name, files.policies.name, files.renders.name,
+               files.policy_checkpoints("x").name]
+    out = {n: re.compile(rf"(?<![\w.]){re.escape(n)}(?!\w)") for n in names}
+    out |= {n: re.compile(rf"(^|[/\\]){re.escape(n)}([/\\]|$)") for n in folders}
+    return out
+
+
+@pytest.mark.parametrize("folders", [PACKAGES + ("benchmarks", "scripts")])
+def test_only_task_version_spells_the_task_layout(repo_root, folders):
+    owner = repo_root / "gendex_envs" / "task_version.py"
+    patterns = _layout_patterns()
+    found = []
+    for path in _sources(repo_root, folders):
+        if path == owner:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                for name, pattern in patterns.items():
+                    if pattern.search(node.value):
+                        found.append(f"{path.relative_to(repo_root)}:{node.lineno}: {name!r}")
+    assert not found, "layout names outside TaskVersion:\n" + "\n".join(found)
+
+
+def test_the_layout_search_finds_what_it_looks_for():
+    patterns = _layout_patterns()
+    assert patterns["task.yaml"].search("generated_tasks/X/v0/task.yaml")
+    assert patterns["policies"].search("v0/policies/grasp.zip") and not patterns["policies"].search("two policies")
+    assert not patterns["task.yaml"].search("mytask.yaml")
+
+
+def test_no_module_is_too_long(repo_root):
+    long = {str(p.relative_to(repo_root)): n for p in _sources(repo_root)
+            if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES}
+    assert not long, f"modules over {MAX_MODULE_LINES} lines: {long}"
+
+
+def test_library_code_logs_instead_of_printing(repo_root):
+    prints = [f"{p.relative_to(repo_root)}:{n.lineno}" for p in _sources(repo_root)
+              for n in ast.walk(ast.parse(p.read_text()))
+              if isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id == "print"]
+    assert not prints, prints
