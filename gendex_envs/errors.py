@@ -45,6 +45,10 @@ class StageError(GenDexError, ValueError):
     """A task stage does not exist, or a stage env lacks what it needs (start states, a policy)."""
 
 
+class RenderModeError(GenDexError, ValueError):
+    """A render mode that does not exist, or that this machine cannot serve (a viewer without a display)."""
+
+
 class PolicyError(GenDexError, ValueError):
     """A trained policy does not fit the stage it is used for (observation or action size, control mode)."""
 

@@ -50,7 +50,7 @@ from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, 
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
-from gendex_envs.errors import ControlModeError, GenDexError, StageError, TaskSpecError, suggest
+from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
@@ -67,10 +67,6 @@ VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 HAND_CAMERA = "hand_camera"
 DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_reward.py"
 """Reward module of an in-memory spec: no failure, reward = reaching the first stage's target."""
-
-
-class RenderModeError(GenDexError, ValueError):
-    """A render mode this machine cannot serve."""
 
 
 RENDER_MODES = (None, "rgb_array", "sensors", "all", "human")

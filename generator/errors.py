@@ -25,7 +25,7 @@ class TranscriptMismatchError(BackendError):
 
 
 class ModelOutputError(GeneratorError, ValueError):
-    """A model answer could not be parsed into the record the stage needs (malformed JSON / YAML / directives)."""
+    """A model answer could not be parsed into the record the step needs (malformed JSON / YAML / directives)."""
 
 
 class ProposalError(ModelOutputError):
@@ -53,7 +53,7 @@ class RewardProbeError(RewardCodeError):
 
 
 class RetriesExhaustedError(GeneratorError):
-    """A stage kept failing after its bounded number of retries; the last reason is attached."""
+    """A pipeline step kept failing after its bounded number of retries; the last reason is attached."""
 
 
 class CommitError(GeneratorError, OSError):

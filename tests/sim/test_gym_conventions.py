@@ -13,7 +13,7 @@ import torch
 from gendex.data.collector import CollectConfig, collect
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 from gendex_envs.agents.ur10e_shadow import ALL_JOINTS, COUPLED_DISTAL
-from gendex_envs.errors import GenDexError
+from gendex_envs.errors import RenderModeError
 from gendex_envs.registry import registered_tasks
 
 TASK = "GenDex/PutAppleBowl-v0"
@@ -85,9 +85,9 @@ def test_the_batched_api_truncates_each_sub_scene_with_a_tensor(make_env):
 def test_human_rendering_without_a_display_is_a_clear_error(monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
-    with pytest.raises(GenDexError, match=r"render_mode='human' opens a viewer window.*no display.*'rgb_array'"):
+    with pytest.raises(RenderModeError, match=r"render_mode='human' opens a viewer window.*no display.*'rgb_array'"):
         gym.make(TASK, render_mode="human")
-    with pytest.raises(GenDexError, match=r"render_mode='video' is not a mode; allowed: \[None, 'rgb_array'"):
+    with pytest.raises(RenderModeError, match=r"render_mode='video' is not a mode; allowed: \[None, 'rgb_array'"):
         gym.make(TASK, render_mode="video")
 
 
