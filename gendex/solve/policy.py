@@ -28,6 +28,8 @@ log = logging.getLogger(__name__)
 
 POLICY_FORMAT = 1
 """Version of a policy's JSON record; bumped when the observation or action layout changes."""
+WHOLE_TASK = "task"
+"""Stage name of a policy trained on the whole task (every joint, the task's reward and success)."""
 
 
 def stage_observation(env, judge: Judge, info: dict | None = None) -> torch.Tensor:
@@ -68,7 +70,8 @@ class StagePolicy:
                               f"{POLICY_FORMAT}")
         model = PPO.load(str(files.model), device="cpu")
         norm = meta["obs_norm"]
-        return cls(stage=files.stage, control_joint=meta["control_joint"], judge=version.judge(files.stage),
+        judge = version.judge(None if files.stage == WHOLE_TASK else files.stage)
+        return cls(stage=files.stage, control_joint=meta["control_joint"], judge=judge,
                    model=model, obs_mean=np.asarray(norm["mean"], dtype=np.float32),
                    obs_var=np.asarray(norm["var"], dtype=np.float32), clip_obs=float(norm["clip"]), meta=meta)
 

@@ -12,10 +12,11 @@ from collections.abc import Callable
 
 import gymnasium as gym
 
+from gendex.solve.policy import WHOLE_TASK
 from gendex_envs.start_states import StartStates
 from gendex_envs.task_version import TaskVersion
 
-TASK_STAGE = "task"
+TASK_STAGE = WHOLE_TASK
 """Name of the pseudo-stage that is the whole task (the ablation's "no sub-goals" variant)."""
 
 

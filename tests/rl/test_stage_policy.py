@@ -113,3 +113,17 @@ def test_executor_runs_a_present_policy(bottle, tmp_path):
         assert next(log for log in ex.logs if log.stage == "lift_bottle").steps > 0
     finally:
         env.close()
+
+
+def test_a_whole_task_policy_is_judged_by_the_tasks_success(bottle, tmp_path):
+    """The ablation's 'no sub-goals' policy trains on the whole task: it loads with the task's judge."""
+    from gendex.solve.policy import WHOLE_TASK
+    from gendex.train.presets import PRESETS
+    from gendex.train.train import train_stage
+
+    r = train_stage(bottle, None, steps=128, n_envs=1, run_dir=tmp_path / "run", control_joint="both",
+                    eval_episodes=1, progress=False,
+                    preset=dataclasses.replace(PRESETS["cpu"], n_steps=128, batch_size=64, n_epochs=1))
+    assert r.stage == WHOLE_TASK and r.policy.meta()["stage"] == WHOLE_TASK
+    policy = StagePolicy.load(bottle, r.policy)
+    assert policy.judge.stage is None and policy.judge.conditions == bottle.spec.success.conditions

@@ -3,26 +3,25 @@
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-
 
 @pytest.mark.parametrize("task", ["GenDex/PutAppleBowl-v0", "GenDex/OpenCabinet-v0"])
-def test_step_rate_benchmark_runs_and_builds_an_equivalent_scene(task):
-    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "step_rate.py"), "--task", task, "--steps", "20",
-                          "--warmup", "5", "--repeats", "1"], capture_output=True, text=True, timeout=300)
+def test_step_rate_benchmark_runs_and_builds_an_equivalent_scene(repo_root, task):
+    script = repo_root / "benchmarks" / "step_rate.py"
+    out = subprocess.run([sys.executable, str(script), "--task", task, "--steps", "20", "--warmup", "5", "--repeats",
+                          "1"], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     bodies = re.search(r"bodies \(dynamic, static, links\): env (\(.*?\))\s+raw (\(.*?\))", out.stdout)
     assert bodies and bodies.group(1) == bodies.group(2), out.stdout
     assert re.search(r"ratio env / raw\s+\d+\.\d+", out.stdout), out.stdout
 
 
-def test_collect_benchmark_reports_success_rate_and_steps_per_success():
-    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "collect.py"), "--tasks", "GenDex/PutAppleBowl-v0",
-                          "--episodes", "3", "--workers-trial", "0"], capture_output=True, text=True, timeout=300)
+def test_collect_benchmark_reports_success_rate_and_steps_per_success(repo_root):
+    script = repo_root / "benchmarks" / "collect.py"
+    out = subprocess.run([sys.executable, str(script), "--tasks", "GenDex/PutAppleBowl-v0", "--episodes", "3",
+                          "--workers-trial", "0"], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     m = re.search(r"PutAppleBowl-v0: (\d+)/3 succeeded .*?([\d.]+) env steps per success", out.stdout)
     assert m, out.stdout
