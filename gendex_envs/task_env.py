@@ -65,7 +65,7 @@ CONTROL_FREQ = 20
 VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 """The three scene views used by rendering, refinement and the docs."""
 HAND_CAMERA = "hand_camera"
-DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_reward.py"
+DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_rewards.py"
 """Reward module of an in-memory spec: no failure, reward = reaching the first stage's target."""
 
 

@@ -1,5 +1,5 @@
 """RotateTennisBall: the palm_up keyframe, a stable scene, success = the declared rotation unless the ball left the
-palm (reward.py's fail), random is not enough."""
+palm (the reward module's fail), random is not enough."""
 
 import math
 

@@ -13,7 +13,7 @@ from generator.errors import RewardCodeError, UnsafeCodeError
 from generator.steps.validate import check_reward_file, check_reward_source
 
 SHIPPED = [m for v in sorted(registered_tasks().values(), key=lambda v: v.env_id) for m in v.files.reward_modules()]
-PREVIEW = Path(gendex_envs.__file__).parent / "preview_reward.py"
+PREVIEW = Path(gendex_envs.__file__).parent / "preview_rewards.py"
 
 HEAD = "import torch\n\n"
 EVALUATE = (
@@ -40,7 +40,7 @@ def in_reward(body: str) -> str:
 
 def rejected(source: str, error: type[RewardCodeError] = UnsafeCodeError) -> str:
     with pytest.raises(RewardCodeError) as info:
-        check_reward_source(source, "stage_rewards/grasp.py")
+        check_reward_source(source, "grasp.py")
     assert type(info.value) is error, f"{type(info.value).__name__}: {info.value}"
     return str(info.value)
 
@@ -294,7 +294,7 @@ def test_interface_problems_are_named(source, pattern):
 
 def test_syntax_error_names_the_line():
     message = rejected(HEAD + "def evaluate(env)\n    return {}\n", RewardCodeError)
-    assert message.startswith("stage_rewards/grasp.py: syntax error at line 3") and "def evaluate(env)" in message
+    assert message.startswith("grasp.py: syntax error at line 3") and "def evaluate(env)" in message
 
 
 @pytest.mark.parametrize("source", ["x = 1\x00\n", "x = (" * 300 + "1" + ")" * 300 + "\n", "x = 1\n" * 30000])
