@@ -477,13 +477,14 @@ def spec_to_dict(spec: TaskSpec) -> dict:
     return _plain(dataclasses.asdict(spec))
 
 
-def _compact(value: Any) -> Any:
-    """Drop None-valued fields, and ``negate: false`` of conditions (the default that a reader need not see)."""
+def omit_unset(value: Any) -> Any:
+    """A plain spec mapping (or list) without what a reader need not see: None-valued fields and the conditions'
+    default ``negate: false``."""
     if isinstance(value, dict):
-        return {k: _compact(v) for k, v in value.items()
+        return {k: omit_unset(v) for k, v in value.items()
                 if v is not None and not (k == "negate" and v is False and "type" in value)}
     if isinstance(value, list):
-        return [_compact(v) for v in value]
+        return [omit_unset(v) for v in value]
     return value
 
 
@@ -501,5 +502,5 @@ _Dumper.add_representer(list, _represent_list)
 
 def dump_task_spec(spec: TaskSpec) -> str:
     """YAML text of ``spec``; None-valued (default) fields are omitted. parse(safe_load(dump(s))) == s."""
-    return yaml.dump(_compact(spec_to_dict(spec)), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
+    return yaml.dump(omit_unset(spec_to_dict(spec)), Dumper=_Dumper, sort_keys=False, allow_unicode=True,
                      default_flow_style=False, width=100)

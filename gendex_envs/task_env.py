@@ -467,14 +467,6 @@ class TaskEnv(BaseEnv):
         self.obj(name)
         return self._container_extent[name]
 
-    def joint_record(self, name: str, joint: str | None = None) -> JointEntry:
-        """The catalog entry of ``name``'s joint (default: its main joint)."""
-        return self._joint_record(name, joint)
-
-    def joint_index(self, name: str, joint: str | None = None) -> int:
-        """Position of ``name``'s joint among its articulation's active joints."""
-        return self._joint_index(name, joint)
-
     def hand_forces(self, name: str, part: str | None = None, joint: str | None = None) -> torch.Tensor:
         """[N, 6] mean contact force (N) of each hand group (th, ff, mf, rf, lf, palm) on object ``name``, or on its
         handle link (``part='handle'``); read once per step."""
@@ -483,24 +475,26 @@ class TaskEnv(BaseEnv):
             return self.agent.get_hand_group_obj_mean_force(entity)[..., 0]
         return self._cached(("hand_forces", name, part, joint), compute)
 
-    def _joint_record(self, name: str, joint: str | None = None) -> JointEntry:
+    def joint_record(self, name: str, joint: str | None = None) -> JointEntry:
+        """The catalog entry of ``name``'s joint (default: its main joint)."""
         rec = self._records[name]
         if not rec.articulated:
             raise TaskSpecError(f"object {name!r} (asset {rec.id!r}) is not articulated")
         return rec.joints[0] if joint is None else rec.joint(joint)
 
-    def _joint_index(self, name: str, joint: str | None) -> int:
-        jr = self._joint_record(name, joint)
+    def joint_index(self, name: str, joint: str | None = None) -> int:
+        """Position of ``name``'s joint among its articulation's active joints."""
+        jr = self.joint_record(name, joint)
         names = [j.name for j in self.articulations[name].get_active_joints()]
         return names.index(jr.name)
 
     def handle_link(self, name: str, joint: str | None = None) -> Link:
         """The link carrying the handle of ``name``'s joint (default: its main joint)."""
-        return self.articulations[name].links_map[self._joint_record(name, joint).handle_link]
+        return self.articulations[name].links_map[self.joint_record(name, joint).handle_link]
 
     def handle_pos(self, name: str, joint: str | None = None) -> torch.Tensor:
         """[N, 3] world position of the handle's grip point."""
-        jr = self._joint_record(name, joint)
+        jr = self.joint_record(name, joint)
         link = self.handle_link(name, joint)
         scale = self.task_spec.object(name).scale
         local = torch.tensor(jr.handle_point_m, dtype=torch.float32, device=self.device) * scale
@@ -508,17 +502,17 @@ class TaskEnv(BaseEnv):
 
     def joint_qpos(self, name: str, joint: str | None = None) -> torch.Tensor:
         """[N] current position of ``name``'s joint (default: its main joint)."""
-        return self.articulations[name].get_qpos()[:, self._joint_index(name, joint)]
+        return self.articulations[name].get_qpos()[:, self.joint_index(name, joint)]
 
     def open_qpos(self, name: str, joint: str | None = None) -> float:
-        return self._joint_record(name, joint).open_qpos
+        return self.joint_record(name, joint).open_qpos
 
     def closed_qpos(self, name: str, joint: str | None = None) -> float:
-        return self._joint_record(name, joint).closed_qpos
+        return self.joint_record(name, joint).closed_qpos
 
     def joint_open_fraction(self, name: str, joint: str | None = None) -> torch.Tensor:
         """[N] 0 when closed, 1 when at the open target (may exceed 1)."""
-        jr = self._joint_record(name, joint)
+        jr = self.joint_record(name, joint)
         return (self.joint_qpos(name, joint) - jr.closed_qpos) / (jr.open_qpos - jr.closed_qpos)
 
     @property

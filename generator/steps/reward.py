@@ -16,7 +16,7 @@ from pathlib import Path
 
 import yaml
 
-from gendex_envs.spec import TaskSpec, dump_task_spec, spec_to_dict
+from gendex_envs.spec import TaskSpec, dump_task_spec, omit_unset, spec_to_dict
 from gendex_envs.task_version import TaskLayout
 from generator.backends.base import Backend
 from generator.errors import RetriesExhaustedError, RewardCodeError
@@ -37,9 +37,8 @@ class RewardSet:
     reports: list[dict]
 
 
-def _conditions_yaml(conditions) -> str:
-    return yaml.safe_dump([{k: v for k, v in c.items() if v is not None and not (k == "negate" and v is False)}
-                           for c in conditions], sort_keys=False, default_flow_style=None, width=110).strip()
+def _conditions_yaml(conditions: list[dict]) -> str:
+    return yaml.safe_dump(omit_unset(conditions), sort_keys=False, default_flow_style=None, width=110).strip()
 
 
 def _stage_conditions(spec: TaskSpec, i: int) -> list[dict]:
