@@ -179,6 +179,20 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
         _die(exc)
     typer.echo(f"{state.successes}/{state.attempts} attempts succeeded; {state.env_steps} env steps "
                f"({state.env_steps_per_success:.0f} per success); output in {out}")
+    _echo_failures(state.failures)
+
+
+def _echo_failures(failures: dict[str, int]) -> None:
+    """The failed attempts per stage, skill and cause (also in the collection's state file)."""
+    from gendex.solve.failure import breakdown, by_cause
+
+    if not failures:
+        return
+    causes = ", ".join(f"{cause} {n}" for cause, n in sorted(by_cause(failures).items(), key=lambda kv: -kv[1]))
+    typer.echo(f"failed attempts by cause: {causes}")
+    for key, n in breakdown(failures):
+        stage, skill, cause = key.split("/")
+        typer.echo(f"  {n:4d}  {cause:20s} stage {stage} ({skill})")
 
 
 def _write_card(cfg, instruction: str, solver: str, state) -> None:

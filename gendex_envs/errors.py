@@ -37,8 +37,34 @@ class ControlModeError(GenDexError, ValueError):
     """An unknown control_joint mode or controller name."""
 
 
+FAILURE_CAUSES: dict[str, str] = {
+    "no_ik": "no IK solution reaches the pose a primitive needs",
+    "no_plan": "no collision-free arm motion was found",
+    "grasp_failed": "the grasp did not close on the object or did not hold it",
+    "slipped": "the object slipped out of the hand while lifting or carrying",
+    "target_not_reached": "the stage ended without reaching its goal",
+    "timeout": "the episode's step limit ended the attempt",
+    "unstable_physics": "the simulation went unstable (non-finite or exploding state)",
+    "task_fail": "the task's own failure condition ended the episode",
+    "unsupported": "the solver has no primitive for the stage's skill on its target",
+}
+"""Why a solver's attempt failed: cause -> meaning (the keys of ``gendex collect``'s failure breakdown)."""
+
+
 class ExecutionError(GenDexError):
-    """A scripted solver's primitive could not run (no reachable grasp, no plan, unsupported stage)."""
+    """A solver's attempt could not go on: which ``cause`` (:data:`FAILURE_CAUSES`), in which stage and skill."""
+
+    def __init__(self, message: str, cause: str = "target_not_reached", stage: str | None = None,
+                 skill: str | None = None):
+        if cause not in FAILURE_CAUSES:
+            raise ValueError(f"unknown failure cause {cause!r}; causes: {sorted(FAILURE_CAUSES)}")
+        super().__init__(message)
+        self.cause = cause
+        self.stage = stage
+        self.skill = skill
+
+    def __reduce__(self):  # keep the cause through pickling (worker processes)
+        return (type(self), (str(self), self.cause, self.stage, self.skill))
 
 
 class StageError(GenDexError, ValueError):

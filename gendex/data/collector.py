@@ -26,6 +26,7 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
+from gendex.solve.failure import Failure
 from gendex_envs.atomic_io import write_json
 from gendex_envs.errors import ExecutionError
 
@@ -68,6 +69,8 @@ class CollectState:
     env_steps: int = 0
     kept_seeds: list[int] = field(default_factory=list)
     seconds: float = 0.0
+    failures: dict[str, int] = field(default_factory=dict)
+    """Failed attempts per ``stage/skill/cause`` (:class:`~gendex.solve.failure.Failure`)."""
 
     @property
     def successes(self) -> int:
@@ -83,7 +86,7 @@ def _load_state(cfg: CollectConfig) -> CollectState:
     if not path.is_file():
         return CollectState(task_id=cfg.task_id, seed=cfg.seed)
     raw = json.loads(path.read_text())
-    state = CollectState(**raw)
+    state = CollectState(**{k: v for k, v in raw.items() if k in CollectState.__dataclass_fields__})
     if (state.task_id, state.seed) != (cfg.task_id, cfg.seed):
         raise EpisodeError(f"{path} belongs to a collection of {state.task_id} with seed {state.seed}; asked for "
                            f"{cfg.task_id} with seed {cfg.seed} (use another --out or the same task and seed)")
@@ -121,6 +124,8 @@ class AttemptResult:
     """The recorded episode when it succeeded, else None."""
     steps: int
     seconds: float
+    failure: Failure | None = None
+    """Why it failed (None when it succeeded)."""
 
 
 def _make_env(cfg: CollectConfig) -> gym.Env:
@@ -138,13 +143,15 @@ class _Attempter:
 
     def __call__(self, seed: int) -> AttemptResult:
         t0 = time.perf_counter()
-        episode, images = _attempt(self.env, self.recorder, self.solver, seed, self.cfg.cameras)
+        episode, images, failure = _attempt(self.env, self.recorder, self.solver, seed, self.cfg.cameras)
         kept = None
         if episode is not None and episode.succeeded:
             episode.images.update(images)
             episode.info.update(solver=self.solver.name)
-            kept = episode
-        return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0)
+            kept, failure = episode, None
+        elif failure is None:  # recorded, but the success came too late or not at all
+            failure = Failure("target_not_reached", detail="the episode ended without the task's success")
+        return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0, failure)
 
 
 _WORKER: _Attempter | None = None
@@ -212,6 +219,10 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
                 raise EpisodeError(f"attempt {state.attempts} (seed {result.seed}) was exported before an "
                                    "interruption but did not succeed when re-run: the solver or env is not "
                                    "deterministic")
+            else:
+                failure = result.failure or Failure("target_not_reached")
+                state.failures[failure.key] = state.failures.get(failure.key, 0) + 1
+                log.info("attempt %d (seed %d) failed: %s", state.attempts, result.seed, failure)
             pending = {}
             state.attempts += 1
             state.env_steps += result.steps
@@ -238,26 +249,38 @@ def _exported(writer) -> int:
 
 
 def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int, cameras: tuple[str, ...]
-             ) -> tuple[Episode | None, dict[str, np.ndarray]]:
-    obs, _ = recorder.begin(seed)
+             ) -> tuple[Episode | None, dict[str, np.ndarray], Failure | None]:
+    """Run one attempt; the recorded episode (None if no step was taken), camera frames, and why it failed (None
+    when it may have succeeded: the caller checks)."""
+    obs, info = recorder.begin(seed)
     solver.reset(env, obs)
     frames = {c: [_image(obs, c)] for c in cameras}
+    failure: Failure | None = None
+    terminated = truncated = False
     while True:
         try:
             action = solver.act(env, obs)
         except ExecutionError as exc:  # the solver gave up on this attempt: a failed attempt, not a crash
-            log.warning("attempt with seed %d: %s", seed, exc)
+            failure = Failure.of_error(exc)
+            log.info("attempt with seed %d: %s", seed, failure)
             break
         if action is None:
             break
-        obs, _, terminated, truncated, _ = recorder.step(action)
+        obs, _, terminated, truncated, info = recorder.step(action)
         for c in cameras:
             frames[c].append(_image(obs, c))
         if terminated or truncated:
             break
+    if failure is None and not _succeeded(info):
+        failure = Failure.of_ending(solver, env, bool(terminated), bool(truncated))
     if recorder.steps == 0:
-        return None, {}
-    return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}
+        return None, {}, failure or Failure("target_not_reached", detail="the solver took no step")
+    return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}, failure
+
+
+def _succeeded(info: dict) -> bool:
+    value = info.get("success", False)
+    return bool(np.asarray(value.cpu() if hasattr(value, "cpu") else value).reshape(-1)[0])
 
 
 def _image(obs, camera: str) -> np.ndarray:

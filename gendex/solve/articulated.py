@@ -130,7 +130,7 @@ def read_joint(env: TaskEnv, name: str, env_idx: int = 0) -> JointFrame:
     px = px_objects(joint)[env_idx]  # PhysX's own joint pose
     if px.type not in ("revolute", "revolute_unwrapped"):
         raise ExecutionError(f"{name!r}: joint {joint.name!r} is {px.type}; the articulated primitives open "
-                             f"revolute joints (doors, lids) only")
+                             f"revolute joints (doors, lids) only", cause="unsupported")
     frame = _matrix(px.get_global_pose())
     pose = env.handle_link(name).pose
     link = _matrix(sapien.Pose(pose.p[env_idx].cpu().numpy(), pose.q[env_idx].cpu().numpy()))
@@ -242,7 +242,8 @@ class HandlePrimitives:
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
         """The actions of primitive ``prim`` (``approach_handle``, ``hook`` or ``pull``) for ``stage``."""
         if prim not in ("approach_handle", "hook", "pull"):
-            raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull")
+            raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull",
+                                 cause="unsupported")
         return getattr(self, prim)(stage)
 
     def mark_hooked(self, target: str) -> None:
@@ -308,7 +309,7 @@ class HandlePrimitives:
             break
         if chosen is None:
             raise ExecutionError(f"no hook grasp of {name!r}'s handle that the arm can reach and pull along the "
-                                 f"door's arc")
+                                 f"door's arc", cause="no_ik")
         grasp, q_pre, q0 = chosen
         log.info("%r: %s", name, grasp)
         self.grasp, self.target, self.hooked = grasp, name, False
@@ -345,12 +346,12 @@ class HandlePrimitives:
                 return
             if len(history) > c.stall_steps and history[-1] - history[-1 - c.stall_steps] < c.stall_rad:
                 raise ExecutionError(f"the door of {name!r} stalled at {joint.q:.3f} rad (goal {goal:.3f}): the "
-                                     f"hook slipped off the handle")
+                                     f"hook slipped off the handle", cause="slipped")
             target = ex.target()
             q_next = min(q_cmd + c.rate_rad, joint.q + c.lead_rad, goal + 0.05)
             q = ex.ik.solve(self.grasp.palm_at(joint, q_next), target, restarts=0)
             if q is None:
-                raise ExecutionError(f"no IK for the palm on {name!r}'s door arc at {q_next:.3f} rad")
+                raise ExecutionError(f"no IK for the palm on {name!r}'s door arc at {q_next:.3f} rad", cause="no_ik")
             # where the arm must turn fast for the palm to keep up, the door command slows down instead (a uniform
             # scale of the joint step keeps the palm on the arc; a per-joint clip would not)
             delta = q[ex.ik.arm] - target[ex.ik.arm]
@@ -360,7 +361,7 @@ class HandlePrimitives:
             t[ex.ik.arm] = target[ex.ik.arm] + scale * delta
             yield ex.emit(t, guard=True)
         raise ExecutionError(f"the door of {name!r} reached {read_joint(u, name).q:.3f} rad of {goal:.3f} in "
-                             f"{c.max_steps} pull steps")
+                             f"{c.max_steps} pull steps", cause="target_not_reached")
 
 
 __all__ = ["HOOK_CLOSED", "HOOK_OPEN", "HandleConfig", "HandlePrimitives", "HookGrasp", "JointFrame",
