@@ -124,9 +124,11 @@ class ObjectSpec:
     joint_state: dict[str, float] = field(default_factory=dict)
     """Initial joint positions by joint name, for articulated assets only."""
     randomize: RandomizeSpec = field(default_factory=RandomizeSpec)
-    """Pose noise applied at reset."""
+    """Pose noise applied at reset (layouts are drawn free of overlaps between objects)."""
     color_rgba: tuple[float, float, float, float] | None = None
     """Optional colour override, each channel in [0, 1]."""
+    distractor: bool = False
+    """True for clutter the task is not about: no stage acts on it and no condition names it; solvers avoid it."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -409,6 +411,13 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         p.append(f"{path} = {value!r} does not name an object{extra}; allowed: {', '.join(map(repr, options))}."
                  f"{suggest_value(value, options)}")
 
+    distractors = {o.name for o in spec.objects if o.distractor}
+
+    def not_distractor(value: str | None, path: str) -> None:
+        if value in distractors:
+            p.append(f"{path} = {value!r} names a distractor (objects with distractor: true take part in no stage "
+                     "or condition); name a task object or drop the distractor flag")
+
     need(len(spec.stages) >= 1, "stages", [], "at least one stage is required")
     stage_names: set[str] = set()
     for i, s in enumerate(spec.stages):
@@ -419,11 +428,14 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         need(bool(s.instruction.strip()), f"{at}.instruction", s.instruction, "must be a non-empty string")
         need(s.horizon >= 1, f"{at}.horizon", s.horizon, "must be >= 1")
         ref(s.target, f"{at}.target")
+        not_distractor(s.target, f"{at}.target")
         if s.success is not None:
             need(len(s.success) >= 1, f"{at}.success", [], "leave it out (the stage then succeeds with the task) "
                  "or give at least one condition")
             for j, c in enumerate(s.success):
                 p += _condition_problems(c, f"{at}.success[{j}]", ref)
+                not_distractor(c.object, f"{at}.success[{j}].object")
+                not_distractor(c.target, f"{at}.success[{j}].target")
 
     need(bool(spec.success.description.strip()), "success.description", spec.success.description,
          "must be a non-empty string")
@@ -431,6 +443,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
     need(len(spec.success.conditions) >= 1, "success.conditions", [], "at least one condition is required")
     for i, c in enumerate(spec.success.conditions):
         p += _condition_problems(c, f"success.conditions[{i}]", ref)
+        not_distractor(c.object, f"success.conditions[{i}].object")
+        not_distractor(c.target, f"success.conditions[{i}].target")
     return p
 
 
@@ -478,11 +492,12 @@ def spec_to_dict(spec: TaskSpec) -> dict:
 
 
 def omit_unset(value: Any) -> Any:
-    """A plain spec mapping (or list) without what a reader need not see: None-valued fields and the conditions'
-    default ``negate: false``."""
+    """A plain spec mapping (or list) without what a reader need not see: None-valued fields, the conditions'
+    default ``negate: false`` and the objects' default ``distractor: false``."""
     if isinstance(value, dict):
         return {k: omit_unset(v) for k, v in value.items()
-                if v is not None and not (k == "negate" and v is False and "type" in value)}
+                if v is not None and not (k == "negate" and v is False and "type" in value)
+                and not (k == "distractor" and v is False and "asset" in value)}
     if isinstance(value, list):
         return [omit_unset(v) for v in value]
     return value

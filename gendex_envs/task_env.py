@@ -52,6 +52,7 @@ from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_
 from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
+from gendex_envs.placement import Footprint, Item, place
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
 from gendex_envs.start_states import StartStates
@@ -248,6 +249,7 @@ class TaskEnv(BaseEnv):
         self.articulations.clear()
         self._art_init_qpos: dict[str, torch.Tensor] = {}
         self._init_pose: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
+        self._layout: list[Item] = []
         for obj in self.task_spec.objects:
             rec = self._records[obj.name]
             p, q = self._spec_pose(obj)
@@ -259,6 +261,8 @@ class TaskEnv(BaseEnv):
                 self._art_init_qpos[obj.name] = self._initial_joint_state(obj.name, rec, entity)
             self._init_pose[obj.name] = (torch.tensor(p, dtype=torch.float32, device=self.device),
                                          torch.tensor(q, dtype=torch.float32, device=self.device))
+            self._layout.append(Item(obj.name, (float(p[0]), float(p[1])), obj.randomize.xy_m,
+                                     math.radians(obj.randomize.yaw_deg), self._footprint(obj, q), obj.fixed))
         with torch.device(self.device):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
             self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}
@@ -288,6 +292,16 @@ class TaskEnv(BaseEnv):
         x, y, clearance = obj.pos_m
         z = self.table_height + clearance - lowest_point_z(rec, obj.scale, q)
         return np.array([x, y, z]), q
+
+    def _footprint(self, obj, q: np.ndarray) -> Footprint:
+        """The table rectangle object ``obj`` covers at orientation ``q``: its box's corners turned, seen from above."""
+        rec = self._records[obj.name]
+        lo, hi = np.asarray(rec.bbox_min_m) * obj.scale, np.asarray(rec.bbox_max_m) * obj.scale
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        xy = (corners @ sapien.Pose(q=q.tolist()).to_transformation_matrix()[:3, :3].T)[:, :2]
+        a, b = xy.min(axis=0), xy.max(axis=0)
+        return Footprint(offset=(float(a[0] + b[0]) / 2, float(a[1] + b[1]) / 2),
+                         half=(float(b[0] - a[0]) / 2, float(b[1] - a[1]) / 2))
 
     def _initial_joint_state(self, name: str, rec: AssetRecord, art: Articulation) -> torch.Tensor:
         """[dof] joint positions at reset: the spec's joint_state, else the joint's closed value, else its lower
@@ -408,16 +422,16 @@ class TaskEnv(BaseEnv):
             qpos = torch.as_tensor(self.agent.qpos_from_names(keyframe))
             self.agent.robot.set_qpos(qpos.expand(b, -1).clone())
             self.agent.robot.set_qvel(torch.zeros(b, qpos.shape[0]))
+            table = self.task_spec.table
+            noise = place(self._layout, b, (table.size_m[0] / 2, table.size_m[1] / 2), self.device)
             for obj in self.task_spec.objects:
                 p0, q0 = self._init_pose[obj.name]
                 p = p0.expand(b, 3).clone()
                 q = q0.expand(b, 4).clone()
-                rx, ry = obj.randomize.xy_m
-                if rx > 0 or ry > 0:
-                    p[:, :2] += (torch.rand(b, 2) * 2 - 1) * torch.tensor([rx, ry])
+                dxy, dyaw = noise[obj.name]
+                p[:, :2] += dxy
                 if obj.randomize.yaw_deg > 0:
-                    yaw = (torch.rand(b) * 2 - 1) * math.radians(obj.randomize.yaw_deg)
-                    q = quat_mul(yaw_quat(yaw), q)
+                    q = quat_mul(yaw_quat(dyaw), q)
                 entity = self.objects[obj.name]
                 entity.set_pose(Pose.create_from_pq(p, q))
                 if obj.name in self.articulations:

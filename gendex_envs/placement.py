@@ -1,0 +1,136 @@
+"""Collision-free random layouts at reset: every object's pose noise drawn so that no two footprints overlap.
+
+Each object has a :class:`Footprint` — the rectangle it covers on the table at the spec's orientation, from its
+catalog bounding box; its yaw noise turns it about the object's origin. :func:`place` draws the objects' noise in
+spec order, batched over envs: an env whose drawn object would overlap one placed before it (with :data:`GAP_M`
+between them) or leave the table (unless it is fixed) draws again, up to :data:`TRIES` times; an env where an object
+never finds room draws its whole layout again (:data:`ROUNDS`), and one that never succeeds keeps the nominal layout.
+The draws come from torch's RNG, which ManiSkill seeds from the reset seed, so a layout is a function of the seed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+
+GAP_M = 0.01
+"""Least gap between two objects' footprints after randomization."""
+TRIES = 32
+"""Draws per object and env before the env's layout is drawn again."""
+ROUNDS = 8
+"""Whole-layout draws per env before it falls back to the nominal layout."""
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """A rectangle on the table in an object's frame: centre offset from the origin (x, y) and half extents."""
+
+    offset: tuple[float, float]
+    half: tuple[float, float]
+
+
+def _axes(yaw: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    c, s = torch.cos(yaw), torch.sin(yaw)
+    return torch.stack([c, s], -1), torch.stack([-s, c], -1)
+
+
+def corners_center(pos: torch.Tensor, yaw: torch.Tensor, fp: Footprint) -> torch.Tensor:
+    """[B, 2] world centre of the footprint of an object at ``pos`` [B, 2] turned by ``yaw`` [B]."""
+    u, v = _axes(yaw)
+    return pos + u * fp.offset[0] + v * fp.offset[1]
+
+
+def overlap(ca: torch.Tensor, yaw_a: torch.Tensor, fa: Footprint, cb: torch.Tensor, yaw_b: torch.Tensor,
+            fb: Footprint, gap: float = GAP_M) -> torch.Tensor:
+    """[B] bool: rectangles a and b (footprint centres [B, 2], yaws [B]) come closer than ``gap`` (separating axes)."""
+    ua, va = _axes(yaw_a)
+    ub, vb = _axes(yaw_b)
+    d = cb - ca
+    hit = torch.ones(len(d), dtype=torch.bool, device=d.device)
+    for n in (ua, va, ub, vb):
+        ra = fa.half[0] * (ua * n).sum(-1).abs() + fa.half[1] * (va * n).sum(-1).abs()
+        rb = fb.half[0] * (ub * n).sum(-1).abs() + fb.half[1] * (vb * n).sum(-1).abs()
+        hit &= (d * n).sum(-1).abs() < ra + rb + gap
+    return hit
+
+
+def on_table(center: torch.Tensor, yaw: torch.Tensor, fp: Footprint, table_half: tuple[float, float]) -> torch.Tensor:
+    """[B] bool: the footprint lies on the table top (centred at the origin, half extents ``table_half``)."""
+    u, v = _axes(yaw)
+    ext_x = fp.half[0] * u[:, 0].abs() + fp.half[1] * v[:, 0].abs()
+    ext_y = fp.half[0] * u[:, 1].abs() + fp.half[1] * v[:, 1].abs()
+    return (center[:, 0].abs() + ext_x <= table_half[0]) & (center[:, 1].abs() + ext_y <= table_half[1])
+
+
+@dataclass(frozen=True)
+class Item:
+    """One object to place: nominal position (x, y), noise half-ranges, footprint at the nominal orientation."""
+
+    name: str
+    pos: tuple[float, float]
+    noise_xy: tuple[float, float]
+    noise_yaw_rad: float
+    footprint: Footprint
+    fixed: bool = False
+    """Fixed objects (a cabinet against the table's back edge) may overhang the table; others must lie on it."""
+
+
+def place(items: list[Item], batch: int, table_half: tuple[float, float], device=None
+          ) -> dict[str, tuple[torch.Tensor, torch.Tensor]]:
+    """Noise for every item: name -> (xy offset [B, 2], yaw offset [B]), layouts free of overlaps (module doc).
+
+    An env where some object found no room is drawn again as a whole, up to :data:`ROUNDS` times; one that never
+    succeeds keeps every object's nominal pose (the spec's layout, which the physical checks keep free)."""
+    out, ok = _draw(items, batch, table_half, device)
+    for _ in range(ROUNDS - 1):
+        if bool(ok.all()):
+            break
+        again, ok_again = _draw(items, batch, table_half, device)
+        take = ~ok & ok_again
+        for name, (dxy, dyaw) in again.items():
+            out[name][0][take] = dxy[take]
+            out[name][1][take] = dyaw[take]
+        ok |= ok_again
+    for dxy, dyaw in out.values():
+        dxy[~ok] = 0.0
+        dyaw[~ok] = 0.0
+    return out
+
+
+def _draw(items: list[Item], batch: int, table_half: tuple[float, float], device=None
+          ) -> tuple[dict[str, tuple[torch.Tensor, torch.Tensor]], torch.Tensor]:
+    """One layout per env, objects drawn in order (module doc); and [B] bool: every object found room."""
+    placed: list[tuple[Item, torch.Tensor, torch.Tensor]] = []  # item, footprint centre [B, 2], yaw [B]
+    out: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
+    all_ok = torch.ones(batch, dtype=torch.bool, device=device)
+    for it in items:
+        base = torch.tensor(it.pos, dtype=torch.float32, device=device).expand(batch, 2)
+        noise_xy = torch.zeros(batch, 2, device=device)
+        noise_yaw = torch.zeros(batch, device=device)
+        todo = torch.ones(batch, dtype=torch.bool, device=device)
+        moves = it.noise_xy[0] > 0 or it.noise_xy[1] > 0
+        turns = it.noise_yaw_rad > 0
+        if not (moves or turns):
+            todo[:] = False
+        for _ in range(TRIES if moves or turns else 0):
+            if not bool(todo.any()):
+                break
+            # draw only what the object randomizes: a layout without overlaps keeps the draws of one try each
+            dxy = ((torch.rand(batch, 2, device=device) * 2 - 1) * torch.tensor(it.noise_xy, device=device)
+                   if moves else torch.zeros(batch, 2, device=device))
+            dyaw = ((torch.rand(batch, device=device) * 2 - 1) * it.noise_yaw_rad if turns
+                    else torch.zeros(batch, device=device))
+            center = corners_center(base + dxy, dyaw, it.footprint)
+            ok = (torch.ones(batch, dtype=torch.bool, device=device) if it.fixed
+                  else on_table(center, dyaw, it.footprint, table_half))
+            for other, oc, oyaw in placed:
+                ok &= ~overlap(center, dyaw, it.footprint, oc, oyaw, other.footprint)
+            take = todo & ok
+            noise_xy[take] = dxy[take]
+            noise_yaw[take] = dyaw[take]
+            todo &= ~ok
+        all_ok &= ~todo
+        placed.append((it, corners_center(base + noise_xy, noise_yaw, it.footprint), noise_yaw))
+        out[it.name] = (noise_xy, noise_yaw)
+    return out, all_ok
