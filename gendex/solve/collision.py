@@ -47,6 +47,7 @@ class ArmCollisionModel:
                 self._spheres.append((link.name, centres, np.full(len(centres), r)))
         self._housing = t
         self._attached: tuple[np.ndarray, np.ndarray] | None = None  # palm-frame centres [k, 3], radii [k]
+        self._hand: tuple[np.ndarray, np.ndarray] | None = None  # the same, for the hand itself
         self._palm = ik.link_names.index("palm")
 
     def attach(self, world_centres: np.ndarray, radii: np.ndarray, q: np.ndarray) -> None:
@@ -58,6 +59,11 @@ class ArmCollisionModel:
 
     def detach(self) -> None:
         self._attached = None
+
+    def cover_hand(self, palm_centres: np.ndarray | None, radii: np.ndarray | None = None) -> None:
+        """Include the hand in the model as spheres (palm-frame centres [k, 3], radii [k]) — e.g. the opened hand
+        while the arm brings it next to an object — or leave it out again (``None``, the default: the arm only)."""
+        self._hand = None if palm_centres is None else (np.asarray(palm_centres, float), np.asarray(radii, float))
 
     @property
     def attached(self) -> bool:
@@ -80,10 +86,11 @@ class ArmCollisionModel:
         b = (base @ ik.model.get_link_pose(ik.link_names.index("wrist")).to_transformation_matrix())[:3, 3]
         centres.append(a + self._housing * (b - a))
         radii.append(np.full(len(self._housing), HOUSING_RADIUS_M))
-        if self._attached is not None:
-            m = base @ ik.model.get_link_pose(self._palm).to_transformation_matrix()
-            centres.append(self._attached[0] @ m[:3, :3].T + m[:3, 3])
-            radii.append(self._attached[1])
+        m = base @ ik.model.get_link_pose(self._palm).to_transformation_matrix()
+        for palm_spheres in (self._attached, self._hand):
+            if palm_spheres is not None:
+                centres.append(palm_spheres[0] @ m[:3, :3].T + m[:3, 3])
+                radii.append(palm_spheres[1])
         return np.concatenate(centres), np.concatenate(radii)
 
     def clearance(self, q: np.ndarray) -> float:

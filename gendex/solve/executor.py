@@ -14,11 +14,12 @@ release     ``release``
 open                             ``pull`` (hooks first when no stage did)
 ==========  ===================  =============================================================================
 
-``approach``: grasp synthesis on the object's measured pose, IK, planned path to the pre-grasp, straight descent.
-``grasp``: guarded finger-then-thumb closing, squeeze, lift and a hold check. ``lift``: raise the held object to
-the success height. ``carry``: planned path (the held object attached to the palm in the collision model) until
-the held object is over the target. ``release``: open the hand and back off. A skill without a primitive for its
-target raises :class:`~gendex_envs.errors.ExecutionError` naming what exists.
+The rigid primitives (:mod:`gendex.solve.rigid`) synthesize grasps over the object's geometry, rank them by a
+physics trial in a private copy of the scene, and grasp again once after a slip. A skill without a primitive for
+its target raises :class:`~gendex_envs.errors.ExecutionError` naming what exists.
+
+Every ``ExecutionError`` that ends an attempt carries its cause (:data:`~gendex_envs.errors.FAILURE_CAUSES`) and
+the stage and skill it happened in; ``gendex collect`` counts them.
 
 A stage whose trained policy is present (in the task version, or in the policy folders given) runs the policy
 instead — for RL stages, or for every stage with ``policy_stages="all"`` — until the stage's success conditions
@@ -35,12 +36,12 @@ from dataclasses import dataclass, field
 
 import gymnasium as gym
 import numpy as np
-import sapien
 
 from gendex.solve.articulated import HandlePrimitives
-from gendex.solve.grasp import OPEN_HAND, GraspPlan, grasp_candidates
+from gendex.solve.grasp import GraspPlan
 from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
+from gendex.solve.rigid import RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 from gendex_envs.task_version import Artifacts, PolicyFiles
 
@@ -54,19 +55,11 @@ ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "
 
 @dataclass
 class ExecutorConfig:
-    """Speeds and margins of the scripted primitives (control steps at 20 Hz)."""
+    """Arm motion limits and the rigid primitives' settings (control steps at 20 Hz)."""
 
-    descend_m_per_step: float = 0.01
-    lift_m: float = 0.15
-    lift_m_per_step: float = 0.006
-    close_steps: int = 12
-    thumb_steps: int = 12
-    squeeze_steps: int = 6
-    release_steps: int = 8
-    carry_clearance_m: float = 0.07
-    """Height of the held object's bottom above the target container's rim while carrying."""
     settle_steps: int = 2
     max_arm_step_rad: float = 0.06
+    rigid: RigidConfig = field(default_factory=RigidConfig)
 
 
 @dataclass
@@ -101,10 +94,10 @@ class StageExecutor:
             self._env = u
             self.motion = ArmHandMotion(u, self.config.max_arm_step_rad, self.config.settle_steps)
             self._policies: dict[str, StagePolicy] = {}
-        self.held: str | None = None
+            self.rigid = RigidPrimitives(self.motion, self.config.rigid)
+        self.rigid.reset()
         self.carried = False
         self.logs: list[StageLog] = []
-        self._plan: GraspPlan | None = None
         self._handles = HandlePrimitives(self.motion)
         self.stage_index = -1
         """Index of the stage being executed (-1 before the first)."""
@@ -114,22 +107,46 @@ class StageExecutor:
 
     def act(self, env: gym.Env, obs) -> np.ndarray | None:
         before = self.motion.steps
-        action = next(self._actions, None)
+        try:
+            action = next(self._actions, None)
+        except ExecutionError as exc:  # say where it happened
+            stage = self.current_stage
+            if stage is not None and exc.stage is None:
+                exc.stage, exc.skill = stage.name, stage.skill
+            raise
         if self.logs:
             self.logs[-1].steps += self.motion.steps - before
         return action
+
+    @property
+    def current_stage(self):
+        """The spec of the stage being executed (None before the first and after the last)."""
+        stages = self._env.task_spec.stages
+        return stages[self.stage_index] if 0 <= self.stage_index < len(stages) and not self.finished else None
+
+    @property
+    def held(self) -> str | None:
+        """The object the hand holds, if any."""
+        return self.rigid.held
+
+    @property
+    def grasp_plan(self) -> GraspPlan | None:
+        """The grasp the rigid primitives executed last."""
+        return self.rigid.plan
 
     # ------------------------------------------------------------------ dispatch
     def primitive(self, stage) -> str:
         """The primitive that runs ``stage`` (module docstring); ExecutionError when there is none."""
         if stage.target is None:
-            raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it")
+            raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it",
+                                 cause="unsupported", stage=stage.name, skill=stage.skill)
         articulated = stage.target in self._env.articulations
         table = ARTICULATED_PRIMITIVES if articulated else RIGID_PRIMITIVES
         if stage.skill not in table:
             kind = "an articulated" if articulated else "a rigid"
             raise ExecutionError(f"stage {stage.name!r}: the executor has no primitive for skill {stage.skill!r} on "
-                                 f"{kind} target ({stage.target!r}); skills it runs there: {sorted(table)}")
+                                 f"{kind} target ({stage.target!r}); skills it runs there: {sorted(table)}",
+                                 cause="unsupported", stage=stage.name, skill=stage.skill)
         return table[stage.skill]
 
     def _policy_files(self, stage) -> PolicyFiles | None:
@@ -187,119 +204,45 @@ class StageExecutor:
                 break
         if not done:
             raise ExecutionError(f"policy of stage {stage.name!r} did not reach the stage's goal in {stage.horizon} "
-                                 "steps")
+                                 "steps", cause="target_not_reached")
         articulated = stage.target in env.articulations
         if stage.skill == "grasp" and articulated:
             self._handles.mark_hooked(stage.target)
         elif stage.skill == "grasp":
-            self.held = stage.target
+            self.rigid.held = stage.target
         elif stage.skill == "carry":
             self.carried = True
         elif stage.skill == "release":
-            self.held = None
+            self.rigid.held = None
 
     # ------------------------------------------------------------------ primitives
     def _approach(self, stage) -> Iterator[np.ndarray]:
-        m, name = self.motion, stage.target
-        center, bottom, height, radius = m.object_geometry(name)
-        m.avoid_objects(exclude=(name,))
-        base = m.ik.base.p
-        prefer = float(np.arctan2(center[1] - base[1], center[0] - base[0]))  # fingers pointing away from the base
-        q0 = m.target()
-        chosen: tuple[GraspPlan, np.ndarray] | None = None
-        for plan in grasp_candidates(center, bottom, height, radius, prefer_yaw_rad=prefer):
-            open_q = m.with_hand(q0, plan.open_hand)
-            q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
-            if q_pre is None or m.ik.solve(plan.palm, q_pre, restarts=0) is None:
-                continue
-            chosen = (plan, q_pre)
-            break
-        if chosen is None:
-            raise ExecutionError(f"no reachable collision-free grasp of {name!r}")
-        plan, q_pre = chosen
-        self._plan = plan
-        yield from m.move_arm(q_pre, hand=m.with_hand(q0, plan.open_hand))
-        yield from m.cartesian(plan.palm.p - plan.pregrasp.p, self.config.descend_m_per_step)
-        yield from m.settle()
+        yield from self.rigid.approach(stage.target, self._grip_conditions(stage.target))
+
+    def _grip_conditions(self, name: str) -> tuple:
+        """The ``grasped`` conditions the next grasp stage on ``name`` declares: a grasp is only chosen if its trial
+        meets them too (how many fingers, palm force), so the stage's success follows from the grasp."""
+        spec = self._env.task_spec
+        for later in spec.stages[self.stage_index + 1:]:
+            if later.skill == "grasp" and later.target == name:
+                return tuple(c for c in later.success or () if c.type == "grasped" and c.object == name
+                             and not c.negate)
+        return ()
 
     def _grasp(self, stage) -> Iterator[np.ndarray]:
-        plan, m, c = self._plan, self.motion, self.config
-        if plan is None:
-            raise ExecutionError(f"stage {stage.name!r} grasps {stage.target!r} but no stage approached it")
-        yield from m.ramp(m.with_hand(m.target(), plan.fingers), c.close_steps, guard=True)
-        yield from m.ramp(m.with_hand(m.target(), plan.thumb), c.thumb_steps, guard=True)
-        for _ in range(c.squeeze_steps):
-            yield m.emit(m.with_hand(m.target(), plan.fingers | plan.thumb), guard=True)
-        self.held = stage.target
-        z0 = float(self._env.obj(stage.target).pose.p[0, 2])
-        yield from m.cartesian(np.array([0.0, 0.0, c.lift_m]), c.lift_m_per_step, guard=True)
-        risen = float(self._env.obj(stage.target).pose.p[0, 2]) - z0
-        if risen < 0.5 * c.lift_m:
-            self.held = None
-            raise ExecutionError(f"grasp of {stage.target!r} failed its lift check (rose {risen:.3f} m of "
-                                 f"{c.lift_m:.3f} m)")
+        yield from self.rigid.grasp(stage.target)
 
     def _lift(self, stage) -> Iterator[np.ndarray]:
-        c = self.config
         heights = [cond.min_height_m for cond in self._env.task_spec.success.conditions
                    if cond.type == "lifted" and cond.object == stage.target]
-        need = max(heights) if heights else c.lift_m
-        risen = float(self._env.obj_height(stage.target)[0])
-        if risen < need + 0.02:
-            yield from self.motion.cartesian(np.array([0.0, 0.0, need + 0.03 - risen]), c.lift_m_per_step, guard=True)
+        yield from self.rigid.lift(stage.target, max(heights) if heights else self.config.rigid.motion.lift_m)
 
     def _carry(self, stage) -> Iterator[np.ndarray]:
-        c, m = self.config, self.motion
-        held, target = self.held, stage.target
-        if held is None:
-            raise ExecutionError(f"stage {stage.name!r} carries to {target!r} but the hand holds nothing")
-        held_lo, held_hi = m.world_aabb(held)
-        if held_lo[2] < self._env.table_height + 0.5 * c.lift_m:
-            # still at the table (a trained grasp policy closes the hand but does not lift, unlike the scripted
-            # grasp): lift straight up first, so the planned carry never drags the object across the table
-            z0 = float(self._env.obj(held).pose.p[0, 2])
-            yield from m.cartesian(np.array([0.0, 0.0, c.lift_m]), c.lift_m_per_step, guard=True)
-            risen = float(self._env.obj(held).pose.p[0, 2]) - z0
-            if risen < 0.5 * c.lift_m:
-                raise ExecutionError(f"{held!r} slipped when lifted for the carry (rose {risen:.3f} m of "
-                                     f"{c.lift_m:.3f} m)")
-            held_lo, held_hi = m.world_aabb(held)
-        t_center = m.object_geometry(target)[0]
-        t_hi = m.world_aabb(target)[1]
-        obj_p = (held_lo + held_hi) / 2
-        goal_center = np.array([t_center[0], t_center[1], t_hi[2] + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
-        q_now = m.target()
-        palm = m.ik.fk(q_now)
-        goal = sapien.Pose(palm.p + (goal_center - obj_p), palm.q)
-        # the held object moves with the palm: plan with it attached, against every other object (the target too)
-        m.avoid_objects(exclude=(held,))
-        m.collision.attach(*self._object_spheres(held_lo, held_hi), q_now)
-        try:
-            q_goal = m.ik.solve(goal, q_now, restarts=20, valid=m.collision.is_free)
-            if q_goal is None:
-                raise ExecutionError(f"no reachable collision-free pose holding {held!r} above {target!r}")
-            yield from m.move_arm(q_goal)
-        finally:
-            m.collision.detach()
+        yield from self.rigid.carry(stage.target)
         self.carried = True
 
-    @staticmethod
-    def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
-        """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii."""
-        size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
-        r = float(min(size[:2]) / 2)
-        n = max(1, int(np.ceil(size[2] / (2 * r))))
-        z = np.linspace(lo[2] + shrink_m + r, hi[2] - shrink_m - r, n) if n > 1 else np.array([(lo[2] + hi[2]) / 2])
-        centre = (lo + hi) / 2
-        pts = np.stack([np.full(n, centre[0]), np.full(n, centre[1]), z], axis=1)
-        return pts, np.full(n, float(np.linalg.norm(size[:2]) / 2))
-
     def _release(self, stage) -> Iterator[np.ndarray]:
-        m = self.motion
-        t = m.with_hand(m.target(), OPEN_HAND | {j: 0.0 for j in ("THJ3", "THJ1", "THJ0")})
-        yield from m.ramp(t, self.config.release_steps)
-        self.held = None
-        yield from m.cartesian(np.array([0.0, 0.0, 0.05]), 0.01)
+        yield from self.rigid.release()
 
 
 __all__ = ["ARTICULATED_PRIMITIVES", "RIGID_PRIMITIVES", "ExecutionError", "ExecutorConfig", "StageExecutor",

@@ -45,7 +45,7 @@ class ArmHandMotion:
         self.hand = np.array([i for i in range(len(names)) if i not in set(self.ik.arm)])
         if ctrl.config.use_delta or set(self.ik.arm) - set(self.free):
             raise ExecutionError("scripted primitives drive absolute arm and hand targets: make the env with "
-                                 "control_mode='pd_joint_pos', control_joint='both'")
+                                 "control_mode='pd_joint_pos', control_joint='both'", cause="unsupported")
         self.steps = 0
         """Actions emitted so far."""
 
@@ -90,6 +90,11 @@ class ArmHandMotion:
 
     def move_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None) -> Iterator[np.ndarray]:
         """Planned arm motion to ``q_goal``'s arm joints, hand targets held (or ``hand``'s)."""
+        yield from self.plan_arm(q_goal, hand)
+
+    def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None) -> Iterator[np.ndarray]:
+        """:meth:`move_arm`, planned now (against the collision model as it is now; ``ExecutionError`` with cause
+        ``no_plan`` if there is no path) and stepped when iterated."""
         start = self.target()
         goal = start.copy()
         goal[self.arm] = q_goal[self.arm]
@@ -98,7 +103,10 @@ class ArmHandMotion:
         try:
             path = self.planner.plan(start, goal)
         except PlanningError as e:
-            raise ExecutionError(str(e)) from e
+            raise ExecutionError(str(e), cause="no_plan") from e
+        return self._follow(path, goal)
+
+    def _follow(self, path: np.ndarray, goal: np.ndarray) -> Iterator[np.ndarray]:
         for q in path:
             q = q.copy()
             q[self.hand] = goal[self.hand]
@@ -114,7 +122,7 @@ class ArmHandMotion:
             goal = sapien.Pose(palm.p + offset * k / n, palm.q)
             nq = self.ik.solve(goal, q, restarts=0)
             if nq is None:
-                raise ExecutionError(f"no IK along the straight palm motion at step {k}/{n}")
+                raise ExecutionError(f"no IK along the straight palm motion at step {k}/{n}", cause="no_ik")
             q = nq
             t = self.target()
             t[self.arm] = q[self.arm]

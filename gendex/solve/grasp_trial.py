@@ -1,0 +1,166 @@
+"""Rank grasp candidates by trying them: a short physics trial in a private copy of the scene.
+
+Kinematics says whether a grasp can be reached; only physics says whether it holds. :class:`GraspTrials` keeps a
+second env of the same task (no observations, no rewards) beside the one being solved. A trial copies the solved
+env's full state into it (every body, joint and controller target), puts the arm at the candidate's pre-grasp pose
+with the hand opened, and runs exactly the actions the executor would: the straight approach, the guarded closing
+ramps, the squeeze, the executor's lift (``GraspMotion.lift_m``) and a hold of :data:`TRIAL_HOLD_STEPS` control
+steps (1 s). The candidate holds when the object rose at least :data:`HELD_FRACTION` of the lift, ends the hold
+still touched by the thumb and a finger, and is not moving. The solved env is never touched, so trials leave its
+history — and the episode being recorded — exactly as they were.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+import torch
+
+from gendex.solve.grasp import GraspPlan
+from gendex.solve.motion import ArmHandMotion
+from gendex_envs.errors import ExecutionError
+from gendex_envs.spec import ConditionSpec
+from gendex_envs.success import conditions_hold
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gendex_envs.task_env import TaskEnv
+
+log = logging.getLogger(__name__)
+
+TRIAL_HOLD_STEPS = 20
+"""1 s at 20 Hz."""
+HELD_FRACTION = 0.8
+"""A trial holds when the object rose at least this fraction of the lift by the end of the hold."""
+STILL_M_PER_S = 0.15
+"""...and moves slower than this at the end of the hold."""
+FORCE_MARGIN = 0.6
+"""Fraction of a required condition's force ceiling a trial must stay under (:func:`with_margin`)."""
+
+
+@dataclass(frozen=True)
+class GraspMotion:
+    """Speeds of a grasp, shared by the executor and its trials (control steps at 20 Hz)."""
+
+    approach_m_per_step: float = 0.01
+    squeeze_steps: int = 6
+    lift_m: float = 0.15
+    """The grasp primitive lifts this far right after closing (and checks that the object came along)."""
+    lift_m_per_step: float = 0.006
+    settle_steps: int = 2
+
+
+def close_hand(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[np.ndarray]:
+    """The guarded closing ramps of ``plan``, then the squeeze (targets held at the closed shape)."""
+    for targets, steps in plan.closing:
+        yield from m.ramp(m.with_hand(m.target(), targets), steps, guard=True)
+    closed = plan.closed_hand
+    for _ in range(speed.squeeze_steps):
+        yield m.emit(m.with_hand(m.target(), closed), guard=True)
+
+
+def approach(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[np.ndarray]:
+    """The straight move from the pre-grasp pose to the grasp pose, then a short settle."""
+    yield from m.cartesian(plan.palm.p - plan.pregrasp.p, speed.approach_m_per_step)
+    yield from m.hold(speed.settle_steps)
+
+
+def with_margin(c: ConditionSpec) -> ConditionSpec:
+    """Condition ``c`` with its force ceiling lowered to :data:`FORCE_MARGIN` of itself: the executed grasp starts
+    from a pose the arm reached by its own motion, not the trial's teleport, and must still meet the ceiling."""
+    if c.max_palm_force_n is None:
+        return c
+    return replace(c, max_palm_force_n=FORCE_MARGIN * c.max_palm_force_n)
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    plan: GraspPlan
+    held: bool
+    rise_m: float
+    """How far the object rose by the end of the hold."""
+    touching: bool
+    """Thumb and at least one finger touch the object at the end."""
+    speed_m_s: float
+    steps: int
+    why: str = ""
+
+    def __str__(self) -> str:
+        verdict = "held" if self.held else f"failed ({self.why})"
+        return f"{self.plan}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps"
+
+
+class GraspTrials:
+    """Physics trials of grasps of objects in ``env``'s scene (see the module docstring)."""
+
+    def __init__(self, env: TaskEnv, speed: GraspMotion | None = None, max_arm_step_rad: float = 0.06):
+        from gendex_envs.task_env import TaskEnv
+
+        self.main = env
+        kwargs = dict(control_mode="pd_joint_pos", control_joint="both", obs_mode="none", reward_mode="none",
+                      sim_backend="physx_cpu", render_mode=None, num_envs=1)
+        if env.task is not None:
+            self.sim = TaskEnv(task=env.task, **kwargs)
+        else:
+            self.sim = TaskEnv(task_spec=env.task_spec, **kwargs)
+        self.sim.reset(seed=0)
+        self.motion = ArmHandMotion(self.sim, max_arm_step_rad, settle_steps=2)
+        self.speed = speed or GraspMotion()
+        self.steps = 0
+        """Simulated control steps of every trial so far (none of them are the episode's)."""
+
+    def close(self) -> None:
+        self.sim.close()
+
+    def trial(self, plan: GraspPlan, q_pre: np.ndarray, name: str, require: tuple[ConditionSpec, ...] = ()
+              ) -> TrialResult:
+        """Try ``plan`` on object ``name`` from the pre-grasp joint vector ``q_pre`` [J] (arm and opened hand);
+        ``require``: conditions (the task's own ``grasped`` ones) that must hold at the end as well."""
+        sim, m, speed = self.sim, self.motion, self.speed
+        sim.set_state(self.main.get_state())
+        q = torch.as_tensor(q_pre[None], dtype=torch.float32)
+        sim.agent.robot.set_qpos(q)
+        sim.agent.robot.set_qvel(torch.zeros_like(q))
+        sim.agent.set_controller_state({"target_qpos": q.clone()})
+        obj = sim.obj(name)
+        z0 = float(obj.pose.p[0, 2])
+        xy0 = obj.pose.p[0, :2].cpu().numpy()
+        steps = 0
+        why = ""
+
+        def run(actions: Iterator[np.ndarray]) -> None:
+            nonlocal steps
+            for a in actions:
+                sim.step(torch.as_tensor(a[None]))
+                steps += 1
+
+        try:
+            run(approach(m, plan, speed))
+            run(close_hand(m, plan, speed))
+            pushed = float(np.linalg.norm(obj.pose.p[0, :2].cpu().numpy() - xy0))
+            run(m.cartesian(np.array([0.0, 0.0, speed.lift_m]), speed.lift_m_per_step, guard=True))
+            run(m.hold(TRIAL_HOLD_STEPS))
+        except ExecutionError as exc:  # an IK failure mid-motion is a failed trial, not a crash
+            why = f"motion failed: {exc}"
+            pushed = 0.0
+        self.steps += steps
+        rise = float(obj.pose.p[0, 2]) - z0
+        forces = sim.hand_forces(name)[0].cpu().numpy()
+        touching = bool(forces[0] > 0.3 and np.any(forces[1:5] > 0.3))
+        speed_now = float(torch.linalg.norm(obj.linear_velocity[0]))
+        meets = bool(conditions_hold(sim, tuple(map(with_margin, require)))[0]) if require else True
+        held = (not why and rise >= HELD_FRACTION * speed.lift_m and touching and speed_now < STILL_M_PER_S
+                and meets)
+        if not held and not why:
+            why = (f"rose {rise:.3f} m" if rise < HELD_FRACTION * speed.lift_m else
+                   "not touched by the thumb and a finger" if not touching else
+                   f"still moving {speed_now:.2f} m/s" if speed_now >= STILL_M_PER_S else
+                   "the grasp stage's own conditions do not hold")
+            if pushed > 0.02:
+                why += f", pushed {pushed:.3f} m while closing"
+        result = TrialResult(plan, held, rise, touching, speed_now, steps, why)
+        log.debug("grasp trial: %s", result)
+        return result

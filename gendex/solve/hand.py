@@ -1,0 +1,195 @@
+"""ShadowHand kinematics in the palm frame: where the fingertips and every hand link are for given finger joints,
+and finger inverse kinematics that puts a fingertip pad on a point.
+
+Grasp synthesis (:mod:`gendex.solve.grasp`) plans in the palm frame (+z along the fingers, the palm's skin facing
+-y, the thumb on +x): it asks where a pad must be, solves the finger's joints with :meth:`HandModel.finger_ik`, and
+checks with :meth:`HandModel.spheres` that the opened hand touches neither the table nor the object before it closes.
+Forward kinematics uses the robot's Pinocchio model (:class:`~gendex.solve.ik.ArmIK`'s); the sphere cover comes from
+the hand links' PhysX collision shapes, so it is the geometry the simulator collides.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial import cKDTree
+
+from gendex.solve.ik import ArmIK
+from gendex_envs.agents.ur10e_shadow import COUPLED_DISTAL, FINGER_JOINTS, TIP_LINKS, WRIST_JOINTS
+from gendex_envs.physx import px_objects
+
+FINGERS = ("th", "ff", "mf", "rf", "lf")
+"""Finger names in the order of every per-finger array (thumb, index, middle, ring, little)."""
+PAD_ALONG_M = 0.016
+"""Where a fingertip pad is: this far along its distal link's axis (the capsule's centre line)."""
+TIP_ALONG_M = 0.024
+"""Where the fingertip's end is: the centre of the distal capsule's end cap (no part of the link lies beyond this
+point by more than the capsule radius, whichever way the finger points)."""
+PAD_RADIUS_M = {"th": 0.0092, "ff": 0.0071, "mf": 0.0071, "rf": 0.0071, "lf": 0.0071}
+"""Radius of the distal capsules: a pad touches a surface when its axis point is this far from it."""
+_FLEX = (("th", "THJ0", -1.0), ("ff", "FFJ1", 1.0), ("mf", "MFJ1", 1.0), ("rf", "RFJ1", 1.0), ("lf", "LFJ1", 1.0))
+"""Each finger's last flexing joint and the sign of its flexion."""
+IK_TOL_M = 0.002
+"""A finger IK answer counts when its pad point is within this of the target."""
+_SAMPLES = 2500
+
+
+def actuated(finger: str) -> tuple[str, ...]:
+    """The joints of ``finger`` an action drives (the coupled distal J0 follows J1)."""
+    return tuple(j for j in FINGER_JOINTS[finger] if j not in COUPLED_DISTAL)
+
+
+@dataclass(frozen=True)
+class SphereCover:
+    """Spheres covering the hand's collision shapes in the palm frame: centres [S, 3], radii [S], and the finger
+    (or ``palm``) each belongs to."""
+
+    centers: np.ndarray
+    radii: np.ndarray
+    owner: np.ndarray
+
+
+class HandModel:
+    """Palm-frame forward and inverse kinematics of the ShadowHand of one robot."""
+
+    def __init__(self, ik: ArmIK, robot):
+        self.ik = ik
+        self.names = list(ik.joint_names)
+        self._index = {n: i for i, n in enumerate(self.names)}
+        self._palm = ik.link_names.index("palm")
+        self._tips = [ik.link_names.index(n) for n in TIP_LINKS]
+        self._shapes = _hand_spheres(robot, ik.link_names)
+        rng = np.random.default_rng(0)
+        self._samples: dict[tuple[str, float], tuple[np.ndarray, cKDTree]] = {}
+        for f in FINGERS:
+            js = actuated(f)
+            lo, hi = self.bounds(js)
+            qs = rng.uniform(lo, hi, size=(_SAMPLES, len(js)))
+            for along in (PAD_ALONG_M, TIP_ALONG_M):
+                pts = np.array([self.pads(dict(zip(js, q, strict=True)), along)[FINGERS.index(f)] for q in qs])
+                self._samples[f, along] = (qs, cKDTree(pts))
+
+    # ------------------------------------------------------------------ forward kinematics
+    def vector(self, hand: dict[str, float]) -> np.ndarray:
+        """Full joint vector (arm and wrist at zero) with ``hand``'s joints set; coupled distal joints follow."""
+        q = np.zeros(len(self.names))
+        for j, v in hand.items():
+            q[self._index[j]] = v
+        for follower, leader in COUPLED_DISTAL.items():
+            if leader in hand and follower not in hand:
+                q[self._index[follower]] = hand[leader]
+        for j in WRIST_JOINTS:
+            q[self._index[j]] = 0.0
+        return q
+
+    def _link_frames(self, hand: dict[str, float]) -> tuple[np.ndarray, list[np.ndarray]]:
+        model = self.ik.model
+        model.compute_forward_kinematics(self.vector(hand))
+        inv = np.linalg.inv(model.get_link_pose(self._palm).to_transformation_matrix())
+        return inv, [inv @ model.get_link_pose(i).to_transformation_matrix() for i in range(len(self.ik.link_names))]
+
+    def pads(self, hand: dict[str, float], along: float = PAD_ALONG_M) -> np.ndarray:
+        """[5, 3] pad points (th, ff, mf, rf, lf) in the palm frame: ``along`` the distal links' axes (the pads, or
+        with :data:`TIP_ALONG_M` the fingertips' ends)."""
+        _, frames = self._link_frames(hand)
+        return np.array([frames[i][:3, :3] @ [0.0, 0.0, along] + frames[i][:3, 3] for i in self._tips])
+
+    def pad_normals(self, hand: dict[str, float], eps: float = 1e-3, along: float = PAD_ALONG_M) -> np.ndarray:
+        """[5, 3] unit directions the pads face (palm frame): where each pad moves when its finger's last joint
+        flexes (the thumb's THJ0 flexes with negative angles)."""
+        base = self.pads(hand, along)
+        out = np.zeros((5, 3))
+        for k, (f, joint, sign) in enumerate(_FLEX):
+            bent = dict(hand)
+            bent[joint] = hand.get(joint, 0.0) + sign * eps
+            if f != "th":
+                bent[joint.replace("J1", "J0")] = bent[joint]
+            d = self.pads(bent, along)[k] - base[k]
+            out[k] = d / max(np.linalg.norm(d), 1e-12)
+        return out
+
+    def spheres(self, hand: dict[str, float]) -> SphereCover:
+        """Sphere cover of the hand at ``hand``'s joints, palm frame."""
+        _, frames = self._link_frames(hand)
+        centers, radii, owner = [], [], []
+        for link, local, r, who in self._shapes:
+            m = frames[link]
+            centers.append(local @ m[:3, :3].T + m[:3, 3])
+            radii.append(r)
+            owner.append(np.full(len(r), who))
+        return SphereCover(np.concatenate(centers), np.concatenate(radii), np.concatenate(owner))
+
+    # ------------------------------------------------------------------ inverse kinematics
+    def bounds(self, joints) -> tuple[np.ndarray, np.ndarray]:
+        lim = self.ik.limits
+        return (np.array([lim[self._index[j], 0] for j in joints]), np.array([lim[self._index[j], 1] for j in joints]))
+
+    def reach_gap(self, finger: str, points: np.ndarray, along: float = PAD_ALONG_M) -> np.ndarray:
+        """[P] distance from each palm-frame point to the nearest sampled pad position of ``finger`` (a cheap test
+        of whether the pad can get there)."""
+        return self._samples[finger, along][1].query(np.atleast_2d(points))[0]
+
+    def finger_ik(self, finger: str, target: np.ndarray, prefer: dict[str, float] | None = None,
+                  along: float = PAD_ALONG_M) -> tuple[dict[str, float], float]:
+        """Joints of ``finger`` (its actuated ones) putting its pad point (``along`` its distal axis) on ``target``
+        (palm frame), and the remaining distance (m). Starts from the nearest sampled configurations; ``prefer``
+        breaks ties."""
+        js = actuated(finger)
+        lo, hi = self.bounds(js)
+        k = FINGERS.index(finger)
+        qs, tree = self._samples[finger, along]
+        _, idx = tree.query(np.asarray(target, float), k=3)
+        starts = [qs[i] for i in np.atleast_1d(idx)]
+        if prefer is not None:
+            starts.insert(0, np.clip([prefer.get(j, 0.0) for j in js], lo, hi))
+        best: tuple[np.ndarray, float] | None = None
+        for x0 in starts:
+            sol = least_squares(lambda x: self.pads(dict(zip(js, x, strict=True)), along)[k] - target,
+                                np.clip(x0, lo + 1e-6, hi - 1e-6), bounds=(lo, hi), xtol=1e-6)
+            err = float(np.linalg.norm(sol.fun))
+            if best is None or err < best[1] - 1e-4:
+                best = (sol.x, err)
+            if err < IK_TOL_M / 4:
+                break
+        return dict(zip(js, (float(v) for v in best[0]), strict=True)), best[1]
+
+
+@functools.cache
+def _unit_grid(n: int) -> np.ndarray:
+    return np.linspace(-1.0, 1.0, n)
+
+
+def _hand_spheres(robot, link_names: list[str]) -> list[tuple[int, np.ndarray, np.ndarray, str]]:
+    """(link index, local centres [k, 3], radii [k], owner) covering every collision shape of the palm and fingers."""
+    from sapien import physx
+
+    owners = {"palm": "palm"}
+    for f in FINGERS:
+        for link in robot.get_links():
+            if link.name.startswith(f) or (f == "th" and link.name == "thbase"):
+                owners[link.name] = f
+    owners["lfmetacarpal"] = "lf"
+    out = []
+    for link in robot.get_links():
+        if link.name not in owners:
+            continue
+        for shape in px_objects(link)[0].collision_shapes:
+            m = shape.local_pose.to_transformation_matrix()
+            if isinstance(shape, physx.PhysxCollisionShapeCapsule):  # along local x
+                r, h = shape.radius, shape.half_length
+                n = max(2, int(np.ceil(2 * h / r)) + 1)
+                local = np.stack([_unit_grid(n) * h, np.zeros(n), np.zeros(n)], axis=1)
+                radii = np.full(n, r)
+            elif isinstance(shape, physx.PhysxCollisionShapeBox):
+                hs = np.asarray(shape.half_size)
+                r = float(hs.min())
+                axes = [_unit_grid(max(1, int(np.ceil(h / r)) + 1)) * max(h - r, 0.0) for h in hs]
+                local = np.array([[x, y, z] for x in axes[0] for y in axes[1] for z in axes[2]])
+                radii = np.full(len(local), 1.2 * r)  # a little fatter: the box edges between the centres
+            else:
+                continue
+            out.append((link_names.index(link.name), local @ m[:3, :3].T + m[:3, 3], radii, owners[link.name]))
+    return out

@@ -1,0 +1,113 @@
+"""Lift-and-hold: can the solver pick up a given catalog object? (The measure behind ``benchmarks/grasp.py``.)
+
+:func:`lift_spec` is a one-object task: the object at a random pose (anywhere in :data:`REGION_XY_M` around
+:data:`CENTER_XY_M`, any yaw), a ``reach`` and a ``grasp`` stage. :func:`lift_and_hold` runs the stage executor on it
+(grasp synthesis, physics-trial ranking, the grasp primitive's 15 cm lift and its regrasp after a slip), then holds
+for :data:`HOLD_STEPS` control steps. It succeeds when the object ends at least :data:`MIN_RISE_M` above where it
+lay, touched by the thumb and at least one finger.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import torch
+
+from gendex.solve.executor import StageExecutor
+from gendex.solve.failure import Failure
+from gendex_envs.errors import ExecutionError
+from gendex_envs.spec import TaskSpec, parse_task_spec
+
+CENTER_XY_M = (0.10, 0.0)
+REGION_XY_M = (0.12, 0.22)
+"""Half-ranges of the object's position around :data:`CENTER_XY_M` (in front of the robot, within its reach)."""
+MIN_RISE_M = 0.10
+HOLD_STEPS = 20
+"""1 s at 20 Hz."""
+
+
+def lift_spec(asset: str, scale: float = 1.0) -> TaskSpec:
+    """The one-object lift task of ``asset`` (see the module docstring)."""
+    stage = {"method": "motion_planning", "target": "obj"}
+    return parse_task_spec({
+        "name": "LiftAndHold", "instruction": f"Pick up the {asset} and hold it.",
+        "objects": [{"name": "obj", "asset": asset, "scale": scale, "pos_m": [*CENTER_XY_M, 0.0],
+                     "randomize": {"xy_m": list(REGION_XY_M), "yaw_deg": 180.0}}],
+        "stages": [{"name": "reach", "instruction": "Bring the open hand to the object.", "skill": "reach",
+                    "control_joint": "arm", **stage},
+                   {"name": "grasp", "instruction": "Close the hand on the object and lift it.", "skill": "grasp",
+                    "control_joint": "hand", **stage}],
+        "success": {"description": "The object is held 10 cm above where it lay.",
+                    "conditions": [{"type": "lifted", "object": "obj", "min_height_m": MIN_RISE_M}]},
+        "max_episode_steps": 400,
+    }, source=f"<lift check of {asset}>")
+
+
+@dataclass(frozen=True)
+class LiftResult:
+    asset: str
+    seed: int
+    held: bool
+    rise_m: float
+    grasp: str
+    """The grasp executed last (family and parameters), or '' when none was."""
+    trials: int
+    """Physics trials the grasp choice ran."""
+    steps: int
+    """Env steps of the episode (trials excluded)."""
+    seconds: float
+    failure: Failure | None = None
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["failure"] = self.failure.to_dict() if self.failure else None
+        return d
+
+
+class LiftChecker:
+    """Runs lift-and-hold attempts of one asset, keeping its env and executor between seeds."""
+
+    def __init__(self, asset: str):
+        from gendex_envs.task_env import TaskEnv
+
+        self.asset = asset
+        self.env = TaskEnv(task_spec=lift_spec(asset), control_mode="pd_joint_pos", control_joint="both",
+                           obs_mode="none", reward_mode="none")
+        self.executor = StageExecutor()
+
+    def close(self) -> None:
+        if hasattr(self.executor, "rigid"):
+            self.executor.rigid.close()
+        self.env.close()
+
+    def __call__(self, seed: int) -> LiftResult:
+        env, ex = self.env, self.executor
+        t0 = time.perf_counter()
+        env.reset(seed=seed)
+        ex.reset(env, None)
+        steps, failure = 0, None
+        try:
+            while not ex.finished:
+                action = ex.act(env, None)
+                if action is None:
+                    break
+                env.step(torch.as_tensor(action[None]))
+                steps += 1
+            hold = ex.motion.target()
+            for _ in range(HOLD_STEPS):
+                env.step(torch.as_tensor(ex.motion.emit(hold)[None]))
+                steps += 1
+        except ExecutionError as exc:
+            failure = Failure.of_error(exc)
+        rise = float(env.obj_height("obj")[0])
+        forces = env.hand_forces("obj")[0].cpu().numpy()
+        touched = bool(forces[0] > 0.3 and np.any(forces[1:5] > 0.3))
+        held = failure is None and rise >= MIN_RISE_M and touched
+        if failure is None and not held:
+            failure = Failure("slipped", "grasp", "grasp", f"rose {rise:.3f} m, thumb/finger contact {touched} after "
+                                                           f"the {HOLD_STEPS}-step hold")
+        plan = ex.grasp_plan
+        return LiftResult(self.asset, seed, held, rise, str(plan) if plan else "", len(ex.rigid.trial_log), steps,
+                          time.perf_counter() - t0, failure)

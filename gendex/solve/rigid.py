@@ -1,0 +1,323 @@
+"""Scripted primitives for rigid targets: approach, grasp, lift, carry, release (and their failure causes).
+
+Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is a rigid object.
+
+- ``approach`` — grasp synthesis on the object's measured pose and collision geometry
+  (:class:`~gendex.solve.grasp.GraspSynthesizer`); each candidate the arm reaches without collision (IK with
+  restarts, pre-grasp and grasp pose) is tried in a private copy of the scene
+  (:class:`~gendex.solve.grasp_trial.GraspTrials`) until one holds; the arm is then planned to its pre-grasp pose.
+  If the object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from
+  where it is now. Then the straight approach.
+- ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m``. If the object did not come
+  up (it slipped), the hand opens, backs off and grasps once more from the object's new pose (``regrasps``).
+- ``lift`` — raise the held object to the task's ``lifted`` height.
+- ``carry`` — planned arm motion, the held object attached to the palm in the collision model, until the held
+  object is over the target; an object that is no longer with the hand at the end has slipped.
+- ``release`` — open the hand and back off.
+
+Every :class:`~gendex_envs.errors.ExecutionError` raised here names its cause (``no_ik``, ``no_plan``,
+``grasp_failed``, ``slipped``, ...).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+import sapien
+
+from gendex.solve.grasp import RELEASE_HAND, GraspPlan, GraspSynthesizer, object_heading
+from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand
+from gendex.solve.hand import HandModel
+from gendex.solve.shape import ObjectShape, PosedShape
+from gendex_envs.errors import ExecutionError
+from gendex_envs.spec import ConditionSpec
+from gendex_envs.success import conditions_hold
+
+if TYPE_CHECKING:  # pragma: no cover
+    from gendex.solve.motion import ArmHandMotion
+
+log = logging.getLogger(__name__)
+
+MOVED_M = 0.005
+"""An object that moved more than this between planning its grasp and reaching the pre-grasp is re-planned."""
+STAGING_M = ((0.06, 0.06), (0.10, 0.0), (0.0, 0.10), (0.04, 0.14))
+"""(back along the approach, up) offsets of the staging poses tried on the way to a pre-grasp pose, metres."""
+EASE_STEPS = 16
+EASE_FRACTION = 0.85
+"""Grip easing (:meth:`RigidPrimitives._ease_grip`): steps at most, and the part of the finger targets' lead over
+the measured angles kept each step."""
+SLIP_M = 0.03
+"""A held object that drifted more than this from its place in the hand during a carry has slipped."""
+
+
+@dataclass
+class RigidConfig:
+    """Speeds, margins and search budgets of the rigid primitives (control steps at 20 Hz)."""
+
+    carry_clearance_m: float = 0.07
+    """Height of the held object's bottom above the target's top while carrying."""
+    release_steps: int = 8
+    max_trials: int = 10
+    """Physics trials per grasp before giving up (0: no trials, the first reachable candidate is used)."""
+    regrasps: int = 1
+    """Further grasps after one whose object slipped out while lifting."""
+    replans: int = 2
+    """Re-syntheses when the object moved before the hand got to it."""
+    motion: GraspMotion = GraspMotion()
+
+
+class RigidPrimitives:
+    """The rigid-object primitives of one env (see the module docstring)."""
+
+    def __init__(self, motion: ArmHandMotion, config: RigidConfig | None = None):
+        self.m = motion
+        self.env = motion.env
+        self.config = config or RigidConfig()
+        self.held: str | None = None
+        """The object the hand holds, if any."""
+        self.plan: GraspPlan | None = None
+        """The grasp being executed."""
+        self.trial_log: list[TrialResult] = []
+        self._shapes: dict[str, ObjectShape] = {}
+        self._hand: HandModel | None = None
+        self._trials: GraspTrials | None = None
+        self._synth: GraspSynthesizer | None = None
+        self._require: tuple[ConditionSpec, ...] = ()
+
+    def reset(self) -> None:
+        self.held = None
+        self.plan = None
+        self.trial_log = []
+
+    def close(self) -> None:
+        if self._trials is not None:
+            self._trials.close()
+            self._trials = None
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def hand(self) -> HandModel:
+        if self._hand is None:
+            self._hand = HandModel(self.m.ik, self.env.agent.robot)
+        return self._hand
+
+    @property
+    def trials(self) -> GraspTrials:
+        if self._trials is None:
+            self._trials = GraspTrials(self.env, self.config.motion, self.m.max_arm_step_rad)
+        return self._trials
+
+    def shape(self, name: str) -> PosedShape:
+        """Object ``name``'s collision geometry at its pose now."""
+        if name not in self._shapes:
+            self._shapes[name] = ObjectShape.of_actor(self.env.obj(name))
+        pose = self.env.obj(name).pose
+        m = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
+        return self._shapes[name].posed(m)
+
+    def _pose_now(self, name: str) -> np.ndarray:
+        pose = self.env.obj(name).pose
+        return np.concatenate([pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()])
+
+    # ------------------------------------------------------------------ approach and grasp
+    def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = ()) -> tuple[GraspPlan, np.ndarray]:
+        """The first reachable grasp of ``name`` that holds in a trial (meeting the ``grasped`` conditions
+        ``require`` as well), and its pre-grasp joint vector."""
+        m, c, env = self.m, self.config, self.env
+        shape = self.shape(name)
+        others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
+        prefer = object_heading(shape.footprint().center, m.ik.base.p[:2])
+        synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others)
+        self._synth = synth
+        m.avoid_objects(exclude=(name,))
+        q0 = m.target()
+        reachable, results = 0, []
+        for plan in synth.candidates():
+            open_q = m.with_hand(q0, plan.open_hand)
+            q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
+            q_at = None if q_pre is None else m.ik.solve(plan.palm, q_pre, restarts=0)
+            lifted = sapien.Pose(plan.palm.p + [0.0, 0.0, c.motion.lift_m], plan.palm.q)
+            if q_at is None or m.ik.solve(lifted, q_at, restarts=0) is None:
+                continue
+            reachable += 1
+            if c.max_trials == 0:
+                return plan, q_pre
+            result = self.trials.trial(plan, q_pre, name, require)
+            results.append(result)
+            self.trial_log.append(result)
+            if result.held:
+                log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
+                return plan, q_pre
+            if len(results) >= c.max_trials:
+                break
+        if not reachable:
+            raise ExecutionError(f"no grasp of {name!r} that the arm reaches without collision (families "
+                                 f"{synth.families()})", cause="no_ik")
+        best = max(results, key=lambda r: r.rise_m)
+        raise ExecutionError(f"none of {len(results)} grasps of {name!r} held in a physics trial; best: {best}",
+                             cause="grasp_failed")
+
+    def approach(self, name: str, require: tuple[ConditionSpec, ...] = ()) -> Iterator[np.ndarray]:
+        m = self.m
+        for attempt in range(self.config.replans + 1):
+            before = self._pose_now(name)
+            plan, q_pre = self.choose_grasp(name, require)
+            self._require = require
+            yield from self._bring_hand(name, plan, q_pre)
+            moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
+            if moved <= MOVED_M or attempt == self.config.replans:
+                break
+            log.info("%r moved %.3f m while the arm came: planning its grasp again", name, moved)
+        self.plan = plan
+        yield from approach(m, plan, self.config.motion)
+
+    def _bring_hand(self, name: str, plan: GraspPlan, q_pre: np.ndarray) -> Iterator[np.ndarray]:
+        """Planned arm motion to the pre-grasp pose that keeps the opened hand off every object, the target
+        included: to a staging pose (:data:`STAGING_M` back along the approach and/or up) planned with the hand's
+        spheres in the collision model, then straight to the pre-grasp pose along a path checked against the
+        objects' geometry. When no staging pose works, the arm alone is planned to the pre-grasp pose."""
+        m, synth = self.m, self._synth
+        hand_q = m.with_hand(m.target(), plan.open_hand)
+        cover = self.hand.spheres(plan.open_hand)
+        up = np.array([0.0, 0.0, 1.0])
+        m.avoid_objects()
+        m.collision.cover_hand(cover.centers, cover.radii)
+        try:
+            for back, rise in STAGING_M:
+                offset = -back * plan.approach + rise * up
+                stage = sapien.Pose(plan.pregrasp.p + offset, plan.pregrasp.q)
+                if synth is not None and not synth.path_clear(plan.open_hand, plan.pregrasp, offset, np.zeros(3)):
+                    continue
+                q_stage = m.ik.solve(stage, q_pre, restarts=0)
+                if q_stage is None or not m.collision.is_free(m.with_hand(q_stage, plan.open_hand)):
+                    continue
+                try:
+                    path = m.plan_arm(q_stage, hand=hand_q)
+                except ExecutionError:
+                    continue
+                m.collision.cover_hand(None)
+                yield from path
+                yield from m.cartesian(-offset, self.config.motion.approach_m_per_step)
+                return
+        finally:
+            m.collision.cover_hand(None)
+            m.avoid_objects(exclude=(name,))
+        log.info("no staged approach to the %s: planning the arm alone", plan)
+        yield from m.move_arm(q_pre, hand=hand_q)
+
+    def grasp(self, name: str) -> Iterator[np.ndarray]:
+        m, c = self.m, self.config
+        if self.plan is None:
+            raise ExecutionError(f"grasping {name!r} needs a stage that approached it first", cause="unsupported")
+        for attempt in range(c.regrasps + 1):
+            z0 = float(self.env.obj(name).pose.p[0, 2])
+            yield from close_hand(m, self.plan, c.motion)
+            self.held = name
+            yield from m.cartesian(np.array([0.0, 0.0, c.motion.lift_m]), c.motion.lift_m_per_step, guard=True)
+            risen = float(self.env.obj(name).pose.p[0, 2]) - z0
+            if risen >= 0.5 * c.motion.lift_m:
+                yield from self._ease_grip()
+                return
+            self.held = None
+            if attempt == c.regrasps:
+                raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting (rose {risen:.3f} m of "
+                                     f"{c.motion.lift_m:.3f} m)", cause="slipped")
+            log.info("%r slipped (rose %.3f m): opening and grasping again", name, risen)
+            yield from self._let_go()
+            yield from self.approach(name, self._require)
+
+    def _ease_grip(self) -> Iterator[np.ndarray]:
+        """When the grasp stage's own conditions fail only by a force ceiling (fingers pulling the object into the
+        palm too hard), ease the finger targets towards the measured angles a step at a time until they hold."""
+        require = tuple(c for c in self._require if c.max_palm_force_n is not None)
+        if not require:
+            return
+        m = self.m
+        for _ in range(EASE_STEPS):
+            if bool(conditions_hold(self.env, require)[0]):
+                return
+            loose = tuple(replace(c, max_palm_force_n=None) for c in require)
+            if not bool(conditions_hold(self.env, loose)[0]):
+                return  # not a matter of force: easing would only loosen a grasp that already fails otherwise
+            t, q = m.target(), m.qpos()
+            t[m.hand] = q[m.hand] + EASE_FRACTION * (t[m.hand] - q[m.hand])
+            yield m.emit(t)
+
+    def _let_go(self) -> Iterator[np.ndarray]:
+        """Open the hand and back off upwards (as far as the arm reaches, up to 8 cm)."""
+        m = self.m
+        yield from m.ramp(m.with_hand(m.target(), RELEASE_HAND), self.config.release_steps)
+        for up in (0.08, 0.04):
+            if m.ik.solve(sapien.Pose(m.ik.fk(m.target()).p + [0.0, 0.0, up], m.ik.fk(m.target()).q), m.target(),
+                          restarts=0) is not None:
+                yield from m.cartesian(np.array([0.0, 0.0, up]), 0.01)
+                return
+
+    # ------------------------------------------------------------------ moving what is held
+    def lift(self, name: str, need_m: float) -> Iterator[np.ndarray]:
+        risen = float(self.env.obj_height(name)[0])
+        if risen < need_m + 0.02:
+            yield from self.m.cartesian(np.array([0.0, 0.0, need_m + 0.03 - risen]),
+                                        self.config.motion.lift_m_per_step, guard=True)
+
+    def carry(self, target: str) -> Iterator[np.ndarray]:
+        c, m = self.config, self.m
+        held = self.held
+        if held is None:
+            raise ExecutionError(f"carrying to {target!r} needs an object in the hand; it holds nothing",
+                                 cause="slipped")
+        held_lo, held_hi = m.world_aabb(held)
+        if held_lo[2] < self.env.table_height + 0.5 * c.motion.lift_m:
+            # still at the table (a trained grasp policy closes the hand but does not lift, unlike the scripted
+            # grasp): lift straight up first, so the planned carry never drags the object across the table
+            z0 = float(self.env.obj(held).pose.p[0, 2])
+            yield from m.cartesian(np.array([0.0, 0.0, c.motion.lift_m]), c.motion.lift_m_per_step, guard=True)
+            risen = float(self.env.obj(held).pose.p[0, 2]) - z0
+            if risen < 0.5 * c.motion.lift_m:
+                raise ExecutionError(f"{held!r} slipped when lifted for the carry (rose {risen:.3f} m of "
+                                     f"{c.motion.lift_m:.3f} m)", cause="slipped")
+            held_lo, held_hi = m.world_aabb(held)
+        t_center = m.object_geometry(target)[0]
+        t_hi = m.world_aabb(target)[1]
+        obj_p = (held_lo + held_hi) / 2
+        goal_center = np.array([t_center[0], t_center[1], t_hi[2] + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
+        q_now = m.target()
+        palm = m.ik.fk(q_now)
+        in_hand = m.ik.fk(m.qpos()).inv() * sapien.Pose(self._pose_now(held)[:3])
+        goal = sapien.Pose(palm.p + (goal_center - obj_p), palm.q)
+        # the held object moves with the palm: plan with it attached, against every other object (the target too)
+        m.avoid_objects(exclude=(held,))
+        m.collision.attach(*_object_spheres(held_lo, held_hi), q_now)
+        try:
+            q_goal = m.ik.solve(goal, q_now, restarts=20, valid=m.collision.is_free)
+            if q_goal is None:
+                raise ExecutionError(f"no reachable collision-free pose holding {held!r} above {target!r}",
+                                     cause="no_ik")
+            yield from m.move_arm(q_goal)
+        finally:
+            m.collision.detach()
+        drift = float(np.linalg.norm((m.ik.fk(m.qpos()) * in_hand).p - self._pose_now(held)[:3]))
+        if drift > SLIP_M:
+            raise ExecutionError(f"{held!r} slipped in the hand while carried to {target!r} (drifted {drift:.3f} m)",
+                                 cause="slipped")
+
+    def release(self) -> Iterator[np.ndarray]:
+        m = self.m
+        yield from m.ramp(m.with_hand(m.target(), RELEASE_HAND), self.config.release_steps)
+        self.held = None
+        yield from m.cartesian(np.array([0.0, 0.0, 0.05]), 0.01)
+
+
+def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii."""
+    size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
+    r = float(min(size[:2]) / 2)
+    n = max(1, int(np.ceil(size[2] / (2 * r))))
+    z = np.linspace(lo[2] + shrink_m + r, hi[2] - shrink_m - r, n) if n > 1 else np.array([(lo[2] + hi[2]) / 2])
+    centre = (lo + hi) / 2
+    pts = np.stack([np.full(n, centre[0]), np.full(n, centre[1]), z], axis=1)
+    return pts, np.full(n, float(np.linalg.norm(size[:2]) / 2))

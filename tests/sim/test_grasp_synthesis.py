@@ -1,0 +1,144 @@
+"""Grasp synthesis over object geometry: shapes, finger kinematics, pinch lines, the kinematic check, physics trials."""
+
+import numpy as np
+import pytest
+import sapien
+
+from gendex.solve.grasp import GraspSynthesizer, object_heading, pinch_shape
+from gendex.solve.grasp_trial import GraspTrials
+from gendex.solve.hand import PAD_RADIUS_M, HandModel
+from gendex.solve.ik import ArmIK
+from gendex.solve.lift_check import LiftChecker, lift_spec
+from gendex.solve.shape import ObjectShape
+from gendex_envs.task_env import TaskEnv
+
+
+class Scene:
+    """One object in a lift scene, with its shape, the hand model and a synthesizer."""
+
+    def __init__(self, asset: str, seed: int = 3):
+        self.env = TaskEnv(task_spec=lift_spec(asset), control_mode="pd_joint_pos", obs_mode="none",
+                           reward_mode="none")
+        self.env.reset(seed=seed)
+        self.ik = ArmIK(self.env.agent)
+        self.hand = HandModel(self.ik, self.env.agent.robot)
+        pose = self.env.obj("obj").pose
+        m = sapien.Pose(pose.p[0].numpy(), pose.q[0].numpy()).to_transformation_matrix()
+        self.shape = ObjectShape.of_actor(self.env.obj("obj")).posed(m)
+        prefer = object_heading(self.shape.footprint().center, self.ik.base.p[:2])
+        self.synth = GraspSynthesizer(self.hand, self.shape, 0.0, prefer)
+
+
+@pytest.fixture(scope="module")
+def bowl():
+    s = Scene("bowl")
+    yield s
+    s.env.close()
+
+
+@pytest.fixture(scope="module")
+def golf():
+    s = Scene("golf_ball")
+    yield s
+    s.env.close()
+
+
+def test_rays_find_both_walls_of_a_bowl_and_one_solid_ball(bowl, golf):
+    fp = bowl.shape.footprint()
+    assert fp.length == pytest.approx(0.15, abs=0.005) and fp.height == pytest.approx(0.063, abs=0.003)
+    origin = np.array([fp.center[0] - 0.2, fp.center[1], fp.bottom + 0.04])
+    spans = bowl.shape.ray_intervals(origin, np.array([1.0, 0.0, 0.0]))
+    assert len(spans) == 2  # the near wall and the far wall, the hollow between them
+    assert all(0.002 < b - a < 0.015 for a, b in spans)
+    gfp = golf.shape.footprint()
+    spans = golf.shape.ray_intervals(np.array([gfp.center[0] - 0.2, gfp.center[1], gfp.bottom + 0.0215]),
+                                     np.array([1.0, 0.0, 0.0]))
+    assert len(spans) == 1 and spans[0][1] - spans[0][0] == pytest.approx(0.043, abs=0.002)
+    # signed distance: inside negative, 5 cm above the top positive
+    assert golf.shape.signed_distance(np.array([[*gfp.center, 0.02]]))[0] < 0
+    assert golf.shape.signed_distance(np.array([[*gfp.center, gfp.top + 0.05]]))[0] == pytest.approx(0.05, abs=0.002)
+
+
+def test_families_follow_the_shape(bowl, golf):
+    assert golf.synth.families() == ["pinch"]  # too small for a power grasp
+    assert bowl.synth.families() == ["pinch"]  # too wide for the hand: a wall pinch at the rim
+    assert any("wall" in line.note for line in bowl.synth.pinch_lines())
+    bottle = Scene("bottle")
+    apple = Scene("apple")
+    try:
+        assert bottle.synth.families()[0] == "side" and apple.synth.families()[0] == "top"
+    finally:
+        bottle.env.close()
+        apple.env.close()
+
+
+def test_pinch_pads_land_on_the_contact_points(golf):
+    line = golf.synth.pinch_lines()[0]
+    plan = next(p for p in golf.synth.candidates() if p.kind == "pinch")
+    axis_palm = tuple(float(v) for v in plan.note.split("palm axis (")[1].split(")")[0].split(", "))
+    shape = pinch_shape(golf.hand, axis_palm, line.width)
+    m = plan.palm.to_transformation_matrix()
+    pads = golf.hand.pads(shape.contact) @ m[:3, :3].T + m[:3, 3]
+    a = line.axis
+    # the pinch was solved for the width rounded up to 5 mm: each pad within 2.5 mm (+ IK tolerance) of its contact
+    assert np.linalg.norm(pads[0] - (line.thumb - PAD_RADIUS_M["th"] * a)) < 0.005
+    assert np.linalg.norm(pads[1] - (line.finger + PAD_RADIUS_M["ff"] * a)) < 0.005
+    normals = golf.hand.pad_normals(shape.contact) @ m[:3, :3].T
+    assert normals[0] @ a > 0.3 and normals[1] @ -a > 0.3  # the pads face each other across the ball
+
+
+def test_kinematic_check_rejects_a_hand_in_the_table_or_the_object(golf):
+    plan = next(golf.synth.candidates())
+    assert golf.synth.hand_clear(plan)
+    import dataclasses
+
+    low = dataclasses.replace(plan, palm=sapien.Pose(plan.palm.p - [0.0, 0.0, 0.03], plan.palm.q))
+    assert not golf.synth.hand_clear(low)  # pads pushed 3 cm into the table
+    inside = dataclasses.replace(plan, open_hand=plan.closed_hand, approach_m=0.0)
+    assert not golf.synth.hand_clear(inside)  # the closing target lies inside the ball
+
+
+def test_physics_trial_holds_a_good_grasp_and_rejects_a_bad_one(golf):
+    trials = GraspTrials(golf.env)
+    try:
+        m_state = golf.env.get_state().clone()
+        q0 = golf.env.agent.controller.target_qpos[0].numpy().astype(np.float64)
+        from gendex.solve.motion import ArmHandMotion
+
+        motion = ArmHandMotion(golf.env)
+        held = None
+        for plan in golf.synth.candidates():
+            q_pre = motion.ik.solve(plan.pregrasp, motion.with_hand(q0, plan.open_hand), restarts=20,
+                                    valid=motion.collision.is_free)
+            if q_pre is None:
+                continue
+            held = trials.trial(plan, q_pre, "obj")
+            if held.held:
+                break
+        assert held is not None and held.held and held.rise_m > 0.12
+        # the same grasp 6 cm too high closes on air
+        import dataclasses
+
+        high = dataclasses.replace(held.plan, palm=sapien.Pose(held.plan.palm.p + [0.0, 0.0, 0.06], held.plan.palm.q))
+        q_high = motion.ik.solve(high.pregrasp, q_pre, restarts=20)
+        bad = trials.trial(high, q_high, "obj")
+        assert not bad.held and bad.rise_m < 0.02 and "rose" in bad.why
+        # trials never touch the env being solved
+        assert torch_equal(golf.env.get_state(), m_state)
+    finally:
+        trials.close()
+
+
+def torch_equal(a, b) -> bool:
+    return bool((a == b).all())
+
+
+@pytest.mark.parametrize("asset", ["dice", "bowl", "spatula"])
+def test_lift_and_hold_beyond_the_two_objects_the_old_grasp_knew(asset):
+    checker = LiftChecker(asset)
+    try:
+        result = checker(1004)
+    finally:
+        checker.close()
+    assert result.held, result.failure
+    assert result.rise_m >= 0.10 and result.trials >= 1 and result.grasp.startswith("pinch")
