@@ -10,6 +10,7 @@ reach       ``approach``         ``approach_handle``
 grasp       ``grasp``            ``hook``
 lift        ``lift``
 carry       ``carry``
+place       ``place``
 release     ``release``
 open                             ``pull`` (hooks first when no stage did)
 ==========  ===================  =============================================================================
@@ -47,7 +48,8 @@ from gendex_envs.task_version import Artifacts, PolicyFiles
 
 log = logging.getLogger(__name__)
 
-RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "release": "release"}
+RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
+                    "release": "release"}
 """Skill -> primitive for a rigid target."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull"}
 """Skill -> primitive for an articulated target."""
@@ -240,6 +242,9 @@ class StageExecutor:
     def _carry(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.carry(stage.target)
         self.carried = True
+
+    def _place(self, stage) -> Iterator[np.ndarray]:
+        yield from self.rigid.place(stage.target)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.release()

@@ -92,10 +92,12 @@ class ArmHandMotion:
         """Planned arm motion to ``q_goal``'s arm joints, hand targets held (or ``hand``'s)."""
         yield from self.plan_arm(q_goal, hand)
 
-    def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None) -> Iterator[np.ndarray]:
+    def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, start: np.ndarray | None = None
+                 ) -> Iterator[np.ndarray]:
         """:meth:`move_arm`, planned now (against the collision model as it is now; ``ExecutionError`` with cause
-        ``no_plan`` if there is no path) and stepped when iterated."""
-        start = self.target()
+        ``no_plan`` if there is no path) and stepped when iterated; from ``start`` (default: the current targets)
+        when other motions will have brought the arm there first."""
+        start = self.target() if start is None else start
         goal = start.copy()
         goal[self.arm] = q_goal[self.arm]
         if hand is not None:

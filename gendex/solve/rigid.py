@@ -44,12 +44,24 @@ log = logging.getLogger(__name__)
 
 MOVED_M = 0.005
 """An object that moved more than this between planning its grasp and reaching the pre-grasp is re-planned."""
-STAGING_M = ((0.06, 0.06), (0.10, 0.0), (0.0, 0.10), (0.04, 0.14))
-"""(back along the approach, up) offsets of the staging poses tried on the way to a pre-grasp pose, metres."""
+STAGING_M = tuple(sorted(((b, u, a) for b in (0.0, 0.06, 0.12) for u in (0.0, 0.08, 0.16, 0.24) for a in (0.0, 0.08)
+                          if b + u + a > 0), key=lambda o: (sum(x * x for x in o), o)))
+"""(back along the approach, up, away from the object) offsets of the staging poses tried on the way to a pre-grasp
+pose, metres, nearest first."""
 EASE_STEPS = 16
 EASE_FRACTION = 0.85
 """Grip easing (:meth:`RigidPrimitives._ease_grip`): steps at most, and the part of the finger targets' lead over
 the measured angles kept each step."""
+ESCAPE_M = 0.15
+"""Highest rise of the opened hand out of the collision model's margins before a staged approach is planned."""
+PLACE_CORRECTIONS = 3
+PLACE_TOLERANCE_M = 0.005
+"""Before a place lowers the object, it is moved over the target's centre (at most this many corrections, until
+within the tolerance)."""
+PLACE_GAP_M = 0.005
+"""A placed object is let down to this far above the surface under it (contact does the rest)."""
+PLACE_RESTING_M = 0.008
+"""The descent of a place stops once the palm has gone this much further down than the held object."""
 SLIP_M = 0.03
 """A held object that drifted more than this from its place in the hand during a carry has slipped."""
 
@@ -184,22 +196,31 @@ class RigidPrimitives:
         hand_q = m.with_hand(m.target(), plan.open_hand)
         cover = self.hand.spheres(plan.open_hand)
         up = np.array([0.0, 0.0, 1.0])
+        away = np.zeros(3)
+        away[:2] = plan.pregrasp.p[:2] - self.shape(name).footprint().center
+        away /= max(float(np.linalg.norm(away)), 1e-9)
         m.avoid_objects()
         m.collision.cover_hand(cover.centers, cover.radii)
         try:
-            for back, rise in STAGING_M:
-                offset = -back * plan.approach + rise * up
+            lift, start = self._clear_start(hand_q)
+            for back, rise, out in STAGING_M:
+                offset = -back * plan.approach + rise * up + out * away
                 stage = sapien.Pose(plan.pregrasp.p + offset, plan.pregrasp.q)
                 if synth is not None and not synth.path_clear(plan.open_hand, plan.pregrasp, offset, np.zeros(3)):
+                    log.debug("staging %s: the straight move to the pre-grasp pose touches something", offset)
                     continue
-                q_stage = m.ik.solve(stage, q_pre, restarts=0)
+                q_stage = m.ik.solve(stage, q_pre, restarts=4)
                 if q_stage is None or not m.collision.is_free(m.with_hand(q_stage, plan.open_hand)):
+                    log.debug("staging %s: %s", offset, "no IK" if q_stage is None else "in collision")
                     continue
                 try:
-                    path = m.plan_arm(q_stage, hand=hand_q)
-                except ExecutionError:
+                    path = m.plan_arm(q_stage, hand=hand_q, start=start)
+                except ExecutionError as exc:
+                    log.debug("staging %s: %s", offset, exc)
                     continue
                 m.collision.cover_hand(None)
+                if lift > 0:
+                    yield from m.cartesian(np.array([0.0, 0.0, lift]), self.config.motion.approach_m_per_step)
                 yield from path
                 yield from m.cartesian(-offset, self.config.motion.approach_m_per_step)
                 return
@@ -208,6 +229,21 @@ class RigidPrimitives:
             m.avoid_objects(exclude=(name,))
         log.info("no staged approach to the %s: planning the arm alone", plan)
         yield from m.move_arm(q_pre, hand=hand_q)
+
+    def _clear_start(self, hand_q: np.ndarray) -> tuple[float, np.ndarray]:
+        """How far the palm must rise (0 to :data:`ESCAPE_M`, in 3 cm steps) before the opened hand (targets
+        ``hand_q``) is clear of the collision model, and the joint vector there: the planner must start from a free
+        configuration, or it would plan a hand that hovers over an object in its rest pose straight through it."""
+        m = self.m
+        q = hand_q.copy()
+        palm = m.ik.fk(q)
+        for up in np.arange(0.0, ESCAPE_M + 1e-9, 0.03):
+            goal = q if up == 0 else m.ik.solve(sapien.Pose(palm.p + [0.0, 0.0, up], palm.q), q, restarts=0)
+            if goal is None:
+                break
+            if m.collision.is_free(goal):
+                return float(up), goal
+        return 0.0, q
 
     def grasp(self, name: str) -> Iterator[np.ndarray]:
         m, c = self.m, self.config
@@ -304,6 +340,41 @@ class RigidPrimitives:
         if drift > SLIP_M:
             raise ExecutionError(f"{held!r} slipped in the hand while carried to {target!r} (drifted {drift:.3f} m)",
                                  cause="slipped")
+
+    def place(self, target: str) -> Iterator[np.ndarray]:
+        """Lower the held object onto ``target`` (a surface, another object, a container's floor) until it rests
+        there: the palm descends (grip guarded) to where the object's bottom meets the target's top under it; the
+        descent stops early once the object stops following the palm (it is supported)."""
+        c, m = self.config, self.m
+        held = self.held
+        if held is None:
+            raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing",
+                                 cause="slipped")
+        goal_xy = self.shape(target).footprint().center
+        for _ in range(PLACE_CORRECTIONS):  # the carry ends within a few cm: centre the object over the target
+            lo, hi = m.world_aabb(held)
+            error = goal_xy - (lo[:2] + hi[:2]) / 2
+            if float(np.linalg.norm(error)) < PLACE_TOLERANCE_M:
+                break
+            yield from m.cartesian(np.array([error[0], error[1], 0.0]), c.motion.lift_m_per_step, guard=True)
+            yield from m.hold(c.motion.settle_steps)
+        lo, hi = m.world_aabb(held)
+        xy = (lo[:2] + hi[:2]) / 2
+        surface = self.shape(target).top_at(xy)
+        if surface is None:
+            raise ExecutionError(f"the held {held!r} is not over {target!r} (nothing of it under {xy.round(3)})",
+                                 cause="target_not_reached")
+        drop = float(lo[2] - surface - PLACE_GAP_M)
+        if drop <= 0:
+            return
+        n = max(1, int(np.ceil(drop / c.motion.lift_m_per_step)))
+        palm0, z0 = m.ik.fk(m.qpos()).p[2], float(self.env.obj(held).pose.p[0, 2])
+        for k, action in enumerate(m.cartesian(np.array([0.0, 0.0, -drop]), c.motion.lift_m_per_step, guard=True)):
+            yield action
+            lag = (palm0 - m.ik.fk(m.qpos()).p[2]) - (z0 - float(self.env.obj(held).pose.p[0, 2]))
+            if k < n - 1 and lag > PLACE_RESTING_M:
+                break  # the object stopped while the palm went on: it rests on something
+        yield from m.hold(self.config.motion.settle_steps)
 
     def release(self) -> Iterator[np.ndarray]:
         m = self.m
