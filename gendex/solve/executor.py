@@ -12,6 +12,7 @@ lift        ``lift``
 carry       ``carry``
 place       ``place``
 release     ``release``
+push        ``push``
 open                             ``pull`` (hooks first when no stage did)
 ==========  ===================  =============================================================================
 
@@ -44,12 +45,13 @@ from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.rigid import RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
+from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.task_version import Artifacts, PolicyFiles
 
 log = logging.getLogger(__name__)
 
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
-                    "release": "release"}
+                    "release": "release", "push": "push"}
 """Skill -> primitive for a rigid target."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull"}
 """Skill -> primitive for an articulated target."""
@@ -245,6 +247,18 @@ class StageExecutor:
 
     def _place(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.place(stage.target)
+
+    def _push(self, stage) -> Iterator[np.ndarray]:
+        """Push the target to where a ``near`` condition on it (the stage's, else the task's) wants it."""
+        env = self._env
+        conds = [c for c in (*(stage.success or ()), *env.task_spec.success.conditions)
+                 if c.type == "near" and c.object == stage.target and not c.negate]
+        if not conds:
+            raise ExecutionError(f"stage {stage.name!r} pushes {stage.target!r} but no near condition says where to",
+                                 cause="unsupported")
+        c = conds[0]
+        goal = env.goal_pos if c.target == GOAL_TARGET else env.obj_pose(c.target).p
+        yield from self.rigid.push(stage.target, goal[0, :2].cpu().numpy().astype(np.float64), c.max_dist_m)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.release()

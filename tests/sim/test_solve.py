@@ -152,8 +152,8 @@ def test_stage_executor_solves_put_apple_bowl(apple_env):
 
 @pytest.mark.parametrize(("edit", "message"), [
     ({"target": None}, "no target object"),
-    ({"skill": "push"}, r"no primitive for skill 'push' on a rigid target \('apple'\); skills it runs there: "
-                        r"\['carry', 'grasp', 'lift', 'place', 'reach', 'release'\]"),
+    ({"skill": "turn"}, r"no primitive for skill 'turn' on a rigid target \('apple'\); skills it runs there: "
+                        r"\['carry', 'grasp', 'lift', 'place', 'push', 'reach', 'release'\]"),
 ])
 def test_stage_executor_refuses_a_stage_it_cannot_script(task_version, edit, message):
     """A stage without a target, or whose skill has no primitive for its target, ends the attempt with the named

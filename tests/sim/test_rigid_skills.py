@@ -1,5 +1,8 @@
-"""The ``place`` skill: a held object is centred over its destination and let down until it rests there."""
+"""Rigid skills beyond pick-and-carry: ``place`` (a held object is centred over its destination and let down until it
+rests there) and ``push`` (an object slid across the table with the flat hand, closed loop on its measured pose)."""
 
+import gymnasium as gym
+import numpy as np
 import torch
 
 from gendex.solve.executor import StageExecutor
@@ -44,6 +47,32 @@ def test_place_sets_a_block_down_on_a_plate_from_wide_random_layouts():
             # let down, not dropped: when the hand opened, the block was already within 2 cm of the plate's top
             assert lowest and lowest[0] < 0.045, (seed, lowest[:3])
             assert float(env.obj("block").linear_velocity[0].norm()) < 0.05
+    finally:
+        executor.rigid.close()
+        env.close()
+
+
+def test_push_slides_the_block_onto_the_goal_without_grasping_it(task_version):
+    version = task_version("PushBlockToGoal")
+    env = gym.make(version.env_id, control_mode="pd_joint_pos", control_joint="both")
+    u = env.unwrapped
+    executor = StageExecutor()
+    try:
+        for seed in (901, 902):
+            obs, _ = env.reset(seed=seed)
+            start = u.obj("block").pose.p[0, :2].numpy().copy()
+            executor.reset(env, obs)
+            lifted, info = 0.0, {}
+            while (action := executor.act(env, obs)) is not None:
+                obs, _, terminated, truncated, info = env.step(action)
+                lifted = max(lifted, float(u.obj("block").pose.p[0, 2]))
+                if terminated or truncated:
+                    break
+            end = u.obj("block").pose.p[0, :2].numpy()
+            goal = u.goal_pos[0, :2].numpy()
+            assert bool(info["success"]), (seed, start, end, goal)
+            assert np.linalg.norm(end - start) > 0.15  # it travelled the table...
+            assert lifted < 0.005  # ...on the table, never picked up
     finally:
         executor.rigid.close()
         env.close()
