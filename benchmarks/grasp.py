@@ -72,6 +72,9 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", type=Path, help="write the rows here")
     ap.add_argument("--markdown", type=Path, help="write a markdown table here")
+    ap.add_argument("--record", action="store_true",
+                    help="store the rates in gendex/solve/grasp_measured.json (the offline author only proposes "
+                         "objects measured at >= 90 %%)")
     args = ap.parse_args()
     logging.basicConfig(level=logging.ERROR)
     objects = args.objects or graspable()
@@ -101,6 +104,10 @@ def main() -> None:
         args.json.write_text(json.dumps({"seeds": seeds, "rows": rows}, indent=1) + "\n")
     if args.markdown:
         args.markdown.write_text(markdown(rows))
+    if args.record:
+        from gendex.solve.lift_check import write_record
+
+        write_record(rows, seeds)
 
 
 class _Serial:

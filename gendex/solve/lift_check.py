@@ -9,8 +9,10 @@ lay, touched by the thumb and at least one finger.
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -23,6 +25,8 @@ from gendex_envs.spec import TaskSpec, parse_task_spec
 CENTER_XY_M = (0.10, 0.0)
 REGION_XY_M = (0.12, 0.22)
 """Half-ranges of the object's position around :data:`CENTER_XY_M` (in front of the robot, within its reach)."""
+MEASURED_FILE = Path(__file__).with_name("grasp_measured.json")
+"""The lift-and-hold rates last measured by ``benchmarks/grasp.py --record`` (per asset: held, attempts, seeds)."""
 MIN_RISE_M = 0.10
 HOLD_STEPS = 20
 """1 s at 20 Hz."""
@@ -111,3 +115,24 @@ class LiftChecker:
         plan = ex.grasp_plan
         return LiftResult(self.asset, seed, held, rise, str(plan) if plan else "", len(ex.rigid.trial_log), steps,
                           time.perf_counter() - t0, failure)
+
+
+def measured_rates(path: Path = MEASURED_FILE) -> dict[str, float]:
+    """Asset id -> lift-and-hold success rate of the last recorded ``benchmarks/grasp.py`` run (empty if none)."""
+    if not path.is_file():
+        return {}
+    rows = json.loads(path.read_text())["assets"]
+    return {a: r["held"] / r["attempts"] for a, r in rows.items() if r["attempts"]}
+
+
+def measured_graspable(min_rate: float = 0.9, path: Path = MEASURED_FILE) -> frozenset[str]:
+    """Assets the solver picked up and held in at least ``min_rate`` of the recorded attempts."""
+    return frozenset(a for a, rate in measured_rates(path).items() if rate >= min_rate)
+
+
+def write_record(rows: list[dict], seeds: list[int], path: Path = MEASURED_FILE) -> None:
+    """Record a ``benchmarks/grasp.py`` run (what :func:`measured_graspable` reads)."""
+    record = {"what": "lift-and-hold per graspable catalog asset (gendex.solve.lift_check), benchmarks/grasp.py",
+              "seeds": seeds,
+              "assets": {r["asset"]: {"held": r["held"], "attempts": r["attempts"]} for r in rows}}
+    path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")

@@ -42,7 +42,7 @@ def test_guided_proposal_substitutes_the_closest_catalog_object():
 def test_composed_reward_modules_pass_the_static_validator_for_every_skill():
     b = OfflineBackend(seed=0)
     kinds = set()
-    for i, p in enumerate(_proposals(0, 12)):
+    for i, p in enumerate(_proposals(0, 30)):
         ids = {o.asset for o in p.objects}
         context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
                    "candidate_index": 0, "index": i, "attempt": 0}
@@ -55,3 +55,30 @@ def test_composed_reward_modules_pass_the_static_validator_for_every_skill():
                 kinds.add(st["skill"])
                 check_reward_source(compose_stage_module(spec, st["name"], roles), filename=st["name"])
     assert {"grasp", "lift", "release", "open"} <= kinds
+
+
+def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_path):
+    from gendex.solve.lift_check import measured_graspable, measured_rates, write_record
+
+    held = measured_graspable()
+    assert {"fork", "knife", "tuna_can"}.isdisjoint(held)  # 0/20 in the committed record
+    rows = [{"asset": "apple", "held": 19, "attempts": 20}, {"asset": "fork", "held": 3, "attempts": 20}]
+    write_record(rows, [1, 2], tmp_path / "rec.json")
+    assert measured_rates(tmp_path / "rec.json") == {"apple": 0.95, "fork": 0.15}
+    assert measured_graspable(0.9, tmp_path / "rec.json") == {"apple"}
+    for p in _proposals(7, 30):
+        for o in p.objects:
+            if o.role == "graspable":
+                assert o.asset in held, (p.name, o.asset)
+            assert o.asset not in {"fork", "knife", "wrench", "scissors"}
+    # the scene step randomizes every object as the solver issue asks
+    b = OfflineBackend(seed=7)
+    p = _proposals(7, 1)[0]
+    ids = {o.asset for o in p.objects}
+    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+               "candidate_index": 0, "index": 0, "attempt": 0}
+    spec = spec_to_dict(adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="",
+                                                                          context=context)).text, p), p))
+    for obj in spec["objects"]:
+        r = obj["randomize"]
+        assert min(r["xy_m"]) >= (0.05 if obj.get("fixed") else 0.08) and r["yaw_deg"] >= 15.0, obj
