@@ -58,7 +58,9 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     src = _HEADER.format(title=title)
     if kind in ("open", "push", "close"):
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
-        sign = "-" if kind == "close" else ""
+        # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
+        progress = ('(1.0 - info["open_fraction"]) / (1.0 - OPEN_FRACTION)' if kind == "close"
+                    else 'info["open_fraction"] / OPEN_FRACTION')
         src += f'''REWARD_MAX = 4.0
 OPEN_FRACTION = {frac}
 
@@ -70,7 +72,7 @@ def evaluate(env):
 def compute_dense_reward(env, obs, action, info):
     handle = env.handle_pos({obj!r})
     reach = rt.reach(torch.linalg.norm(env.palm_pose.p - handle, dim=-1))
-    progress = rt.fraction({sign}info["open_fraction"] / OPEN_FRACTION)
+    progress = rt.fraction({progress})
     reward = reach + 2.0 * progress
     return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
 

@@ -66,6 +66,8 @@ TILTS_RAD = (0.0, 0.25, 0.5)
 the robot)."""
 WRIST_POSTURES = ({"WRJ0": -0.5}, {"WRJ0": 0.0})
 """Hand wrist postures tried with each tilt (``WRJ0`` < 0 bends the back of the hand towards the forearm)."""
+CLOSE_FRACTION = 0.4
+"""A close aims at this part of the largest open fraction the task allows."""
 ARC_CHECK_RAD = 0.05
 """Door-angle spacing of the reachability check along the arc."""
 MAX_ARC_JUMP_RAD = 0.35
@@ -95,10 +97,10 @@ def _pose(m: np.ndarray) -> sapien.Pose:
 
 @dataclass(frozen=True)
 class JointFrame:
-    """Snapshot of one revolute joint (one env): where its child link is at any joint position.
+    """Snapshot of one revolute or prismatic joint (one env): where its child link is at any joint position.
 
-    Positive joint motion turns the child right-handed about ``axis`` through ``point`` (PhysX: the x axis of the
-    joint frame).
+    Positive joint motion turns the child right-handed about ``axis`` through ``point``, or slides it along ``axis``
+    (PhysX: the x axis of the joint frame).
     """
 
     point: np.ndarray
@@ -109,10 +111,15 @@ class JointFrame:
     """Joint position when read."""
     link: np.ndarray
     """[4, 4] child link pose (world) when read."""
+    prismatic: bool = False
+    """A slide (a drawer): joint positions are metres along ``axis``."""
 
     def link_at(self, q: float) -> np.ndarray:
         """[4, 4] world pose of the child link at joint position ``q``."""
         m = np.eye(4)
+        if self.prismatic:
+            m[:3, 3] = (q - self.q) * self.axis
+            return m @ self.link
         m[:3, :3] = _rotation(self.axis, q - self.q)
         m[:3, 3] = self.point - m[:3, :3] @ self.point
         return m @ self.link
@@ -128,14 +135,14 @@ def read_joint(env: TaskEnv, name: str, env_idx: int = 0) -> JointFrame:
     art = env.articulations[name]
     joint = art.get_active_joints()[env.joint_index(name)]
     px = px_objects(joint)[env_idx]  # PhysX's own joint pose
-    if px.type not in ("revolute", "revolute_unwrapped"):
-        raise ExecutionError(f"{name!r}: joint {joint.name!r} is {px.type}; the articulated primitives open "
-                             f"revolute joints (doors, lids) only", cause="unsupported")
+    if px.type not in ("revolute", "revolute_unwrapped", "prismatic"):
+        raise ExecutionError(f"{name!r}: joint {joint.name!r} is {px.type}; the articulated primitives move "
+                             f"revolute (doors, lids) and prismatic (drawers) joints only", cause="unsupported")
     frame = _matrix(px.get_global_pose())
     pose = env.handle_link(name).pose
     link = _matrix(sapien.Pose(pose.p[env_idx].cpu().numpy(), pose.q[env_idx].cpu().numpy()))
     return JointFrame(point=frame[:3, 3].copy(), axis=frame[:3, 0] / np.linalg.norm(frame[:3, 0]),
-                      q=float(env.joint_qpos(name)[env_idx]), link=link)
+                      q=float(env.joint_qpos(name)[env_idx]), link=link, prismatic=px.type == "prismatic")
 
 
 def handle_local(env: TaskEnv, name: str) -> np.ndarray:
@@ -176,11 +183,17 @@ def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
     every wrist posture of :data:`WRIST_POSTURES`."""
     link = joint.link
     rot_t = link[:3, :3].T
-    axis = rot_t @ joint.axis
-    hinge = rot_t @ (joint.point - link[:3, 3])
     n = DOOR_FRONT_LOCAL
-    radial = handle - hinge
-    radial -= np.dot(radial, axis) * axis  # from the hinge axis to the bar, perpendicular to it
+    if joint.prismatic:  # a drawer: a horizontal bar across its front; fingers down over it first, then up
+        up = rot_t @ np.array([0.0, 0.0, 1.0])
+        axis = np.cross(up, n)
+        axis /= np.linalg.norm(axis)
+        radial = up  # "towards the hinge" below means fingers down
+    else:
+        axis = rot_t @ joint.axis
+        hinge = rot_t @ (joint.point - link[:3, 3])
+        radial = handle - hinge
+        radial -= np.dot(radial, axis) * axis  # from the hinge axis to the bar, perpendicular to it
     out = []
     for to_hinge in (True, False):
         f = -radial if to_hinge else radial
@@ -203,12 +216,26 @@ def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
 def opening_goal(env: TaskEnv, name: str) -> float:
     """Joint position the pull aims for: the success condition's open fraction plus :data:`GOAL_MARGIN`."""
     fractions = [c.min_fraction for c in env.task_spec.success.conditions
-                 if c.type == "joint_open" and c.object == name and c.min_fraction is not None]
+                 if c.type == "joint_open" and c.object == name and c.min_fraction is not None and not c.negate]
     frac = max(fractions) if fractions else 1.0
+    return _clip_joint(env, name, frac + GOAL_MARGIN)
+
+
+def closing_goal(env: TaskEnv, name: str) -> float:
+    """Joint position a close aims for: :data:`CLOSE_FRACTION` of the open fraction a negated ``joint_open``
+    condition still allows (short of the closed end, where the hand would hit the body)."""
+    fractions = [c.min_fraction for c in env.task_spec.success.conditions
+                 if c.type == "joint_open" and c.object == name and c.min_fraction is not None and c.negate]
+    frac = min(fractions) if fractions else 0.1
+    return _clip_joint(env, name, CLOSE_FRACTION * frac)
+
+
+def _clip_joint(env: TaskEnv, name: str, fraction: float) -> float:
+    """The joint position at ``fraction`` of the way from closed to open, kept off the limits."""
     closed, opened = env.closed_qpos(name), env.open_qpos(name)
-    goal = closed + (frac + GOAL_MARGIN) * (opened - closed)
     lo, hi = env.articulations[name].get_qlimits()[0, env.joint_index(name)].tolist()
-    return float(np.clip(goal, lo + 0.02, hi - 0.02))
+    margin = 0.02 if env.joint_record(name).type == "revolute" else 0.004
+    return float(np.clip(closed + fraction * (opened - closed), lo + margin, hi - margin))
 
 
 # ------------------------------------------------------------------------------------------------------ primitives
@@ -220,10 +247,14 @@ class HandleConfig:
     """Door angle the palm target advances per control step (0.8 rad/s: the door never outruns the hand)."""
     lead_rad: float = 0.1
     """The palm target runs at most this far ahead of the measured door angle."""
-    max_steps: int = 90
+    max_steps: int = 160
     stall_steps: int = 12
     """The door moving less than ``stall_rad`` over this many steps ends the pull (hook slipped)."""
     stall_rad: float = 0.01
+    rate_m: float = 0.008
+    lead_m: float = 0.03
+    stall_m: float = 0.005
+    """The same for a slide (a drawer), in metres."""
     close_steps: int = 10
     squeeze_steps: int = 4
     insert_m_per_step: float = 0.012
@@ -240,11 +271,17 @@ class HandlePrimitives:
         self.target: str | None = None
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
-        """The actions of primitive ``prim`` (``approach_handle``, ``hook`` or ``pull``) for ``stage``."""
-        if prim not in ("approach_handle", "hook", "pull"):
-            raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull",
+        """The actions of primitive ``prim`` (``approach_handle``, ``hook``, ``pull`` or ``shut``) for ``stage``."""
+        if prim not in ("approach_handle", "hook", "pull", "shut"):
+            raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull, shut",
                                  cause="unsupported")
         return getattr(self, prim)(stage)
+
+    def _goal(self, name: str) -> float:
+        """Where this task moves ``name``'s joint: towards closed if a stage closes it, else open."""
+        u = self.motion.env
+        closes = any(s.skill == "close" and s.target == name for s in u.task_spec.stages)
+        return closing_goal(u, name) if closes else opening_goal(u, name)
 
     def mark_hooked(self, target: str) -> None:
         """Record that the fingers hold ``target``'s handle (a trained grasp policy hooked it)."""
@@ -278,7 +315,7 @@ class HandlePrimitives:
 
     def _arc(self, grasp: HookGrasp, joint: JointFrame, goal: float) -> list[sapien.Pose]:
         """Palm poses along the door's arc from its angle now to ``goal``, :data:`ARC_CHECK_RAD` apart."""
-        n = max(1, int(np.ceil((goal - joint.q) / ARC_CHECK_RAD)))
+        n = max(1, int(np.ceil(abs(goal - joint.q) / ARC_CHECK_RAD)))
         return [grasp.palm_at(joint, joint.q + (goal - joint.q) * k / n) for k in range(1, n + 1)]
 
     # ------------------------------------------------------------------ primitives
@@ -287,7 +324,7 @@ class HandlePrimitives:
         u = ex.env
         joint = read_joint(u, name)
         handle = handle_local(u, name)
-        goal = opening_goal(u, name)
+        goal = self._goal(name)
         chosen = None
         for grasp in hook_grasps(joint, handle):
             q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
@@ -330,39 +367,52 @@ class HandlePrimitives:
         self.hooked = True
 
     def pull(self, stage) -> Iterator[np.ndarray]:
+        """Open the hooked door or drawer to :func:`opening_goal` along its path."""
+        yield from self._move_joint(stage, opening_goal(self.motion.env, stage.target), 1.0)
+
+    def shut(self, stage) -> Iterator[np.ndarray]:
+        """Close the hooked door or drawer to :func:`closing_goal` along its path (the hook pushes it back)."""
+        yield from self._move_joint(stage, closing_goal(self.motion.env, stage.target), -1.0)
+
+    def _move_joint(self, stage, goal: float, sign: float) -> Iterator[np.ndarray]:
+        """Move the hooked joint towards ``goal`` (``sign`` +1: opening, -1: closing); done at once if it is
+        already there (approaching an open drawer may have pushed it shut)."""
         ex, c, name = self.motion, self.config, stage.target
         if not self.hooked or self.target != name:
             yield from self.hook(stage)
         u = ex.env
-        goal = opening_goal(u, name)
         closed = ex.with_hand(ex.target(), HOOK_CLOSED)
         history: list[float] = []
-        q_cmd = read_joint(u, name).q
+        joint = read_joint(u, name)
+        q_cmd = joint.q
+        rate, lead, stall = ((c.rate_m, c.lead_m, c.stall_m) if joint.prismatic else
+                             (c.rate_rad, c.lead_rad, c.stall_rad))
         for _ in range(c.max_steps):
             joint = read_joint(u, name)
             history.append(joint.q)
-            if joint.q >= goal:
-                log.info("door of %r at %.3f rad (goal %.3f)", name, joint.q, goal)
+            if sign * (joint.q - goal) >= 0:
+                log.info("joint of %r at %.3f (goal %.3f)", name, joint.q, goal)
                 return
-            if len(history) > c.stall_steps and history[-1] - history[-1 - c.stall_steps] < c.stall_rad:
-                raise ExecutionError(f"the door of {name!r} stalled at {joint.q:.3f} rad (goal {goal:.3f}): the "
-                                     f"hook slipped off the handle", cause="slipped")
+            if len(history) > c.stall_steps and sign * (history[-1] - history[-1 - c.stall_steps]) < stall:
+                raise ExecutionError(f"the joint of {name!r} stalled at {joint.q:.3f} (goal {goal:.3f}): the hook "
+                                     f"slipped off the handle", cause="slipped")
             target = ex.target()
-            q_next = min(q_cmd + c.rate_rad, joint.q + c.lead_rad, goal + 0.05)
+            # the command advances at most ``rate`` a step and runs at most ``lead`` ahead of the measured position
+            q_next = sign * min(sign * q_cmd + rate, sign * joint.q + lead, sign * goal + 0.05)
             q = ex.ik.solve(self.grasp.palm_at(joint, q_next), target, restarts=0)
             if q is None:
-                raise ExecutionError(f"no IK for the palm on {name!r}'s door arc at {q_next:.3f} rad", cause="no_ik")
-            # where the arm must turn fast for the palm to keep up, the door command slows down instead (a uniform
-            # scale of the joint step keeps the palm on the arc; a per-joint clip would not)
+                raise ExecutionError(f"no IK for the palm on {name!r}'s path at {q_next:.3f}", cause="no_ik")
+            # where the arm must turn fast for the palm to keep up, the command slows down instead (a uniform scale
+            # of the joint step keeps the palm on the path; a per-joint clip would not)
             delta = q[ex.ik.arm] - target[ex.ik.arm]
             scale = min(1.0, ex.max_arm_step_rad / max(float(np.max(np.abs(delta))), 1e-9))
             q_cmd += (q_next - q_cmd) * scale
             t = closed.copy()
             t[ex.ik.arm] = target[ex.ik.arm] + scale * delta
             yield ex.emit(t, guard=True)
-        raise ExecutionError(f"the door of {name!r} reached {read_joint(u, name).q:.3f} rad of {goal:.3f} in "
-                             f"{c.max_steps} pull steps", cause="target_not_reached")
+        raise ExecutionError(f"the joint of {name!r} reached {read_joint(u, name).q:.3f} of {goal:.3f} in "
+                             f"{c.max_steps} steps", cause="target_not_reached")
 
 
 __all__ = ["HOOK_CLOSED", "HOOK_OPEN", "HandleConfig", "HandlePrimitives", "HookGrasp", "JointFrame",
-           "handle_local", "hook_grasps", "opening_goal", "read_joint"]
+           "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]

@@ -13,7 +13,8 @@ carry       ``carry``
 place       ``place``
 release     ``release``
 push        ``push``
-open                             ``pull`` (hooks first when no stage did)
+open                             ``pull`` (hooks first when no stage did): a door's arc, a drawer's slide
+close                            ``shut``: the same hook, the path run back towards closed
 ==========  ===================  =============================================================================
 
 The rigid primitives (:mod:`gendex.solve.rigid`) synthesize grasps over the object's geometry, rank them by a
@@ -53,7 +54,7 @@ log = logging.getLogger(__name__)
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
                     "release": "release", "push": "push"}
 """Skill -> primitive for a rigid target."""
-ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull"}
+ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull", "close": "shut"}
 """Skill -> primitive for an articulated target."""
 
 

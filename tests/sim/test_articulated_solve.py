@@ -109,20 +109,17 @@ def test_pull_without_a_hook_stalls_and_ends_the_attempt(cabinet_env, monkeypatc
     assert float(env.joint_qpos("cabinet")[0]) < 0.5
 
 
-def test_stage_executor_refuses_a_sliding_joint(task_version):
-    """The articulated primitives open revolute joints only; a drawer is refused with the named error."""
-    from gendex_envs.spec import parse_task_spec, spec_to_dict
-    from gendex_envs.task_env import TaskEnv
-
-    raw = spec_to_dict(task_version("OpenCabinet", 0).spec)
-    raw["objects"][0].update(asset="drawer_chest_1", joint_state={})
-    env = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_pos", control_joint="both",
-                  render_backend="none")
+@pytest.mark.parametrize(("task", "start", "done"), [("OpenDrawer", 0.0, lambda f: f >= 0.8),
+                                                     ("CloseDrawer", 0.9, lambda f: f < 0.1)])
+def test_a_drawer_is_hooked_and_slid_open_or_shut(task_version, task, start, done):
+    """Sliding joints: the hook grasp goes over the drawer's bar (fingers down), the palm follows the slide."""
+    env = gym.make(task_version(task).env_id, control_mode="pd_joint_pos", control_joint="both")
     try:
-        obs, _ = env.reset(seed=0)
-        executor = StageExecutor()
-        executor.reset(env, obs)
-        with pytest.raises(ExecutionError, match="revolute"):
-            executor.act(env, obs)
+        u = env.unwrapped
+        for seed in (901, 902):
+            obs, _ = env.reset(seed=seed)
+            assert float(u.joint_open_fraction("drawer_chest")[0]) == pytest.approx(start, abs=0.02)
+            info, steps = _run(env, seed, StageExecutor())
+            assert bool(info["success"]) and done(float(u.joint_open_fraction("drawer_chest")[0])), (task, seed)
     finally:
         env.close()
