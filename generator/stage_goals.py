@@ -17,6 +17,11 @@ OPEN_FRACTION = 0.8
 """Joint opening when the task states none (a ``joint_open`` success condition states it)."""
 
 
+HELD = {"type": "grasped", "min_fingers": 1}
+"""A rigid object is held when the thumb and at least one finger press on it: what benchmarks/grasp.py measures as a
+hold (a precision pinch holds with thumb and index alone; the default two fingers rejected those)."""
+
+
 def _task_value(task_conditions: list[dict], kind: str, obj: str, key: str, default: float) -> float:
     for c in task_conditions:
         if c.get("type") == kind and c.get("object") == obj and c.get(key) is not None:
@@ -31,10 +36,10 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
     if skill == "grasp":
         if articulated:
             return [{"type": "grasped", "object": target, "part": "handle", "min_fingers": 3, "thumb": False}]
-        return [{"type": "grasped", "object": target}]
+        return [dict(HELD, object=target)]
     if skill == "lift":
         h = _task_value(task_conditions, "lifted", target, "min_height_m", LIFT_M)
-        return [{"type": "grasped", "object": target}, {"type": "lifted", "object": target, "min_height_m": h}]
+        return [dict(HELD, object=target), {"type": "lifted", "object": target, "min_height_m": h}]
     if skill == "release":
         return [*(dict(c) for c in task_conditions), {"type": "grasped", "object": target, "negate": True}]
     if skill in ("open", "close"):

@@ -73,6 +73,11 @@ ARC_CHECK_RAD = 0.05
 MAX_ARC_JUMP_RAD = 0.35
 """Largest arm-joint change between neighbouring arc samples: more means IK jumped to another branch."""
 
+SOLVED_CATEGORIES = ("cabinet", "microwave", "refrigerator", "drawer_chest")
+"""Articulated categories whose main joint these primitives open and close (side-hinged doors, drawers; each variant
+opened on 3-5 seeds). Bottom-hinged doors (oven, dishwasher) find no hook grasp the arm can follow down the arc,
+and lids (boxes, laptops, trash cans) offer a tab, not a bar: neither is solved yet."""
+
 HOOK_OPEN = {"THJ4": 0.0, "THJ3": 0.0, "THJ2": 0.0, "THJ1": 0.0, "THJ0": 0.0} | {
     f + j: 0.0 for f in ("FF", "MF", "RF", "LF") for j in ("J3", "J2", "J1", "J0")} | {"LFJ4": 0.0}
 """Hand while approaching the bar: fingers straight and together, thumb in the palm plane (away from the door)."""
@@ -414,5 +419,5 @@ class HandlePrimitives:
                              f"{c.max_steps} steps", cause="target_not_reached")
 
 
-__all__ = ["HOOK_CLOSED", "HOOK_OPEN", "HandleConfig", "HandlePrimitives", "HookGrasp", "JointFrame",
-           "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]
+__all__ = ["HOOK_CLOSED", "HOOK_OPEN", "SOLVED_CATEGORIES", "HandleConfig", "HandlePrimitives", "HookGrasp",
+           "JointFrame", "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]

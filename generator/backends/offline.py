@@ -107,8 +107,11 @@ def plate_like(a: dict) -> bool:
 
 
 def openable(a: dict) -> bool:
+    """Fixed articulated objects with a door or drawer handle, of a kind the solver's handle primitives open."""
+    from gendex.solve.articulated import SOLVED_CATEGORIES
+
     joints = a.get("joints") or []
-    return (bool(a.get("fixed_base")) and bool(joints)
+    return (bool(a.get("fixed_base")) and bool(joints) and a["category"] in SOLVED_CATEGORIES
             and any(k in joints[0]["handle_link"] for k in _OPENABLE_LINKS))
 
 

@@ -15,12 +15,12 @@ INSIDE = [{"type": "inside", "object": "apple", "target": "bowl"}]
 
 
 @pytest.mark.parametrize(("skill", "articulated", "task", "expected"), [
-    ("grasp", False, INSIDE, [{"type": "grasped", "object": "apple"}]),
+    ("grasp", False, INSIDE, [{"type": "grasped", "object": "apple", "min_fingers": 1}]),
     ("grasp", True, INSIDE, [{"type": "grasped", "object": "apple", "part": "handle", "min_fingers": 3,
                               "thumb": False}]),
-    ("lift", False, LIFT, [{"type": "grasped", "object": "apple"},
+    ("lift", False, LIFT, [{"type": "grasped", "object": "apple", "min_fingers": 1},
                            {"type": "lifted", "object": "apple", "min_height_m": 0.12}]),
-    ("lift", False, INSIDE, [{"type": "grasped", "object": "apple"},
+    ("lift", False, INSIDE, [{"type": "grasped", "object": "apple", "min_fingers": 1},
                              {"type": "lifted", "object": "apple", "min_height_m": 0.1}]),
     ("release", False, INSIDE, [*INSIDE, {"type": "grasped", "object": "apple", "negate": True}]),
     ("open", True, [{"type": "joint_open", "object": "apple", "min_fraction": 0.6}],
