@@ -330,7 +330,8 @@ class OfflineBackend:
         cond = {k: v for k, v in proposal["success"].items() if v is not None}
         spec = {"name": proposal["name"], "instruction": proposal["description"], "objects": objects,
                 "stages": stages, "success": {"description": proposal["success_text"], "conditions": [cond]},
-                "max_episode_steps": 200}
+                # room for a re-planned approach or a regrasp: half as much again as the stages' horizons
+                "max_episode_steps": max(200, int(1.5 * sum(st["horizon"] for st in stages)))}
         return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
 
     # ------------------------------------------------------------------ plan
