@@ -88,12 +88,14 @@ class ArmHandMotion:
         for k in range(1, steps + 1):
             yield self.emit(start + (goal - start) * k / steps, guard)
 
-    def move_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None) -> Iterator[np.ndarray]:
-        """Planned arm motion to ``q_goal``'s arm joints, hand targets held (or ``hand``'s)."""
-        yield from self.plan_arm(q_goal, hand)
-
-    def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, start: np.ndarray | None = None
+    def move_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, max_step_rad: float | None = None
                  ) -> Iterator[np.ndarray]:
+        """Planned arm motion to ``q_goal``'s arm joints, hand targets held (or ``hand``'s); at most
+        ``max_step_rad`` per joint and step (default :attr:`max_arm_step_rad`)."""
+        yield from self.plan_arm(q_goal, hand, max_step_rad=max_step_rad)
+
+    def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, start: np.ndarray | None = None,
+                 max_step_rad: float | None = None) -> Iterator[np.ndarray]:
         """:meth:`move_arm`, planned now (against the collision model as it is now; ``ExecutionError`` with cause
         ``no_plan`` if there is no path) and stepped when iterated; from ``start`` (default: the current targets)
         when other motions will have brought the arm there first."""
@@ -103,7 +105,7 @@ class ArmHandMotion:
         if hand is not None:
             goal[self.hand] = hand[self.hand]
         try:
-            path = self.planner.plan(start, goal)
+            path = self.planner.plan(start, goal, max_step_rad)
         except PlanningError as e:
             raise ExecutionError(str(e), cause="no_plan") from e
         return self._follow(path, goal)

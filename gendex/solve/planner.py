@@ -40,9 +40,10 @@ class ArmPlanner:
         n = max(2, int(np.ceil(np.max(np.abs(b - a)) / self.check_step_rad)) + 1)
         return all(self.collision.is_free(a + (b - a) * t) for t in np.linspace(0.0, 1.0, n))
 
-    def plan(self, q_start: np.ndarray, q_goal: np.ndarray) -> np.ndarray:
+    def plan(self, q_start: np.ndarray, q_goal: np.ndarray, max_step_rad: float | None = None) -> np.ndarray:
         """Waypoints [T, dof] from ``q_start`` (excluded) to ``q_goal`` (included); hand entries copy ``q_goal``.
 
+        ``max_step_rad``: the densification's step for this path (default: the planner's).
         Raises :class:`PlanningError` when the goal is in collision or no path is found within the time limit.
         A start in collision (e.g. fingers already touching an object lifted a little into the margin) is allowed:
         the search leaves it along the straight segment toward the goal when it can.
@@ -59,12 +60,12 @@ class ArmPlanner:
             path = [start, q_goal]
         else:
             path = self._rrt(start, q_goal)
-        return self._densify(path)
+        return self._densify(path, max_step_rad or self.max_step_rad)
 
-    def _densify(self, path: list[np.ndarray]) -> np.ndarray:
+    def _densify(self, path: list[np.ndarray], max_step_rad: float) -> np.ndarray:
         out = []
         for a, b in pairwise(path):
-            n = max(1, int(np.ceil(np.max(np.abs(b - a)) / self.max_step_rad)))
+            n = max(1, int(np.ceil(np.max(np.abs(b - a)) / max_step_rad)))
             out.extend(a + (b - a) * k / n for k in range(1, n + 1))
         return np.asarray(out)
 
