@@ -262,6 +262,14 @@ class StageExecutor:
         yield from self.rigid.push(stage.target, goal[0, :2].cpu().numpy().astype(np.float64), c.max_dist_m)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
+        """Let go; an object held over what a condition wants it in or on is first set down there (a dropped tall
+        object topples out of a bowl)."""
+        held = self.rigid.held
+        conds = (*(stage.success or ()), *self._env.task_spec.success.conditions)
+        onto = next((c.target for c in conds if c.type in ("inside", "over") and c.object == held and not c.negate
+                     and c.target in self._env.objects and c.target not in self._env.articulations), None)
+        if held is not None and onto is not None and self.rigid.placed_on != onto:
+            yield from self.rigid.place(onto)
         yield from self.rigid.release()
 
 

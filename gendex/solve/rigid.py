@@ -128,6 +128,8 @@ class RigidPrimitives:
         """The object the hand holds, if any."""
         self.plan: GraspPlan | None = None
         """The grasp being executed."""
+        self.placed_on: str | None = None
+        """What the held object was last set down on (by :meth:`place`), until the next grasp."""
         self.trial_log: list[TrialResult] = []
         self._shapes: dict[str, ObjectShape] = {}
         self._hand: HandModel | None = None
@@ -138,6 +140,7 @@ class RigidPrimitives:
     def reset(self) -> None:
         self.held = None
         self.plan = None
+        self.placed_on = None
         self.trial_log = []
 
     def close(self) -> None:
@@ -284,6 +287,7 @@ class RigidPrimitives:
         m, c = self.m, self.config
         if self.plan is None:
             raise ExecutionError(f"grasping {name!r} needs a stage that approached it first", cause="unsupported")
+        self.placed_on = None
         for attempt in range(c.regrasps + 1):
             z0 = float(self.env.obj(name).pose.p[0, 2])
             yield from close_hand(m, self.plan, c.motion)
@@ -418,6 +422,7 @@ class RigidPrimitives:
             if k < n - 1 and lag > PLACE_RESTING_M:
                 break  # the object stopped while the palm went on: it rests on something
         yield from m.hold(self.config.motion.settle_steps)
+        self.placed_on = target
         lag = (palm0 - m.ik.fk(m.qpos()).p[2]) - (z0 - float(self.env.obj(held).pose.p[0, 2]))
         if lag > 0.002:  # take the press off: the object rests on its support under its own weight
             yield from m.cartesian(np.array([0.0, 0.0, min(lag, PLACE_PRESS_M)]), c.motion.lift_m_per_step,
