@@ -91,6 +91,10 @@ how far short of the goal (along the first push direction) pushing stops."""
 PUSH_MAX_STEPS = 150
 PUSH_STOP_FRACTION = 0.5
 """Pushing stops once the object's centre is within this fraction of the task's tolerance of the goal."""
+CARRY_YAWS_RAD = (0.0, 0.4, -0.4, 0.8, -0.8)
+CARRY_RAISES_M = (0.0, 0.05, 0.1)
+"""Turns of the hand (and the held object) about the vertical through the carry's goal, and extra heights, tried
+when the grasp's own orientation at the carry height has no collision-free arm pose."""
 CARRY_M_PER_STEP = 0.012
 CARRY_RAMP_STEPS = 6
 """Palm travel per step of a level (straight, orientation-keeping) carry, reached and left over this many steps."""
@@ -375,7 +379,16 @@ class RigidPrimitives:
                     t[m.arm] = q[m.arm]
                     yield m.emit(t)
             else:
-                q_goal = m.ik.solve(goal, q_now, restarts=20, valid=m.collision.is_free)
+                q_goal = None
+                # the object may arrive turned about the vertical, or higher: still over the target (a place or a
+                # release lowers it)
+                for up, yaw in ((u, y) for u in CARRY_RAISES_M for y in CARRY_YAWS_RAD):
+                    turn = sapien.Pose(q=[np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
+                    pivot = sapien.Pose(goal_center)
+                    pose = sapien.Pose([0.0, 0.0, up]) * pivot * turn * pivot.inv() * goal
+                    q_goal = m.ik.solve(pose, q_now, restarts=20, valid=m.collision.is_free)
+                    if q_goal is not None:
+                        break
                 if q_goal is None:
                     raise ExecutionError(f"no reachable collision-free pose holding {held!r} above {target!r}",
                                          cause="no_ik")
