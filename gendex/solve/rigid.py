@@ -1,19 +1,24 @@
-"""Scripted primitives for rigid targets: approach, grasp, lift, carry, release (and their failure causes).
+"""Scripted primitives for rigid targets: approach, grasp, lift, carry, place, push, release (and their failure
+causes).
 
 Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is a rigid object.
 
 - ``approach`` — grasp synthesis on the object's measured pose and collision geometry
   (:class:`~gendex.solve.grasp.GraspSynthesizer`); each candidate the arm reaches without collision (IK with
   restarts, pre-grasp and grasp pose) is tried in a private copy of the scene
-  (:class:`~gendex.solve.grasp_trial.GraspTrials`) until one holds; the arm is then planned to its pre-grasp pose.
-  If the object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from
-  where it is now. Then the straight approach.
+  (:class:`~gendex.solve.grasp_trial.GraspTrials`) until one holds. The arm then goes to a staging pose with the
+  opened hand in the collision model and the target an obstacle, and straight on to the pre-grasp pose. If the
+  object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from where it
+  is now. Then the straight approach.
 - ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m``. If the object did not come
   up (it slipped), the hand opens, backs off and grasps once more from the object's new pose (``regrasps``).
 - ``lift`` — raise the held object to the task's ``lifted`` height.
-- ``carry`` — planned arm motion, the held object attached to the palm in the collision model, until the held
-  object is over the target; an object that is no longer with the hand at the end has slipped.
-- ``release`` — open the hand and back off.
+- ``carry`` — the held object over the target: a level, eased palm path where the hand's orientation can be kept,
+  else a planned arm motion, the held object attached to the palm in the collision model; an object that is no
+  longer with the hand at the end has slipped.
+- ``place`` — centre the held object over the target and lower it until it rests there.
+- ``push`` — slide an object across the table with the flat hand, closed loop on its measured pose.
+- ``release`` — open the hand back to the grasp's pre-shape and back off.
 
 Every :class:`~gendex_envs.errors.ExecutionError` raised here names its cause (``no_ik``, ``no_plan``,
 ``grasp_failed``, ``slipped``, ...).
