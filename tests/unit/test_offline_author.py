@@ -61,7 +61,7 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
     from gendex.solve.lift_check import measured_graspable, measured_rates, write_record
 
     held = measured_graspable()
-    assert {"fork", "knife", "tuna_can"}.isdisjoint(held)  # 0/20 in the committed record
+    assert {"fork", "knife", "wrench"}.isdisjoint(held)  # 0/20 in the committed record
     rows = [{"asset": "apple", "held": 19, "attempts": 20}, {"asset": "fork", "held": 3, "attempts": 20}]
     write_record(rows, [1, 2], tmp_path / "rec.json")
     assert measured_rates(tmp_path / "rec.json") == {"apple": 0.95, "fork": 0.15}
