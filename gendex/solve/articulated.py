@@ -38,7 +38,7 @@ import numpy as np
 import sapien
 
 from gendex.solve.collision import Box
-from gendex.solve.grasp import palm_rotation
+from gendex.solve.grasp import axis_rotation, palm_rotation
 from gendex_envs.errors import ExecutionError
 from gendex_envs.physx import px_objects
 
@@ -68,6 +68,8 @@ WRIST_POSTURES = ({"WRJ0": -0.5}, {"WRJ0": 0.0})
 """Hand wrist postures tried with each tilt (``WRJ0`` < 0 bends the back of the hand towards the forearm)."""
 CLOSE_FRACTION = 0.4
 """A close aims at this part of the largest open fraction the task allows."""
+OVERSHOOT = 0.05
+"""The closed loop commands at most this far (rad or m) past its goal."""
 ARC_CHECK_RAD = 0.05
 """Door-angle spacing of the reachability check along the arc."""
 MAX_ARC_JUMP_RAD = 0.35
@@ -86,12 +88,6 @@ HOOK_CLOSED = {f + j: v for f in ("FF", "MF", "RF", "LF") for j, v in (("J2", 1.
 
 
 # ------------------------------------------------------------------------------------------------------- geometry
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation matrix [3, 3] of ``angle`` rad right-handed about unit ``axis`` (Rodrigues)."""
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * k @ k
-
-
 def _matrix(pose: sapien.Pose) -> np.ndarray:
     return np.asarray(pose.to_transformation_matrix(), dtype=np.float64)
 
@@ -125,7 +121,7 @@ class JointFrame:
         if self.prismatic:
             m[:3, 3] = (q - self.q) * self.axis
             return m @ self.link
-        m[:3, :3] = _rotation(self.axis, q - self.q)
+        m[:3, :3] = axis_rotation(self.axis, q - self.q)
         m[:3, 3] = self.point - m[:3, :3] @ self.point
         return m @ self.link
 
@@ -157,14 +153,26 @@ def handle_local(env: TaskEnv, name: str) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class HookGrasp:
-    """Palm pose fixed in the handle link's frame; it follows the door along its arc."""
+class LinkGrip:
+    """Palm pose fixed in a moving link's frame; it follows the link along its path (a hook, a press)."""
 
     offset: np.ndarray
-    """[4, 4] palm pose in the handle link frame."""
+    """[4, 4] palm pose in the link frame."""
     normal_local: np.ndarray
-    """[3] door's outward normal in the link frame (the pre-pose backs off along it)."""
-    to_hinge: bool
+    """[3] unit direction in the link frame along which the pre-pose backs off (a door's outward normal)."""
+
+    def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
+        """World palm pose at joint position ``q``, backed off ``out_m`` along :attr:`normal_local`."""
+        m = joint.link_at(q) @ self.offset
+        m[:3, 3] += out_m * (joint.link_at(q)[:3, :3] @ self.normal_local)
+        return _pose(m)
+
+
+@dataclass(frozen=True)
+class HookGrasp(LinkGrip):
+    """A hook of the handle bar: fingers straight across it, then curled behind it."""
+
+    to_hinge: bool = True
     """Fingers point towards the hinge (else towards the free edge)."""
     tilt_rad: float = 0.0
     """Palm turned about the bar's axis away from parallel to the door (fingers into the door, forearm out)."""
@@ -174,12 +182,6 @@ class HookGrasp:
     def __str__(self) -> str:
         side = "hinge" if self.to_hinge else "free edge"
         return f"hook grasp (fingers towards the {side}, tilt {self.tilt_rad:.2f} rad, wrist {self.wrist})"
-
-    def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
-        """World palm pose at door angle ``q``, ``out_m`` further out along the door's normal."""
-        m = joint.link_at(q) @ self.offset
-        m[:3, 3] += out_m * (joint.link_at(q)[:3, :3] @ self.normal_local)
-        return _pose(m)
 
 
 def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
@@ -208,10 +210,10 @@ def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
         m[:3, :3] = palm_rotation(f, -n)
         m[:3, 3] = handle + PALM_STANDOFF_M * n - BAR_ALONG_M * f
         # turning about the bar keeps the bar where it is in the palm frame; the sign turns the fingers into the door
-        sign = 1.0 if np.dot(_rotation(axis, 0.1) @ f, n) < 0 else -1.0
+        sign = 1.0 if np.dot(axis_rotation(axis, 0.1) @ f, n) < 0 else -1.0
         for tilt in TILTS_RAD:
             r = np.eye(4)
-            r[:3, :3] = _rotation(axis, sign * tilt)
+            r[:3, :3] = axis_rotation(axis, sign * tilt)
             r[:3, 3] = handle - r[:3, :3] @ handle
             for wrist in WRIST_POSTURES:
                 out.append(HookGrasp(r @ m, n.copy(), to_hinge, tilt, dict(wrist)))
@@ -226,13 +228,13 @@ def opening_goal(env: TaskEnv, name: str) -> float:
     return _clip_joint(env, name, frac + GOAL_MARGIN)
 
 
-def closing_goal(env: TaskEnv, name: str) -> float:
-    """Joint position a close aims for: :data:`CLOSE_FRACTION` of the open fraction a negated ``joint_open``
-    condition still allows (short of the closed end, where the hand would hit the body)."""
+def closing_goal(env: TaskEnv, name: str, part: float = CLOSE_FRACTION) -> float:
+    """Joint position a close aims for: ``part`` of the open fraction a negated ``joint_open`` condition still
+    allows (short of the closed end, where the hand would hit the body)."""
     fractions = [c.min_fraction for c in env.task_spec.success.conditions
                  if c.type == "joint_open" and c.object == name and c.min_fraction is not None and c.negate]
     frac = min(fractions) if fractions else 0.1
-    return _clip_joint(env, name, CLOSE_FRACTION * frac)
+    return _clip_joint(env, name, part * frac)
 
 
 def _clip_joint(env: TaskEnv, name: str, fraction: float) -> float:
@@ -293,8 +295,8 @@ class HandlePrimitives:
         self.hooked, self.target = True, target
 
     # ------------------------------------------------------------------ helpers
-    def _boxes(self, name: str, moving: bool) -> list[Box]:
-        """World boxes of the object's links (without the handle link when ``moving``), inflated 1 cm."""
+    def _boxes(self, name: str, moving: bool, inflate_m: float = 0.01) -> list[Box]:
+        """World boxes of the object's links (without the handle link when ``moving``), inflated ``inflate_m``."""
         u = self.motion.env
         handle = u.handle_link(name).name
         boxes = []
@@ -303,22 +305,23 @@ class HandlePrimitives:
                 continue
             aabb = px_objects(link)[0].compute_global_aabb_tight()  # PhysX's tight box
             lo, hi = np.asarray(aabb, dtype=np.float64)
-            boxes.append(Box(lo - 0.01, hi + 0.01, f"{name}/{link.name}"))
+            boxes.append(Box(lo - inflate_m, hi + inflate_m, f"{name}/{link.name}"))
         return boxes
 
-    def _chain(self, poses: list[sapien.Pose], q: np.ndarray) -> np.ndarray | None:
-        """IK chained through ``poses`` from ``q`` (each solve seeded with the last); None when a pose has no
-        solution, the arm jumps branches (:data:`MAX_ARC_JUMP_RAD`) or a configuration collides."""
+    def _chain(self, poses: list[sapien.Pose], q: np.ndarray, restarts: int = 0) -> np.ndarray | None:
+        """IK chained through ``poses`` from ``q`` (each solve seeded with the last, then from ``restarts`` random
+        starts); None when a pose has no solution, the arm jumps branches (:data:`MAX_ARC_JUMP_RAD`) or a
+        configuration collides."""
         ex = self.motion
         for pose in poses:
-            nq = ex.ik.solve(pose, q, restarts=0)
+            nq = ex.ik.solve(pose, q, restarts=restarts)
             if nq is None or np.max(np.abs(nq[ex.ik.arm] - q[ex.ik.arm])) > MAX_ARC_JUMP_RAD \
                     or not ex.collision.is_free(nq):
                 return None
             q = nq
         return q
 
-    def _arc(self, grasp: HookGrasp, joint: JointFrame, goal: float) -> list[sapien.Pose]:
+    def _arc(self, grasp: LinkGrip, joint: JointFrame, goal: float) -> list[sapien.Pose]:
         """Palm poses along the door's arc from its angle now to ``goal``, :data:`ARC_CHECK_RAD` apart."""
         n = max(1, int(np.ceil(abs(goal - joint.q) / ARC_CHECK_RAD)))
         return [grasp.palm_at(joint, joint.q + (goal - joint.q) * k / n) for k in range(1, n + 1)]
@@ -379,19 +382,24 @@ class HandlePrimitives:
         """Close the hooked door or drawer to :func:`closing_goal` along its path (the hook pushes it back)."""
         yield from self._move_joint(stage, closing_goal(self.motion.env, stage.target), -1.0)
 
-    def _move_joint(self, stage, goal: float, sign: float) -> Iterator[np.ndarray]:
-        """Move the hooked joint towards ``goal`` (``sign`` +1: opening, -1: closing); done at once if it is
-        already there (approaching an open drawer may have pushed it shut)."""
+    def _move_joint(self, stage, goal: float, sign: float, hand: dict[str, float] | None = None,
+                    lead: float | None = None) -> Iterator[np.ndarray]:
+        """Move the joint towards ``goal`` (``sign`` +1: opening, -1: closing) with the palm on :attr:`grasp`'s
+        path: hooked (``hand`` None: the hook is closed first if it is not) or pressing with the hand held at
+        ``hand``. ``lead`` overrides how far the command may run ahead of the measured joint position. Done at
+        once if the joint is already there (approaching an open drawer may have pushed it shut)."""
         ex, c, name = self.motion, self.config, stage.target
-        if not self.hooked or self.target != name:
+        if hand is None and (not self.hooked or self.target != name):
             yield from self.hook(stage)
         u = ex.env
-        closed = ex.with_hand(ex.target(), HOOK_CLOSED)
+        closed = ex.with_hand(ex.target(), HOOK_CLOSED if hand is None else hand)
+        how = "the hook slipped off the handle" if hand is None else "the hand lost contact with it"
         history: list[float] = []
         joint = read_joint(u, name)
         q_cmd = joint.q
-        rate, lead, stall = ((c.rate_m, c.lead_m, c.stall_m) if joint.prismatic else
-                             (c.rate_rad, c.lead_rad, c.stall_rad))
+        rate, default_lead, stall = ((c.rate_m, c.lead_m, c.stall_m) if joint.prismatic else
+                                     (c.rate_rad, c.lead_rad, c.stall_rad))
+        lead = default_lead if lead is None else lead
         for _ in range(c.max_steps):
             joint = read_joint(u, name)
             history.append(joint.q)
@@ -399,11 +407,11 @@ class HandlePrimitives:
                 log.info("joint of %r at %.3f (goal %.3f)", name, joint.q, goal)
                 return
             if len(history) > c.stall_steps and sign * (history[-1] - history[-1 - c.stall_steps]) < stall:
-                raise ExecutionError(f"the joint of {name!r} stalled at {joint.q:.3f} (goal {goal:.3f}): the hook "
-                                     f"slipped off the handle", cause="slipped")
+                raise ExecutionError(f"the joint of {name!r} stalled at {joint.q:.3f} (goal {goal:.3f}): {how}",
+                                     cause="slipped")
             target = ex.target()
             # the command advances at most ``rate`` a step and runs at most ``lead`` ahead of the measured position
-            q_next = sign * min(sign * q_cmd + rate, sign * joint.q + lead, sign * goal + 0.05)
+            q_next = sign * min(sign * q_cmd + rate, sign * joint.q + lead, sign * goal + OVERSHOOT)
             q = ex.ik.solve(self.grasp.palm_at(joint, q_next), target, restarts=0)
             if q is None:
                 raise ExecutionError(f"no IK for the palm on {name!r}'s path at {q_next:.3f}", cause="no_ik")
@@ -420,4 +428,4 @@ class HandlePrimitives:
 
 
 __all__ = ["HOOK_CLOSED", "HOOK_OPEN", "SOLVED_CATEGORIES", "HandleConfig", "HandlePrimitives", "HookGrasp",
-           "JointFrame", "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]
+           "JointFrame", "LinkGrip", "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]

@@ -31,6 +31,26 @@ class Box:
     name: str = ""
 
 
+def rotated_box_cover(lo: np.ndarray, hi: np.ndarray, pose: np.ndarray, margin_m: float, piece_m: float = 0.06,
+                      name: str = "") -> list[Box]:
+    """World-axis-aligned boxes covering the box ``[lo, hi]`` of a frame at ``pose`` [4, 4], each inflated by
+    ``margin_m``: one box where the frame is axis-aligned, else the box is cut into pieces of at most ``piece_m``
+    along each of its axes that is turned away from the world's (a door swung 30 deg gets a row of small boxes
+    along its slab instead of one box over the whole wedge it spans)."""
+    rot = pose[:3, :3]
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    cuts = [1 if np.max(np.abs(rot[:, k])) > 0.985 else max(1, int(np.ceil((hi[k] - lo[k]) / piece_m)))
+            for k in range(3)]
+    out = []
+    for idx in np.ndindex(*cuts):
+        a = lo + (hi - lo) * np.asarray(idx) / cuts
+        b = lo + (hi - lo) * (np.asarray(idx) + 1) / cuts
+        corners = np.array([[(a, b)[i][0], (a, b)[j][1], (a, b)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        world = corners @ rot.T + pose[:3, 3]
+        out.append(Box(world.min(axis=0) - margin_m, world.max(axis=0) + margin_m, name))
+    return out
+
+
 class ArmCollisionModel:
     """Sphere cover of the arm; :meth:`clearance` is the signed free distance (m) of one joint vector."""
 

@@ -3,19 +3,21 @@
 Every stage declares a ``skill`` (:data:`gendex_envs.spec.SKILLS`) and a ``target``; the primitive follows from the
 skill and from what the target is:
 
-==========  ===================  =============================================================================
-skill       rigid target         articulated target (a door, a lid; :mod:`gendex.solve.articulated`)
-==========  ===================  =============================================================================
-reach       ``approach``         ``approach_handle``
+==========  ===================  ==============================================  ==================================
+skill       rigid target         articulated target a stage grasps               articulated target no stage grasps
+                                 (:mod:`gendex.solve.articulated`)               (:mod:`gendex.solve.press`)
+==========  ===================  ==============================================  ==================================
+reach       ``approach``         ``approach_handle``                             ``approach_press``
 grasp       ``grasp``            ``hook``
 lift        ``lift``
 carry       ``carry``
 place       ``place``
 release     ``release``
 push        ``push``
-open                             ``pull`` (hooks first when no stage did): a door's arc, a drawer's slide
-close                            ``shut``: the same hook, the path run back towards closed
-==========  ===================  =============================================================================
+open                             ``pull``: a door's arc, a drawer's slide        ``press`` towards open
+close                            ``shut``: the same hook, run back to closed     ``press`` towards closed
+turn                                                                             ``press`` as ``joint_open`` points
+==========  ===================  ==============================================  ==================================
 
 The rigid primitives (:mod:`gendex.solve.rigid`) synthesize grasps over the object's geometry, rank them by a
 physics trial in a private copy of the scene, and grasp again once after a slip. A skill without a primitive for
@@ -40,10 +42,11 @@ from dataclasses import dataclass, field
 import gymnasium as gym
 import numpy as np
 
-from gendex.solve.articulated import HandlePrimitives
+from gendex.solve.articulated import HOOK_OPEN, HandlePrimitives
 from gendex.solve.grasp import GraspPlan
 from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
+from gendex.solve.press import PressPrimitives
 from gendex.solve.rigid import RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
@@ -55,7 +58,9 @@ RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carr
                     "release": "release", "push": "push"}
 """Skill -> primitive for a rigid target."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull", "close": "shut"}
-"""Skill -> primitive for an articulated target."""
+"""Skill -> primitive for an articulated target that a stage grasps (hooks by its handle)."""
+PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press"}
+"""Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 
 
 @dataclass
@@ -104,6 +109,7 @@ class StageExecutor:
         self.carried = False
         self.logs: list[StageLog] = []
         self._handles = HandlePrimitives(self.motion)
+        self._presses = PressPrimitives(self.motion, self._hand_cover)
         self.stage_index = -1
         """Index of the stage being executed (-1 before the first)."""
         self.finished = False
@@ -122,6 +128,11 @@ class StageExecutor:
         if self.logs:
             self.logs[-1].steps += self.motion.steps - before
         return action
+
+    def _hand_cover(self) -> tuple[np.ndarray, np.ndarray]:
+        """Sphere cover (palm frame: centres, radii) of the hand opened flat for a press."""
+        cover = self.rigid.hand.spheres(HOOK_OPEN)
+        return cover.centers, cover.radii
 
     @property
     def current_stage(self):
@@ -146,13 +157,21 @@ class StageExecutor:
             raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it",
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
         articulated = stage.target in self._env.articulations
-        table = ARTICULATED_PRIMITIVES if articulated else RIGID_PRIMITIVES
+        table = RIGID_PRIMITIVES
+        if articulated:
+            table = ARTICULATED_PRIMITIVES if self._grasped(stage.target) else PRESS_PRIMITIVES
         if stage.skill not in table:
-            kind = "an articulated" if articulated else "a rigid"
+            kind = "a rigid"
+            if articulated:
+                kind = "a hooked articulated" if self._grasped(stage.target) else "an ungrasped articulated"
             raise ExecutionError(f"stage {stage.name!r}: the executor has no primitive for skill {stage.skill!r} on "
                                  f"{kind} target ({stage.target!r}); skills it runs there: {sorted(table)}",
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
         return table[stage.skill]
+
+    def _grasped(self, name: str) -> bool:
+        """Whether a stage of the task grasps ``name`` (an articulated target: hooks its handle)."""
+        return any(s.skill == "grasp" and s.target == name for s in self._env.task_spec.stages)
 
     def _policy_files(self, stage) -> PolicyFiles | None:
         learned = stage.method == "RL" or self.policy_stages == "all"
@@ -181,7 +200,9 @@ class StageExecutor:
             self.logs.append(StageLog(stage.name, prim, "scripted"))
             log.info("stage %r (%s, %s): primitive %r%s", stage.name, stage.skill, stage.method, prim,
                      " (no trained policy)" if stage.method == "RL" else "")
-            if prim in ARTICULATED_PRIMITIVES.values():
+            if prim in PRESS_PRIMITIVES.values():
+                yield from self._presses.run(prim, stage)
+            elif prim in ARTICULATED_PRIMITIVES.values():
                 yield from self._handles.run(prim, stage)
             else:
                 yield from getattr(self, "_" + prim)(stage)
@@ -273,5 +294,5 @@ class StageExecutor:
         yield from self.rigid.release()
 
 
-__all__ = ["ARTICULATED_PRIMITIVES", "RIGID_PRIMITIVES", "ExecutionError", "ExecutorConfig", "StageExecutor",
-           "StageLog"]
+__all__ = ["ARTICULATED_PRIMITIVES", "PRESS_PRIMITIVES", "RIGID_PRIMITIVES", "ExecutionError", "ExecutorConfig",
+           "StageExecutor", "StageLog"]

@@ -184,7 +184,8 @@ def headings(n: int, prefer_rad: float) -> np.ndarray:
     return yaws[order]
 
 
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+def axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rotation matrix [3, 3] of ``angle`` rad right-handed about unit ``axis`` (Rodrigues)."""
     k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
     return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * k @ k
 
@@ -474,7 +475,7 @@ class GraspSynthesizer:
             n_p = np.array([0.0, -1.0, 0.0])  # palm normal, palm frame
             r0 = _frame(a_w, down) @ _frame(shape.axis, n_p).T  # pinch line onto a_w, palm facing down if it can
             for roll in PINCH_ROLLS_RAD:
-                rot = _rotation(a_w, roll) @ r0
+                rot = axis_rotation(a_w, roll) @ r0
                 normal = rot @ n_p
                 if normal[2] > -0.2:
                     continue  # the palm must face the table to come from above
@@ -503,4 +504,4 @@ def object_heading(center_xy: np.ndarray, base_xy: np.ndarray) -> float:
 
 
 __all__ = ["FINGERS", "GUARD_RAD", "OPEN_HAND", "RELEASE_HAND", "GraspPlan", "GraspSynthesizer", "PinchLine",
-           "PinchShape", "headings", "object_heading", "palm_rotation", "pinch_shape", "pose_of"]
+           "PinchShape", "axis_rotation", "headings", "object_heading", "palm_rotation", "pinch_shape", "pose_of"]

@@ -1,0 +1,408 @@
+"""Contact moves of articulated parts: push a door shut, a lid up by its tab or down past its hinge, a tap's lever
+round, with the flat hand and no grasp.
+
+A hinged part whose stages never grasp it is moved by *pressing*: the hand touches the moving link on the side the
+motion comes from and follows the part's own path (:class:`~gendex.solve.articulated.JointFrame`), every control
+step placing the palm where the contact will be a little further along, so the part is pushed ahead of the hand.
+Two primitives, run by :class:`~gendex.solve.executor.StageExecutor` (skills ``reach``, then ``open``, ``close``
+or ``turn``):
+
+- ``approach_press`` — reads the joint from the live articulation, finds where the part's surface is on the push
+  side of its grip point (a ray against the link's PhysX convex parts), and synthesizes *press poses*: the palm
+  faces the direction the contact must move, with its centre (or, for a tab, the fingertips) on that surface,
+  fingers along the hinge axis or across it. A pose is kept only if the arm reaches its pre-pose
+  (:data:`PRE_M` back from the surface) and can follow the contact along the whole path to the goal (IK chained
+  along sampled joint positions, collision-checked against the fixed links). The arm is planned to the pre-pose
+  with the open hand in its collision model and moves straight in.
+- ``press`` — closed loop along the path, as :meth:`~gendex.solve.articulated.HandlePrimitives.pull` runs a hooked
+  handle, with the hand open: the target runs ahead of the measured joint position, so the palm keeps pushing.
+
+Which way a stage moves the joint: ``open`` opens it, ``close`` closes it, and ``turn`` goes where the task's
+``joint_open`` condition on the target points (opening unless the condition is negated).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+import sapien
+
+from gendex.solve.articulated import (
+    ARC_CHECK_RAD,
+    HOOK_OPEN,
+    OVERSHOOT,
+    HandlePrimitives,
+    JointFrame,
+    LinkGrip,
+    closing_goal,
+    handle_local,
+    opening_goal,
+    read_joint,
+)
+from gendex.solve.collision import Box, rotated_box_cover
+from gendex.solve.grasp import axis_rotation, palm_rotation
+from gendex.solve.shape import ObjectShape, PosedShape
+from gendex_envs.errors import ExecutionError
+from gendex_envs.physx import px_bodies
+
+log = logging.getLogger(__name__)
+
+PALM_CONTACT = np.array([0.0, -0.0135, 0.045])
+"""Palm frame point that touches the surface in a palm press: the skin at the palm's centre (the sphere cover of
+the open hand: palm skin at y = -13.3 mm, the palm spans z = 0 to 0.09)."""
+FINGER_CONTACT = np.array([0.0, -0.010, 0.18])
+"""Palm frame point that touches the surface in a fingertip press: the middle finger's skin at its pad, fingers
+straight (the finger pads lie at z = 0.174 to 0.185; the tips end 2 cm further)."""
+CONTACT_GAP_M = 0.008
+"""The press pose stops this short of the surface; the closed loop then pushes."""
+PRESS_LEAD_M = 0.03
+"""The palm's target runs this far (at the contact, along the path) ahead of where the part is."""
+HANDOVER_MARGIN_RAD = 0.15
+"""A press that gravity can finish goes on this far past the point where gravity starts to help enough."""
+HANDOVER_TORQUE_FRACTION = 0.5
+"""Gravity helps enough where its torque towards the goal is at least this part of its largest on the way (joint
+friction holds a lid that is just past upright: measured, a bin lid let go at 1.3 rad stays, at 1.0 rad falls)."""
+RETREAT_M = 0.08
+"""After a handover the palm backs off this far against the push direction and rises as much."""
+FALL_STEPS = 40
+"""Control steps the part gets to fall the rest of the way to the goal after the hand let go (2 s)."""
+PRE_M = 0.08
+"""Pre-pose: the press pose backed off this far from the surface."""
+PRESS_CLOSE_FRACTION = 0.85
+"""A press that closes aims at this part of the open fraction the task's negated ``joint_open`` allows (the
+closed end is where the arm has the least room)."""
+FINGER_ANGLES_DEG = (0, 90, 45, -45, 135, 180, -90, -135)
+"""Finger directions tried, turned about the push direction from the hinge axis (positive: towards the hinge)."""
+FOLLOWS = (1.0, 0.5)
+"""How much of the part's turn the palm takes on (:attr:`PressPose.follow`), in order of preference."""
+SHIFTS_M = ((0.0, 0.0), (0.08, 0.0), (-0.08, 0.0), (0.0, 0.012), (0.0, 0.025), (0.0, -0.06))
+"""Contact points tried: the grip point moved (along the hinge axis, away from the axis) by these distances (a
+door's bar is one place to push it, the door above and below the bar are others; a lever is pushed near its end
+or nearer its hub)."""
+INSERT_CHECKS = 4
+HAND_CLEAR_M = 0.005
+"""The open hand keeps this far off the parts the press does not move (and the table) along the whole path."""
+CHAIN_RESTARTS = 3
+"""Random IK restarts where the seeded solve fails along the path (the jump limit still rejects another branch)."""
+RAY_BACK_M = 0.3
+"""The surface ray starts this far behind the grip point, on the hand's side."""
+
+
+@dataclass(frozen=True)
+class PressPose(LinkGrip):
+    """A palm pose fixed in the moving link's frame that touches the link, ready to push it."""
+
+    site: str = "palm"
+    """What touches: the ``palm`` centre or the ``fingers`` near their tips."""
+    fingers: str = ""
+    """Where the fingers point, in words (for logs)."""
+    back: str = ""
+    """How the pre-pose backs off, in words (for logs)."""
+    shift_m: tuple[float, float] = (0.0, 0.0)
+    """Where the contact is: the grip point moved this far along the hinge axis and away from it."""
+    follow: float = 1.0
+    """How much of the part's turn the palm takes on along the path (1: fixed to the link; 0.5: half, the palm's
+    edge then leads; a slide's palm never turns)."""
+    q_ref: float = 0.0
+    """Joint position at which :attr:`offset` was computed (where the palm faces the surface square on)."""
+    contact: np.ndarray = field(default_factory=lambda: PALM_CONTACT.copy())
+    """[3] palm frame point that touches the part."""
+
+    def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
+        pose = super().palm_at(joint, q, out_m)
+        if self.follow == 1.0 or joint.prismatic:
+            return pose
+        m = pose.to_transformation_matrix()
+        touch = m[:3, :3] @ self.contact + m[:3, 3]  # the contact point stays where the link puts it
+        m[:3, :3] = axis_rotation(joint.axis, -(1.0 - self.follow) * (q - self.q_ref)) @ m[:3, :3]
+        m[:3, 3] = touch - m[:3, :3] @ self.contact
+        return sapien.Pose(np.asarray(m, dtype=np.float32))
+
+    def __str__(self) -> str:
+        return (f"press with the {self.site} at the grip point {self.shift_m[0]:+.2f} m along the axis and "
+                f"{self.shift_m[1]:+.2f} m out (fingers "
+                f"{self.fingers}, following {self.follow:.1f} of the turn, backing off {self.back})")
+
+
+def press_direction(joint: JointFrame, point_local: np.ndarray) -> np.ndarray:
+    """[3] unit direction (link frame) in which the point ``point_local`` of the moving link goes when the joint
+    opens (positive motion)."""
+    rot_t = joint.link[:3, :3].T
+    axis = rot_t @ joint.axis
+    if joint.prismatic:
+        return axis
+    radial = np.asarray(point_local, float) - rot_t @ (joint.point - joint.link[:3, 3])
+    t = np.cross(axis, radial)
+    n = float(np.linalg.norm(t))
+    if n < 1e-6:
+        raise ExecutionError("the grip point lies on the hinge axis: pressing there cannot turn the part",
+                             cause="unsupported")
+    return t / n
+
+
+def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, sign: float) -> list[PressPose]:
+    """Press poses of the moving link (its convex ``shape`` in the link frame) that push the point ``point_local``
+    towards opening (``sign`` +1) or closing (-1), in order of preference: palm presses before fingertip presses;
+    fingers along the hinge axis, then across it (towards the hinge, then away)."""
+    rot_t = joint.link[:3, :3].T
+    axis = rot_t @ joint.axis
+    posed = shape.posed(np.eye(4))
+    contacts = []  # (surface point, motion direction there)
+    hinge = rot_t @ (joint.point - joint.link[:3, 3])
+    for shift, out_m in SHIFTS_M:
+        p = np.asarray(point_local, float) + shift * axis
+        if out_m:
+            if joint.prismatic:
+                continue
+            radial = p - hinge - np.dot(p - hinge, axis) * axis
+            p = p + out_m * radial / max(float(np.linalg.norm(radial)), 1e-9)
+        m = sign * press_direction(joint, p)
+        spans = posed.ray_intervals(p - RAY_BACK_M * m, m)
+        if spans and spans[0][0] < RAY_BACK_M + 0.05:
+            surface = p - RAY_BACK_M * m + spans[0][0] * m
+            contacts.append((surface, sign * press_direction(joint, surface), (shift, out_m)))
+    if not contacts:
+        raise ExecutionError("no surface of the moving part on the line through its grip point", cause="unsupported")
+    out = []
+    for site, contact in (("palm", PALM_CONTACT), ("fingers", FINGER_CONTACT)):
+        for surface, m, shift in contacts:
+            base = axis - np.dot(axis, m) * m
+            if np.linalg.norm(base) < 1e-6:  # a slide pushed along its axis: start from the vertical
+                base = np.array([0.0, 0.0, 1.0]) - m[2] * m
+            base /= np.linalg.norm(base)
+            if not joint.prismatic:  # positive angles turn the fingers towards the hinge
+                hinge = rot_t @ (joint.point - joint.link[:3, 3])
+                if np.dot(np.cross(m, base), hinge - surface) < 0:
+                    m_turn = -m
+                else:
+                    m_turn = m
+            else:
+                m_turn = m
+            for deg in FINGER_ANGLES_DEG:
+                f = axis_rotation(m_turn, np.radians(deg)) @ base
+                words = f"{deg:+d} deg from the hinge axis"
+                rot = palm_rotation(f, m)
+                off = np.eye(4)
+                off[:3, :3] = rot
+                off[:3, 3] = surface - CONTACT_GAP_M * m - rot @ contact
+                backs = [(-m, "from the surface")] + ([(-f, "along the fingers")] if site == "fingers" else [])
+                for back, how in backs:
+                    for follow in FOLLOWS:
+                        out.append(PressPose(off, back.copy(), site=site, fingers=words, back=how, shift_m=shift,
+                                             follow=follow, q_ref=joint.q, contact=contact.copy()))
+    return out
+
+
+def _clear(palm: sapien.Pose, centres: np.ndarray, radii: np.ndarray, shapes: list[PosedShape],
+           margin_m: float) -> bool:
+    """Whether the hand's spheres (palm frame) at ``palm`` stay ``margin_m`` off every shape and the table."""
+    m = palm.to_transformation_matrix()
+    world = centres @ m[:3, :3].T + m[:3, 3]
+    if np.any(world[:, 2] - radii < margin_m):
+        return False
+    return all(np.all(shape.signed_distance(world) - radii >= margin_m) for shape in shapes)
+
+
+class PressPrimitives(HandlePrimitives):
+    """The press primitives of one episode; ``hand_cover`` gives the open hand's sphere cover (palm frame) that
+    the arm's collision model carries while it brings the hand to the part."""
+
+    def __init__(self, motion, hand_cover: Callable[[], tuple[np.ndarray, np.ndarray]], config=None):
+        super().__init__(motion, config)
+        self.hand_cover = hand_cover
+        self._shapes: dict[tuple[str, str], ObjectShape] = {}
+
+    def run(self, prim: str, stage) -> Iterator[np.ndarray]:
+        if prim not in ("approach_press", "press"):
+            raise ExecutionError(f"no press primitive {prim!r}; primitives: approach_press, press",
+                                 cause="unsupported")
+        return getattr(self, prim)(stage)
+
+    def _sign(self, stage) -> float:
+        """+1 when ``stage`` (or, for a reach, the stage that moves the joint after it) opens the joint, else -1."""
+        spec = self.motion.env.task_spec
+        if stage.skill not in ("open", "close", "turn"):
+            stage = next((s for s in spec.stages if s.target == stage.target and s.skill in ("open", "close", "turn")),
+                         stage)
+        if stage.skill in ("open", "close"):
+            return 1.0 if stage.skill == "open" else -1.0
+        conds = [c for c in (*(stage.success or ()), *spec.success.conditions)
+                 if c.type == "joint_open" and c.object == stage.target]
+        return -1.0 if conds and all(c.negate for c in conds) else 1.0
+
+    def _press_goal(self, name: str, sign: float) -> float:
+        u = self.motion.env
+        return opening_goal(u, name) if sign > 0 else closing_goal(u, name, PRESS_CLOSE_FRACTION)
+
+    def _beyond(self, name: str, goal: float, sign: float) -> float:
+        """The furthest joint position the press commands: a little past ``goal`` (within the limits)."""
+        u = self.motion.env
+        lo, hi = u.articulations[name].get_qlimits()[0, u.joint_index(name)].tolist()
+        return float(np.clip(goal + sign * OVERSHOOT, lo, hi))
+
+    def _shape(self, name: str) -> ObjectShape:
+        link = self.motion.env.handle_link(name)
+        key = (name, link.name)
+        if key not in self._shapes:
+            self._shapes[key] = ObjectShape.of_actor(link)
+        return self._shapes[key]
+
+    def _fixed_shapes(self, name: str) -> list[PosedShape]:
+        """World shapes of ``name``'s links that the pressed joint does not move."""
+        moving = self.motion.env.handle_link(name).name
+        out = []
+        for link in self.motion.env.articulations[name].get_links():
+            if link.name == moving:
+                continue
+            key = (name, link.name)
+            if key not in self._shapes:
+                try:
+                    self._shapes[key] = ObjectShape.of_actor(link)
+                except ValueError:  # a link without collision shapes
+                    self._shapes[key] = None
+            if self._shapes[key] is not None:
+                pose = link.pose
+                m = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
+                out.append(self._shapes[key].posed(m))
+        return out
+
+    def _press_boxes(self, name: str) -> list[Box]:
+        """Obstacles while the hand comes to the part: the fixed links' boxes and the moving link's convex parts,
+        each covered by small boxes along it (:func:`rotated_box_cover`), all inflated 1 cm."""
+        boxes = self._boxes(name, moving=True)
+        link = self.motion.env.handle_link(name)
+        pose = link.pose
+        m = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
+        for part in self._shape(name).parts:
+            boxes += rotated_box_cover(part.vertices.min(axis=0), part.vertices.max(axis=0), m, 0.01,
+                                       name=f"{name}/{link.name}")
+        return boxes
+
+    def approach_press(self, stage) -> Iterator[np.ndarray]:
+        ex, name = self.motion, stage.target
+        u = ex.env
+        joint = read_joint(u, name)
+        sign = self._sign(stage)
+        goal = self._press_goal(name, sign)
+        stop = self._handover(name, joint, sign, goal)
+        centres, radii = self.hand_cover()
+        fixed = self._fixed_shapes(name)
+        moving = self._shape(name).posed(joint.link)
+        around = self._press_boxes(name)
+        chosen = None
+        for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign):
+            touch = pose.palm_at(joint, joint.q)
+            if not _clear(touch, centres, radii, [moving], -HAND_CLEAR_M):
+                log.debug("%s: the hand would touch the part elsewhere", pose)
+                continue
+            if not all(_clear(p, centres, radii, fixed, HAND_CLEAR_M) for p in [touch, *self._arc(pose, joint, stop)]):
+                log.debug("%s: the hand would hit the fixed part or the table", pose)
+                continue
+            q0 = ex.with_hand(ex.target(), HOOK_OPEN)
+            ex.collision.set_obstacles(around)  # the pre-pose: the open hand clear of the whole part
+            ex.collision.cover_hand(centres, radii)
+            try:
+                q_pre = ex.ik.solve(pose.palm_at(joint, joint.q, PRE_M), q0, restarts=20, valid=ex.collision.is_free)
+            finally:
+                ex.collision.cover_hand(None)
+            if q_pre is None:
+                log.debug("%s: pre-pose unreachable", pose)
+                continue
+            ex.collision.set_obstacles(self._boxes(name, moving=True, inflate_m=0.0))  # then the arm alone
+            n = INSERT_CHECKS
+            q_in = self._chain([pose.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)], q_pre,
+                               CHAIN_RESTARTS)
+            if q_in is None:
+                log.debug("%s: no straight motion in", pose)
+                continue
+            if self._chain(self._arc(pose, joint, self._beyond(name, stop, sign)), q_in, CHAIN_RESTARTS) is None:
+                log.debug("%s: arm cannot follow the path", pose)
+                continue
+            chosen = (pose, q_pre, q0)
+            break
+        if chosen is None:
+            raise ExecutionError(f"no press pose on {name!r}'s moving part that the arm can reach and follow along "
+                                 f"its path", cause="no_ik")
+        pose, q_pre, q0 = chosen
+        log.info("%r: %s", name, pose)
+        self.grasp, self.target, self.hooked = pose, name, False
+        ex.collision.set_obstacles(around)
+        ex.collision.cover_hand(centres, radii)
+        try:
+            path = ex.plan_arm(q_pre, hand=q0)
+        except ExecutionError as exc:  # the hand starts too close to something: plan the arm alone
+            log.debug("no path with the hand covered (%s): planning the arm alone", exc)
+            path = None
+        finally:
+            ex.collision.cover_hand(None)
+        if path is None:
+            yield from ex.move_arm(q_pre, hand=q0)
+        else:
+            yield from path
+        back = joint.link[:3, :3] @ pose.normal_local
+        yield from ex.cartesian(-PRE_M * back, self.config.insert_m_per_step)
+        yield from ex.settle()
+
+    def press(self, stage) -> Iterator[np.ndarray]:
+        """Push the part along its path to the stage's goal with the open hand."""
+        name = stage.target
+        sign = self._sign(stage)
+        if self.grasp is None or self.target != name or not isinstance(self.grasp, PressPose):
+            yield from self.approach_press(stage)
+        joint = read_joint(self.motion.env, name)
+        lead = None
+        if not joint.prismatic:  # the palm pushes PRESS_LEAD_M into the part, whatever the contact's radius
+            touch = self.grasp.palm_at(joint, joint.q).to_transformation_matrix()
+            point = touch[:3, :3] @ self.grasp.contact + touch[:3, 3] - joint.point
+            radius = float(np.linalg.norm(point - np.dot(point, joint.axis) * joint.axis))
+            lead = max(self.config.lead_rad, PRESS_LEAD_M / max(radius, 1e-3))
+        goal = self._press_goal(name, sign)
+        stop = self._handover(name, joint, sign, goal)
+        yield from self._move_joint(stage, stop, sign, hand=HOOK_OPEN, lead=lead)
+        if stop == goal:
+            return
+        ex = self.motion
+        joint = read_joint(ex.env, name)  # out of the part's way: back against the push, and up
+        touch = self.grasp.palm_at(joint, joint.q).to_transformation_matrix()
+        away = -RETREAT_M * touch[:3, :3] @ np.array([0.0, -1.0, 0.0]) + np.array([0.0, 0.0, RETREAT_M])
+        try:
+            yield from ex.cartesian(away, self.config.insert_m_per_step)
+        except ExecutionError as exc:
+            log.debug("no retreat after the handover (%s)", exc)
+        for _ in range(FALL_STEPS):  # gravity carries the part on; the hand stays where it let go
+            if sign * (float(ex.env.joint_qpos(name)[0]) - goal) >= 0:
+                return
+            yield ex.emit(ex.target())
+        raise ExecutionError(f"the joint of {name!r} stopped at {float(ex.env.joint_qpos(name)[0]):.3f} after the "
+                             f"hand let it go at {stop:.3f} (goal {goal:.3f})", cause="target_not_reached")
+
+    def _handover(self, name: str, joint: JointFrame, sign: float, goal: float) -> float:
+        """Where the press may stop: the joint position :data:`HANDOVER_MARGIN_RAD` past the point after which
+        gravity turns the part the rest of the way to ``goal`` with at least :data:`HANDOVER_TORQUE_FRACTION` of
+        its largest torque (a lid pushed back over upright falls shut), or ``goal`` when gravity never does (a door,
+        a lever, a slide)."""
+        if joint.prismatic:
+            return goal
+        link = self.motion.env.handle_link(name)
+        body = px_bodies(link)[0]
+        com = np.asarray(body.cmass_local_pose.p, dtype=np.float64)
+        qs = np.arange(joint.q, goal, sign * ARC_CHECK_RAD)
+        if len(qs) == 0:
+            return goal
+        torque = np.array([sign * float(np.dot(joint.axis, np.cross(joint.point_at(com, q) - joint.point,
+                                                                    [0.0, 0.0, -1.0]))) for q in qs])
+        helps = torque >= max(HANDOVER_TORQUE_FRACTION * float(torque.max()), 1e-6)
+        start = len(helps)
+        while start > 0 and helps[start - 1]:
+            start -= 1
+        if start >= len(qs):
+            return goal
+        stop = float(qs[start] + sign * HANDOVER_MARGIN_RAD)
+        return goal if sign * (stop - goal) >= 0 else stop
+
+
+__all__ = ["CONTACT_GAP_M", "FINGER_CONTACT", "PALM_CONTACT", "PressPose", "PressPrimitives", "press_direction",
+           "press_poses"]

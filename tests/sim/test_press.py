@@ -1,0 +1,122 @@
+"""Press primitives (gendex.solve.press): pushing a door shut, a lid open or shut and a lever round with the open
+hand, on the reference tasks of those skills."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+
+import gendex_envs  # noqa: F401
+from gendex.solve import press
+from gendex.solve.articulated import handle_local, read_joint
+from gendex.solve.executor import StageExecutor
+from gendex.solve.shape import ObjectShape
+
+KWARGS = {"control_mode": "pd_joint_pos", "control_joint": "both"}
+
+
+@pytest.fixture
+def make_env(task_version):
+    made = []
+
+    def make(task: str):
+        env = gym.make(task_version(task).env_id, **KWARGS)
+        made.append(env)
+        return env
+
+    yield make
+    for env in made:
+        env.close()
+
+
+def _run(env, seed, executor):
+    obs, _ = env.reset(seed=seed)
+    executor.reset(env, obs)
+    info = {}
+    while (action := executor.act(env, obs)) is not None:
+        obs, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
+    return info
+
+
+@pytest.mark.parametrize(("task", "name"), [("TurnFaucet", "faucet"), ("CloseCabinet", "cabinet"),
+                                            ("OpenTrashCan", "trash_can")])
+def test_press_direction_is_where_the_grip_point_moves_in_the_simulator(make_env, task, name):
+    env = make_env(task)
+    u = env.unwrapped
+    env.reset(seed=4)
+    joint = read_joint(u, name)
+    local = handle_local(u, name)
+    before = u.handle_pos(name)[0].numpy().astype(np.float64)
+    art = u.articulations[name]
+    art.set_qpos(torch.tensor([[joint.q + 0.02]], dtype=torch.float32))
+    moved = u.handle_pos(name)[0].numpy().astype(np.float64) - before
+    predicted = joint.link[:3, :3] @ press.press_direction(joint, local)
+    assert np.dot(moved / np.linalg.norm(moved), predicted) == pytest.approx(1.0, abs=2e-3)
+
+
+def test_press_poses_touch_the_part_square_on_and_follow_it(make_env):
+    """Every press pose puts its palm-frame contact point CONTACT_GAP_M off the door's surface on the side the push
+    comes from, the palm facing the push; along the door's path the contact point stays on the door (a pose that
+    follows half the turn keeps the point, not the orientation)."""
+    env = make_env("CloseCabinet")
+    u = env.unwrapped
+    env.reset(seed=2)
+    joint = read_joint(u, "cabinet")
+    shape = ObjectShape.of_actor(u.handle_link("cabinet"))
+    poses = press.press_poses(joint, shape, handle_local(u, "cabinet"), -1.0)
+    assert {p.site for p in poses} == {"palm", "fingers"} and {p.follow for p in poses} == {1.0, 0.5}
+    for pose in poses:
+        palm = pose.palm_at(joint, joint.q).to_transformation_matrix()
+        touch = palm[:3, :3] @ pose.contact + palm[:3, 3]
+        push = palm[:3, :3] @ np.array([0.0, -1.0, 0.0])  # the palm's skin faces -y of the palm frame
+        depth = shape.posed(joint.link).ray_intervals(touch, push)[0][0]
+        assert depth == pytest.approx(press.CONTACT_GAP_M, abs=1e-4), pose
+        surface = np.linalg.inv(joint.link) @ np.append(touch + depth * push, 1.0)
+        m = joint.link[:3, :3] @ (-press.press_direction(joint, surface[:3]))
+        assert np.dot(push, m) == pytest.approx(1.0, abs=1e-6)  # square on to the path where it touches
+        local = np.linalg.inv(joint.link) @ np.append(touch, 1.0)
+        later = pose.palm_at(joint, joint.q - 0.3).to_transformation_matrix()
+        assert np.allclose(later[:3, :3] @ pose.contact + later[:3, 3], joint.point_at(local[:3], joint.q - 0.3),
+                           atol=1e-5)
+        turned = np.degrees(np.arccos(np.clip((np.trace(palm[:3, :3].T @ later[:3, :3]) - 1) / 2, -1, 1)))
+        assert turned == pytest.approx(np.degrees(0.3) * pose.follow, abs=0.01)
+
+
+def test_the_press_stops_where_gravity_takes_over_only_for_a_lid(make_env):
+    """A lid pushed back over upright is let go where gravity closes it hard enough; a door on a vertical hinge
+    gets no help from gravity and is pushed all the way."""
+    env = make_env("CloseTrashCan")
+    env.reset(seed=0)
+    executor = StageExecutor()
+    executor.reset(env, None)
+    presses = executor._presses
+    u = env.unwrapped
+    joint = read_joint(u, "trash_can")
+    goal = presses._press_goal("trash_can", -1.0)
+    stop = presses._handover("trash_can", joint, -1.0, goal)
+    assert goal < stop < np.pi / 2 < joint.q
+    env = make_env("CloseCabinet")
+    env.reset(seed=0)
+    executor.reset(env, None)
+    joint = read_joint(env.unwrapped, "cabinet")
+    goal = executor._presses._press_goal("cabinet", -1.0)
+    assert executor._presses._handover("cabinet", joint, -1.0, goal) == goal
+
+
+@pytest.mark.parametrize(("task", "name", "done"), [
+    ("CloseCabinet", "cabinet", lambda f: f < 0.1),
+    ("TurnFaucet", "faucet", lambda f: f >= 0.8),
+    ("CloseTrashCan", "trash_can", lambda f: f < 0.1),
+    ("OpenTrashCan", "trash_can", lambda f: f >= 0.5),
+])
+def test_the_executor_presses_parts_no_stage_grasps(make_env, task, name, done):
+    env = make_env(task)
+    u = env.unwrapped
+    for seed in (905, 906):
+        executor = StageExecutor()
+        info = _run(env, seed, executor)
+        fraction = float(u.joint_open_fraction(name)[0])
+        assert bool(info["success"]) and done(fraction), (task, seed, fraction)
+        assert [log.primitive for log in executor.logs][:2] == ["approach_press", "press"]
