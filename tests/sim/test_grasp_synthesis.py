@@ -142,3 +142,30 @@ def test_lift_and_hold_beyond_the_two_objects_the_old_grasp_knew(asset):
         checker.close()
     assert result.held, result.failure
     assert result.rise_m >= 0.10 and result.trials >= 1 and result.grasp.startswith("pinch")
+
+
+def test_a_ball_wider_than_a_pinch_is_pinched_above_its_middle_and_held(golf):
+    """The 96 mm softball is wider than the widest pinch at its middle: a pinch line is added where it is
+    PINCH_FIT_M wide, above the middle (there the pads press it down into the hand), and that grasp holds. A ball
+    that fits at its middle (the golf ball) gets no such line."""
+    from gendex.solve import grasp
+
+    s = Scene("softball")
+    try:
+        fp = s.shape.footprint()
+        mid = fp.bottom + fp.height / 2
+        lines = s.synth.pinch_lines()
+        fitted = [ln for ln in lines if ln.center[2] > mid + 0.01 and ln.center[2] < fp.top - 0.02]
+        assert fitted, [ln.note for ln in lines]
+        assert all(ln.width <= grasp.PINCH_FIT_M + 0.002 for ln in fitted)
+    finally:
+        s.env.close()
+    gfp = golf.shape.footprint()
+    heights = {round(float(ln.center[2] - gfp.bottom), 3) for ln in golf.synth.pinch_lines()}
+    assert heights == {round(gfp.height / 2, 3), round(gfp.height - 0.012, 3)}
+    checker = LiftChecker("softball")
+    try:
+        result = checker(1002)
+    finally:
+        checker.close()
+    assert result.held and result.rise_m >= 0.10, result.failure
