@@ -10,10 +10,12 @@ or ``turn``):
 - ``approach_press`` — reads the joint from the live articulation, finds where the part's surface is on the push
   side of its grip point (a ray against the link's PhysX convex parts), and synthesizes *press poses*: the palm
   faces the direction the contact must move, with its centre (or, for a tab, the fingertips) on that surface,
-  fingers along the hinge axis or across it. A pose is kept only if the arm reaches its pre-pose
-  (:data:`PRE_M` back from the surface) and can follow the contact along the whole path to the goal (IK chained
-  along sampled joint positions, collision-checked against the fixed links). The arm is planned to the pre-pose
-  with the open hand in its collision model and moves straight in.
+  the fingers pointing any of eight ways about the push, the palm turning with the part or with half its turn. A
+  pose is kept only if the open hand clears the fixed links and the table along the path, the arm reaches its
+  pre-pose (:data:`PRE_M` back from the surface) with the open hand clear of the whole part, and the arm can
+  follow the contact along the whole path to the goal (IK chained along sampled joint positions, collision-checked
+  against the fixed links). The arm is planned to the pre-pose with the open hand in its collision model and
+  moves straight in.
 - ``press`` — closed loop along the path, as :meth:`~gendex.solve.articulated.HandlePrimitives.pull` runs a hooked
   handle, with the hand open: the target runs ahead of the measured joint position, so the palm keeps pushing.
 
@@ -145,8 +147,9 @@ def press_direction(joint: JointFrame, point_local: np.ndarray) -> np.ndarray:
 
 def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, sign: float) -> list[PressPose]:
     """Press poses of the moving link (its convex ``shape`` in the link frame) that push the point ``point_local``
-    towards opening (``sign`` +1) or closing (-1), in order of preference: palm presses before fingertip presses;
-    fingers along the hinge axis, then across it (towards the hinge, then away)."""
+    (moved by each of :data:`SHIFTS_M`) towards opening (``sign`` +1) or closing (-1), in order of preference: palm
+    presses before fingertip presses; then by contact point; fingers as :data:`FINGER_ANGLES_DEG` orders them; the
+    palm following as :data:`FOLLOWS` does."""
     rot_t = joint.link[:3, :3].T
     axis = rot_t @ joint.axis
     posed = shape.posed(np.eye(4))
