@@ -71,8 +71,10 @@ RETREAT_M = 0.08
 """After a handover the palm backs off this far against the push direction and rises as much."""
 FALL_STEPS = 40
 """Control steps the part gets to fall the rest of the way to the goal after the hand let go (2 s)."""
-PRE_M = 0.08
-"""Pre-pose: the press pose backed off this far from the surface."""
+PRE_M = (0.08, 0.14)
+"""Pre-poses tried: the press pose backed off this far from the surface (the further one is a fallback for where
+the open hand at the nearer one would touch the part; added for the microwave, whose failures turned out to be
+its layout, so no measured case needs it yet)."""
 PRESS_CLOSE_FRACTION = 0.85
 """A press that closes aims at this part of the open fraction the task's negated ``joint_open`` allows (the
 closed end is where the arm has the least room)."""
@@ -84,7 +86,8 @@ SHIFTS_M = ((0.0, 0.0), (0.08, 0.0), (-0.08, 0.0), (0.0, 0.012), (0.0, 0.025), (
 """Contact points tried: the grip point moved (along the hinge axis, away from the axis) by these distances (a
 door's bar is one place to push it, the door above and below the bar are others; a lever is pushed near its end
 or nearer its hub)."""
-INSERT_CHECKS = 4
+INSERT_STEP_M = 0.02
+"""IK checks along the straight move in, this far apart."""
 HAND_CLEAR_M = 0.005
 """The open hand keeps this far off the parts the press does not move (and the table) along the whole path."""
 CHAIN_RESTARTS = 3
@@ -308,15 +311,19 @@ class PressPrimitives(HandlePrimitives):
             ex.collision.set_obstacles(around)  # the pre-pose: the open hand clear of the whole part
             ex.collision.cover_hand(centres, radii)
             try:
-                q_pre = ex.ik.solve(pose.palm_at(joint, joint.q, PRE_M), q0, restarts=20, valid=ex.collision.is_free)
+                for pre in PRE_M:
+                    q_pre = ex.ik.solve(pose.palm_at(joint, joint.q, pre), q0, restarts=20,
+                                        valid=ex.collision.is_free)
+                    if q_pre is not None:
+                        break
             finally:
                 ex.collision.cover_hand(None)
             if q_pre is None:
                 log.debug("%s: pre-pose unreachable", pose)
                 continue
             ex.collision.set_obstacles(self._boxes(name, moving=True, inflate_m=0.0))  # then the arm alone
-            n = INSERT_CHECKS
-            q_in = self._chain([pose.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)], q_pre,
+            n = int(np.ceil(pre / INSERT_STEP_M))
+            q_in = self._chain([pose.palm_at(joint, joint.q, pre * (1 - k / n)) for k in range(1, n + 1)], q_pre,
                                CHAIN_RESTARTS)
             if q_in is None:
                 log.debug("%s: no straight motion in", pose)
@@ -324,12 +331,12 @@ class PressPrimitives(HandlePrimitives):
             if self._chain(self._arc(pose, joint, self._beyond(name, stop, sign)), q_in, CHAIN_RESTARTS) is None:
                 log.debug("%s: arm cannot follow the path", pose)
                 continue
-            chosen = (pose, q_pre, q0)
+            chosen = (pose, q_pre, q0, pre)
             break
         if chosen is None:
             raise ExecutionError(f"no press pose on {name!r}'s moving part that the arm can reach and follow along "
                                  f"its path", cause="no_ik")
-        pose, q_pre, q0 = chosen
+        pose, q_pre, q0, pre = chosen
         log.info("%r: %s", name, pose)
         self.grasp, self.target, self.hooked = pose, name, False
         ex.collision.set_obstacles(around)
@@ -346,7 +353,7 @@ class PressPrimitives(HandlePrimitives):
         else:
             yield from path
         back = joint.link[:3, :3] @ pose.normal_local
-        yield from ex.cartesian(-PRE_M * back, self.config.insert_m_per_step)
+        yield from ex.cartesian(-pre * back, self.config.insert_m_per_step)
         yield from ex.settle()
 
     def press(self, stage) -> Iterator[np.ndarray]:

@@ -110,6 +110,8 @@ def test_the_press_stops_where_gravity_takes_over_only_for_a_lid(make_env):
     ("TurnFaucet", "faucet", lambda f: f >= 0.8),
     ("CloseTrashCan", "trash_can", lambda f: f < 0.1),
     ("OpenTrashCan", "trash_can", lambda f: f >= 0.5),
+    ("OpenBoxLid", "box", lambda f: f >= 0.5),
+    ("CloseMicrowave", "microwave", lambda f: f < 0.1),
 ])
 def test_the_executor_presses_parts_no_stage_grasps(make_env, task, name, done):
     env = make_env(task)
