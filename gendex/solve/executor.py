@@ -156,14 +156,13 @@ class StageExecutor:
         if stage.target is None:
             raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it",
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
-        articulated = stage.target in self._env.articulations
-        table = RIGID_PRIMITIVES
-        if articulated:
-            table = ARTICULATED_PRIMITIVES if self._grasped(stage.target) else PRESS_PRIMITIVES
+        if stage.target not in self._env.articulations:
+            table, kind = RIGID_PRIMITIVES, "a rigid"
+        elif self._grasped(stage.target):
+            table, kind = ARTICULATED_PRIMITIVES, "a hooked articulated"
+        else:
+            table, kind = PRESS_PRIMITIVES, "an ungrasped articulated"
         if stage.skill not in table:
-            kind = "a rigid"
-            if articulated:
-                kind = "a hooked articulated" if self._grasped(stage.target) else "an ungrasped articulated"
             raise ExecutionError(f"stage {stage.name!r}: the executor has no primitive for skill {stage.skill!r} on "
                                  f"{kind} target ({stage.target!r}); skills it runs there: {sorted(table)}",
                                  cause="unsupported", stage=stage.name, skill=stage.skill)

@@ -481,7 +481,7 @@ class GraspSynthesizer:
         w = width(mid)
         if w is None or w <= PINCH_FIT_M:
             return None
-        for z in np.arange(mid, fp.top - 0.01, 0.005):
+        for z in np.arange(mid + 0.005, fp.top - 0.01, 0.005):
             w = width(float(z))
             if w is not None and w <= PINCH_FIT_M:
                 return float(z)

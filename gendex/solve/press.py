@@ -202,6 +202,12 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
     return out
 
 
+def _link_pose(link) -> np.ndarray:
+    """[4, 4] world pose of a ManiSkill link (first sub-scene)."""
+    pose = link.pose
+    return sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
+
+
 def _clear(palm: sapien.Pose, centres: np.ndarray, radii: np.ndarray, shapes: list[PosedShape],
            margin_m: float) -> bool:
     """Whether the hand's spheres (palm frame) at ``palm`` stay ``margin_m`` off every shape and the table."""
@@ -249,39 +255,39 @@ class PressPrimitives(HandlePrimitives):
         lo, hi = u.articulations[name].get_qlimits()[0, u.joint_index(name)].tolist()
         return float(np.clip(goal + sign * OVERSHOOT, lo, hi))
 
-    def _shape(self, name: str) -> ObjectShape:
-        link = self.motion.env.handle_link(name)
+    def _link_shape(self, name: str, link) -> ObjectShape | None:
+        """Convex parts of ``name``'s link ``link`` in its own frame (cached; None for a link without collision
+        shapes)."""
         key = (name, link.name)
         if key not in self._shapes:
-            self._shapes[key] = ObjectShape.of_actor(link)
+            try:
+                self._shapes[key] = ObjectShape.of_actor(link)
+            except ValueError:
+                self._shapes[key] = None
         return self._shapes[key]
+
+    def _shape(self, name: str) -> ObjectShape:
+        """The moving link's convex parts, in its own frame."""
+        link = self.motion.env.handle_link(name)
+        shape = self._link_shape(name, link)
+        if shape is None:
+            raise ExecutionError(f"{name!r}: the moving link {link.name!r} has no collision shapes to press",
+                                 cause="unsupported")
+        return shape
 
     def _fixed_shapes(self, name: str) -> list[PosedShape]:
         """World shapes of ``name``'s links that the pressed joint does not move."""
         moving = self.motion.env.handle_link(name).name
-        out = []
-        for link in self.motion.env.articulations[name].get_links():
-            if link.name == moving:
-                continue
-            key = (name, link.name)
-            if key not in self._shapes:
-                try:
-                    self._shapes[key] = ObjectShape.of_actor(link)
-                except ValueError:  # a link without collision shapes
-                    self._shapes[key] = None
-            if self._shapes[key] is not None:
-                pose = link.pose
-                m = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
-                out.append(self._shapes[key].posed(m))
-        return out
+        links = [k for k in self.motion.env.articulations[name].get_links() if k.name != moving]
+        return [shape.posed(_link_pose(link)) for link in links
+                if (shape := self._link_shape(name, link)) is not None]
 
     def _press_boxes(self, name: str) -> list[Box]:
         """Obstacles while the hand comes to the part: the fixed links' boxes and the moving link's convex parts,
         each covered by small boxes along it (:func:`rotated_box_cover`), all inflated 1 cm."""
         boxes = self._boxes(name, moving=True)
         link = self.motion.env.handle_link(name)
-        pose = link.pose
-        m = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
+        m = _link_pose(link)
         for part in self._shape(name).parts:
             boxes += rotated_box_cover(part.vertices.min(axis=0), part.vertices.max(axis=0), m, 0.01,
                                        name=f"{name}/{link.name}")

@@ -316,12 +316,8 @@ class OfflineBackend:
             a = assets[o["asset"]]
             # articulated objects anywhere at the back, movable ones where the solver measurably works (module
             # constant); overlaps and support are the critic's job
-            if o["role"] == "articulated":
-                (x0, x1), (y0, y1) = ARTICULATED_REGION_M
-                x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
-            else:
-                (x0, x1), (y0, y1) = MOVABLE_REGION_M
-                x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
+            (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else MOVABLE_REGION_M
+            x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
             entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
             if o["role"] == "articulated":
                 j = a["joints"][0]
