@@ -1,7 +1,9 @@
 """Can the solver pick up every graspable object of the catalog? Lift-and-hold success per object.
 
-For every catalog asset tagged ``graspable`` (rigid), ``--seeds`` attempts (seeds ``--seed`` ..): the object at a
-random pose in front of the robot (any yaw), the stage executor's reach and grasp (grasp synthesis over the
+For every catalog asset tagged ``graspable`` (rigid), ``--seeds`` attempts (seeds ``--seed`` ..): the object at the
+size a task holds it (scale 1, or scaled down to the hand's span where it is wider: a large bowl, a plate; see
+:func:`gendex.solve.lift_check.fitted_scale`; ``--catalog-scale`` measures scale 1 throughout), at a random pose in
+front of the robot (any yaw), the stage executor's reach and grasp (grasp synthesis over the
 object's geometry, physics-trial ranking, a 15 cm lift, one regrasp after a slip), then a 1 s hold. An attempt
 succeeds when the object ends >= 10 cm above where it lay, touched by the thumb and a finger
 (:mod:`gendex.solve.lift_check`). The issue's goal: >= 90 % for every object.
@@ -31,21 +33,22 @@ def graspable() -> list[str]:
     return [k for k, r in sorted(catalog().items()) if "graspable" in r.tags and not r.articulated]
 
 
-def run_object(job: tuple[str, list[int]]) -> dict:
+def run_object(job: tuple[str, list[int], bool]) -> dict:
     import torch
 
     from gendex.solve.lift_check import LiftChecker
 
     torch.set_num_threads(1)
-    asset, seeds = job
-    checker = LiftChecker(asset)
+    asset, seeds, catalog_scale = job
+    checker = LiftChecker(asset, scale=1.0 if catalog_scale else None)
     try:
         results = [checker(s) for s in seeds]
     finally:
         checker.close()
     held = [r for r in results if r.held]
     return {
-        "asset": asset, "attempts": len(results), "held": len(held), "rate": len(held) / len(results),
+        "asset": asset, "scale": checker.scale, "attempts": len(results), "held": len(held),
+        "rate": len(held) / len(results),
         "mean_trials": sum(r.trials for r in results) / len(results),
         "families": dict(Counter(r.grasp.split(" ")[0] for r in held)),
         "failures": dict(Counter(r.failure.cause for r in results if r.failure)),
@@ -55,12 +58,13 @@ def run_object(job: tuple[str, list[int]]) -> dict:
 
 
 def markdown(rows: list[dict]) -> str:
-    lines = ["| object | held | rate | grasps that held | failures | trials / attempt |", "|---|---|---|---|---|---|"]
+    lines = ["| object | scale | held | rate | grasps that held | failures | trials / attempt |",
+             "|---|---|---|---|---|---|---|"]
     for r in rows:
         fam = ", ".join(f"{k} {v}" for k, v in sorted(r["families"].items())) or "—"
         fail = ", ".join(f"{k} {v}" for k, v in sorted(r["failures"].items())) or "—"
-        lines.append(f"| `{r['asset']}` | {r['held']}/{r['attempts']} | {100 * r['rate']:.0f} % | {fam} | {fail} | "
-                     f"{r['mean_trials']:.1f} |")
+        lines.append(f"| `{r['asset']}` | {r['scale']:g} | {r['held']}/{r['attempts']} | {100 * r['rate']:.0f} % | "
+                     f"{fam} | {fail} | {r['mean_trials']:.1f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -70,6 +74,8 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--seed", type=int, default=7000, help="first seed (the grasp code was developed on 1000..1009)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--catalog-scale", action="store_true",
+                    help="every object at scale 1, also those wider than the hand (no task holds them at that size)")
     ap.add_argument("--json", type=Path, help="write the rows here")
     ap.add_argument("--markdown", type=Path, help="write a markdown table here")
     ap.add_argument("--record", action="store_true",
@@ -83,14 +89,17 @@ def main() -> None:
           f"{len(seeds)} seeds ({seeds[0]}..{seeds[-1]}), {args.workers} workers", flush=True)
     t0 = time.perf_counter()
     rows = []
-    jobs = [(a, seeds) for a in objects]
+    if args.record and args.catalog_scale:
+        ap.error("--record stores the rates at the scale tasks use; drop --catalog-scale")
+    jobs = [(a, seeds, args.catalog_scale) for a in objects]
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(args.workers) if args.workers > 1 else _Serial() as pool:
         for row in pool.imap(run_object, jobs):
             rows.append(row)
             fam = ", ".join(f"{k} {v}" for k, v in sorted(row["families"].items()))
             fail = ", ".join(f"{k} {v}" for k, v in sorted(row["failures"].items()))
-            print(f"{row['asset']:16s} {row['held']:3d}/{row['attempts']:<3d} {100 * row['rate']:5.1f} %  "
+            print(f"{row['asset']:16s} x{row['scale']:<5g} {row['held']:3d}/{row['attempts']:<3d} "
+                  f"{100 * row['rate']:5.1f} %  "
                   f"trials {row['mean_trials']:4.1f}  held by [{fam}]  failed [{fail}]  {row['seconds']:.0f} s",
                   flush=True)
     ok = [r for r in rows if r["rate"] >= 0.9]

@@ -43,6 +43,9 @@ from scipy.optimize import least_squares
 from gendex.solve.hand import FINGERS, PAD_ALONG_M, PAD_RADIUS_M, TIP_ALONG_M, HandModel, actuated
 from gendex.solve.shape import PosedShape
 
+HAND_SPAN_M = 0.09
+"""Widest object (smallest horizontal extent, m) the ShadowHand closes around reliably. Tasks fit a grasped object
+wider than this to the hand by scaling it down (:func:`hand_fit_scale`; the generator's size step does it)."""
 PALM_THICKNESS_M = 0.011
 """Distance from the palm link origin to the palm's skin along the palm normal."""
 GUARD_RAD = 0.2
@@ -116,6 +119,10 @@ MIDDLE_TUCKED = {"MFJ3": 0.0, "MFJ2": 1.4, "MFJ1": 1.2}
 TABLE_CLEARANCE_M = 0.0
 MAX_RAISE_M = 0.006
 """A pinch whose open hand would dip into the table by at most this much is raised clear of it."""
+RAISE_MARGIN_M = 1e-4
+"""...by this much more than the dip: raised exactly to the table, the pose's float32 rounding left about half of
+those hands a hair (~1e-8 m) below it, and the clearance check rejected them (a marker lying across the robot's view
+had no pinch at all)."""
 PAD_LIFT_M = 0.001
 """A pad's lowest point stays this far above the table: an object thinner than the pads is pinched at its edges by
 fingertips that skim the table."""
@@ -511,7 +518,7 @@ class GraspSynthesizer:
                 dip = self.table_z + TABLE_CLEARANCE_M - low
                 if dip > MAX_RAISE_M:
                     continue
-                palm = palm + np.array([0.0, 0.0, max(dip, 0.0)])
+                palm = palm + np.array([0.0, 0.0, max(dip + RAISE_MARGIN_M, 0.0)])
                 group = []
                 for rest in (TUCKED, STRAIGHT):
                     mid = {} if shape.middle else MIDDLE_TUCKED
@@ -524,10 +531,18 @@ class GraspSynthesizer:
                 yield group
 
 
+def hand_fit_scale(size_xy_m: tuple[float, float], scale: float = 1.0) -> float:
+    """The scale of an object of horizontal size ``size_xy_m`` (at scale 1) that fits the hand: ``scale`` when the
+    object is then at most :data:`HAND_SPAN_M` wide across its narrow side, else the scale that makes it that wide."""
+    narrow = min(size_xy_m)
+    return scale if narrow * scale <= HAND_SPAN_M else HAND_SPAN_M / narrow
+
+
 def object_heading(center_xy: np.ndarray, base_xy: np.ndarray) -> float:
     """Yaw (rad) from the robot base to an object: fingers pointing away from the base reach most easily."""
     return float(np.arctan2(center_xy[1] - base_xy[1], center_xy[0] - base_xy[0]))
 
 
-__all__ = ["FINGERS", "GUARD_RAD", "OPEN_HAND", "RELEASE_HAND", "GraspPlan", "GraspSynthesizer", "PinchLine",
-           "PinchShape", "axis_rotation", "headings", "object_heading", "palm_rotation", "pinch_shape", "pose_of"]
+__all__ = ["FINGERS", "GUARD_RAD", "HAND_SPAN_M", "OPEN_HAND", "RELEASE_HAND", "GraspPlan", "GraspSynthesizer",
+           "PinchLine", "PinchShape", "axis_rotation", "hand_fit_scale", "headings", "object_heading", "palm_rotation",
+           "pinch_shape", "pose_of"]

@@ -5,6 +5,11 @@
 (grasp synthesis, physics-trial ranking, the grasp primitive's 15 cm lift and its regrasp after a slip), then holds
 for :data:`HOLD_STEPS` control steps. It succeeds when the object ends at least :data:`MIN_RISE_M` above where it
 lay, touched by the thumb and at least one finger.
+
+The object is at the size a task holds it: an object wider than the hand across its narrow side (a 22 cm plate, a
+large bowl) is scaled down to :data:`~gendex.solve.grasp.HAND_SPAN_M` by :func:`~gendex.solve.grasp.hand_fit_scale`,
+exactly as the generator's size step fits every grasped object before a task is written. Pass ``scale`` to measure
+another size (``benchmarks/grasp.py --catalog-scale`` measures every object at scale 1).
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import torch
 
 from gendex.solve.executor import StageExecutor
 from gendex.solve.failure import Failure
+from gendex.solve.grasp import hand_fit_scale
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import TaskSpec, parse_task_spec
 
@@ -70,14 +76,26 @@ class LiftResult:
         return d
 
 
-class LiftChecker:
-    """Runs lift-and-hold attempts of one asset, keeping its env and executor between seeds."""
+def fitted_scale(asset: str) -> float:
+    """The scale a task grasps ``asset`` at: 1, or smaller where the object is wider than the hand (rounded to
+    three decimals, as the generator's size step writes it)."""
+    from gendex_envs.assets.catalog import catalog
 
-    def __init__(self, asset: str):
+    e = catalog()[asset].entry
+    size = np.subtract(e.bbox_max_m, e.bbox_min_m)
+    return round(hand_fit_scale((float(size[0]), float(size[1]))), 3)
+
+
+class LiftChecker:
+    """Runs lift-and-hold attempts of one asset, keeping its env and executor between seeds; the asset at
+    ``scale`` (default: :func:`fitted_scale`)."""
+
+    def __init__(self, asset: str, scale: float | None = None):
         from gendex_envs.task_env import TaskEnv
 
         self.asset = asset
-        self.env = TaskEnv(task_spec=lift_spec(asset), control_mode="pd_joint_pos", control_joint="both",
+        self.scale = fitted_scale(asset) if scale is None else scale
+        self.env = TaskEnv(task_spec=lift_spec(asset, self.scale), control_mode="pd_joint_pos", control_joint="both",
                            obs_mode="none", reward_mode="none")
         self.executor = StageExecutor()
 
@@ -132,7 +150,9 @@ def measured_graspable(min_rate: float = 0.9, path: Path = MEASURED_FILE) -> fro
 
 def write_record(rows: list[dict], seeds: list[int], path: Path = MEASURED_FILE) -> None:
     """Record a ``benchmarks/grasp.py`` run (what :func:`measured_graspable` reads)."""
-    record = {"what": "lift-and-hold per graspable catalog asset (gendex.solve.lift_check), benchmarks/grasp.py",
+    record = {"what": "lift-and-hold per graspable catalog asset at the scale a task holds it "
+                      "(gendex.solve.lift_check), benchmarks/grasp.py",
               "seeds": seeds,
-              "assets": {r["asset"]: {"held": r["held"], "attempts": r["attempts"]} for r in rows}}
+              "assets": {r["asset"]: {"held": r["held"], "attempts": r["attempts"], "scale": r["scale"]}
+                         for r in rows}}
     path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")

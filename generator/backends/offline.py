@@ -39,8 +39,6 @@ from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
 
 MODEL_ID = "gendex-offline-1"
-HAND_SPAN_M = 0.09
-"""Widest object (smallest horizontal extent) the ShadowHand closes around reliably; larger ones are scaled down."""
 
 _VERBS = {
     "lift": ("grab", "grasp", "pick", "lift", "hold", "take", "raise"),
@@ -125,7 +123,10 @@ def openable(a: dict) -> bool:
 
 
 def fits_in(g: dict, c: dict) -> bool:
-    return max(g["size_m"][:2]) * min(1.0, HAND_SPAN_M / _min_xy(g)) < 0.7 * _min_xy(c)
+    """Grasped object ``g``, fitted to the hand, fits in container ``c`` with room around it."""
+    from gendex.solve.grasp import hand_fit_scale
+
+    return max(g["size_m"][:2]) * hand_fit_scale(g["size_m"][:2]) < 0.7 * _min_xy(c)
 
 
 class OfflineBackend:

@@ -12,10 +12,10 @@ import dataclasses
 import json
 import logging
 
+from gendex.solve.grasp import HAND_SPAN_M, hand_fit_scale
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.spec import SCALE_RANGE, RobotSpec, TableSpec, TaskSpec, dump_task_spec, parse_task_spec
 from generator.backends.base import Backend
-from generator.backends.offline import HAND_SPAN_M
 from generator.catalog_view import asset_dict, asset_dicts, guidance
 from generator.critic.physical import REACH_MAX_M
 from generator.errors import RetriesExhaustedError, SceneError
@@ -44,8 +44,8 @@ def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
     for o in spec.objects:
         role = roles.get(o.name)
         s = scales[o.name]
-        if role == "graspable" and min(size[o.name][:2]) * s > HAND_SPAN_M:
-            scales[o.name] = _clamp_scale(HAND_SPAN_M / min(size[o.name][:2]))
+        if role == "graspable" and hand_fit_scale(size[o.name][:2], s) != s:
+            scales[o.name] = _clamp_scale(hand_fit_scale(size[o.name][:2], s))
         elif role == "articulated" and size[o.name][2] * s > MAX_ARTICULATED_HEIGHT_M:
             scales[o.name] = _clamp_scale(MAX_ARTICULATED_HEIGHT_M / size[o.name][2])
     held = [n for n, r in roles.items() if r == "graspable" and n in scales]

@@ -42,7 +42,7 @@ def test_guided_proposal_substitutes_the_closest_catalog_object():
 def test_composed_reward_modules_pass_the_static_validator_for_every_skill():
     b = OfflineBackend(seed=0)
     kinds = set()
-    for i, p in enumerate(_proposals(0, 30)):
+    for i, p in enumerate(_proposals(0, 60)):
         ids = {o.asset for o in p.objects}
         context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
                    "candidate_index": 0, "index": i, "attempt": 0}
@@ -62,7 +62,8 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
 
     held = measured_graspable()
     assert {"fork", "knife", "wrench"}.isdisjoint(held)  # 0/20 in the committed record
-    rows = [{"asset": "apple", "held": 19, "attempts": 20}, {"asset": "fork", "held": 3, "attempts": 20}]
+    rows = [{"asset": "apple", "held": 19, "attempts": 20, "scale": 1.0},
+            {"asset": "fork", "held": 3, "attempts": 20, "scale": 1.0}]
     write_record(rows, [1, 2], tmp_path / "rec.json")
     assert measured_rates(tmp_path / "rec.json") == {"apple": 0.95, "fork": 0.15}
     assert measured_graspable(0.9, tmp_path / "rec.json") == {"apple"}
@@ -82,3 +83,31 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
     for obj in spec["objects"]:
         r = obj["randomize"]
         assert min(r["xy_m"]) >= (0.05 if obj.get("fixed") else 0.08) and r["yaw_deg"] >= 15.0, obj
+
+
+def test_the_size_step_fits_a_grasped_object_to_the_hand_as_the_grasp_benchmark_measures_it():
+    """A grasped object wider than the hand is written at the scale ``benchmarks/grasp.py`` measured it at: one rule
+    (:func:`gendex.solve.grasp.hand_fit_scale`) serves both, so the measured rates are those of the tasks' objects."""
+    import pytest
+
+    from gendex.solve.grasp import HAND_SPAN_M, hand_fit_scale
+    from gendex.solve.lift_check import fitted_scale
+    from gendex_envs.spec import parse_task_spec
+    from generator.records import Proposal, ProposedObject, ProposedStep
+
+    assert hand_fit_scale((0.05, 0.3)) == 1.0
+    assert hand_fit_scale((0.3, 0.22)) == pytest.approx(HAND_SPAN_M / 0.22)
+    assert hand_fit_scale((0.3, 0.22), scale=0.3) == 0.3  # already small enough: kept
+    assert fitted_scale("apple") == 1.0
+    size = next(d for d in asset_dicts() if d["id"] == "plate")["size_m"]
+    assert fitted_scale("plate") == round(HAND_SPAN_M / min(size[:2]), 3) < 0.5
+    spec = parse_task_spec({
+        "name": "LiftPlate", "instruction": "Lift the plate.",
+        "objects": [{"name": "plate", "asset": "plate", "pos_m": [0.1, 0.0, 0.0]}],
+        "stages": [{"name": "grasp", "instruction": "Grasp the plate.", "skill": "grasp", "control_joint": "both",
+                    "method": "motion_planning", "target": "plate"}],
+        "success": {"description": "The plate is lifted.",
+                    "conditions": [{"type": "lifted", "object": "plate", "min_height_m": 0.1}]}})
+    proposal = Proposal("LiftPlate", "Lift the plate.", (ProposedObject("plate", "plate", "graspable"),),
+                        (ProposedStep("grasp", "plate", "both", "Grasp the plate."),), {}, "lifted")
+    assert adjust_sizes(spec, proposal).objects[0].scale == fitted_scale("plate")
