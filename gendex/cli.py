@@ -279,6 +279,17 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
             return ReplayBackend(pending.pop(0))
         return make_backend(name, seed=seed, model=model)
 
+    if instruction is not None:  # how the request was read, before anything runs: substitutions are never silent
+        from generator.catalog_view import asset_dicts
+        from generator.instruction import read_instruction
+
+        try:
+            reading = read_instruction(instruction, asset_dicts())
+        except GenDexError as exc:
+            _die(exc)
+        for line in reading.lines():
+            typer.secho(line, fg=typer.colors.YELLOW if "SUBSTITUTED" in line or " chose " in line else None,
+                        err=True)
     command = _command("generate")
     rows = []
     try:
@@ -296,6 +307,9 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         dropped = f" ({s.proposals_tried - 1} earlier proposal(s) dropped)" if s.proposals_tried > 1 else ""
         typer.echo(f"  {s.committed.env_id}: {s.violations_before} -> {s.violations_after} violations in "
                    f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.root}")
+        for phrase, asset in s.substitutions.items():
+            typer.secho(f"    substituted: {phrase!r} -> {asset} (recorded in the task's proposal record)",
+                        fg=typer.colors.YELLOW)
 
 
 @app.command()

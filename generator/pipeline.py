@@ -22,7 +22,9 @@ from gendex_envs.spec import dump_task_spec
 from gendex_envs.task_version import TaskLayout, TaskVersion, clean_drafts, new_draft, publish
 from generator.backends.base import Backend
 from generator.backends.transcript import RecordingBackend
+from generator.catalog_view import asset_dicts
 from generator.errors import GeneratorError
+from generator.instruction import Reading, read_instruction
 from generator.records import GenerationInfo, to_json
 from generator.render import render_spec
 from generator.steps.plan import plan_stages
@@ -57,6 +59,8 @@ class TaskSummary:
     seconds: float
     proposals_tried: int = 1
     """Proposals this task took: a scene refinement could not make sound is dropped and a new task proposed."""
+    substitutions: dict[str, str] = dataclasses.field(default_factory=dict)
+    """Requested object -> catalog asset used instead (human-guided mode; also in the proposal record)."""
 
 
 def author_name(backend: Backend) -> str:
@@ -88,9 +92,13 @@ def _existing_names(root: Path) -> tuple[str, ...]:
 
 def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: int, seed: int,
                   instruction: str | None, command: str, existing: tuple[str, ...] = (),
-                  candidates: int = N_CANDIDATES) -> TaskSummary:
-    """Generate, validate and commit one task with a fresh ``backend_factory()``, recording every exchange."""
+                  candidates: int = N_CANDIDATES, reading: Reading | None = None) -> TaskSummary:
+    """Generate, validate and commit one task with a fresh ``backend_factory()``, recording every exchange. With an
+    ``instruction``: its ``reading`` (read here when not given; :class:`~generator.instruction.InstructionError`
+    before anything is written when it asks for what GenDex cannot do)."""
     t0 = time.perf_counter()
+    if instruction is not None and reading is None:
+        reading = read_instruction(instruction, asset_dicts())
     draft = new_draft(root)
     files = TaskLayout(draft)
     try:
@@ -99,7 +107,9 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
         reasons: list[str] = []
         for attempt in range(MAX_TASK_ATTEMPTS):
             proposal, rejected = propose(backend, index=index + 1000 * attempt, existing=existing,
-                                         instruction=instruction)
+                                         instruction=instruction, reading=reading)
+            for phrase, asset in proposal.substitutions.items():
+                log.warning("task %d: %r is not in the catalog as asked; using %s instead", index, phrase, asset)
             reasons += rejected
             spec, scenes = write_scene(backend, proposal, index=index + 1000 * attempt, n_candidates=candidates)
             before = render_spec(spec, seed=seed)
@@ -141,7 +151,8 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
             source.assert_consumed()  # a replay must use every recorded exchange
         committed = publish(root, proposal.name, draft, required=files.generated)
         return TaskSummary(committed, tuple(c.score for c in scenes), refine_log.violations_before,
-                           refine_log.violations_after, len(refine_log.rounds), time.perf_counter() - t0, attempt + 1)
+                           refine_log.violations_after, len(refine_log.rounds), time.perf_counter() - t0, attempt + 1,
+                           dict(proposal.substitutions))
     finally:
         if draft.exists():
             shutil.rmtree(draft, ignore_errors=True)
@@ -151,13 +162,14 @@ def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, 
              instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None,
              candidates: int = N_CANDIDATES) -> list[TaskSummary]:
     """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again."""
+    reading = None if instruction is None else read_instruction(instruction, asset_dicts())
     root.mkdir(parents=True, exist_ok=True)
     clean_drafts(root)
     out: list[TaskSummary] = []
     existing = _existing_names(root)
     for i in range(n):
         summary = generate_task(backend_factory, root, index=i, seed=seed, instruction=instruction,
-                                command=command, existing=existing, candidates=candidates)
+                                command=command, existing=existing, candidates=candidates, reading=reading)
         existing = (*existing, summary.committed.name)
         out.append(summary)
         if progress is not None:

@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 ROLES = ("graspable", "container", "articulated", "support")
-PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "near")
+PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "near", "over")
 """Success condition types a proposal may state (the task's success; stages get theirs in the plan step)."""
 
 
@@ -46,7 +46,10 @@ class Proposal:
     instruction: str | None = None
     """The human instruction this proposal answers (human-guided mode), else None."""
     substitutions: dict[str, str] = field(default_factory=dict)
-    """Requested object -> catalog asset used instead (human-guided mode)."""
+    """Requested object -> catalog asset used instead (human-guided mode): the catalog lacked it, or the request
+    named only a kind of object ('a fruit'), or the backend chose another object than the one named."""
+    reading: dict[str, Any] | None = None
+    """How the instruction was read before any backend was asked (:class:`generator.instruction.Reading`)."""
 
 
 @dataclass(frozen=True)

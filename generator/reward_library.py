@@ -32,6 +32,26 @@ _FAIL_NONE = '''    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=en
 
 
 
+_PUSH = '''REWARD_MAX = 3.0
+
+
+def evaluate(env):
+{fail}    return {{"fail": fail}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    reward = reach + 2.0 * rt.place(p, env.goal_pos)
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"obj_to_goal": env.goal_pos - env.obj_pose({obj!r}).p}}
+'''
+"""Reward of a push: the palm to the object, the object to the goal mark (format with ``fail`` and ``obj``)."""
+
+
 def _success_condition(spec: dict) -> dict:
     return spec["success"]["conditions"][0]
 
@@ -56,7 +76,9 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
     src = _HEADER.format(title=title)
-    if kind in ("open", "push", "close"):
+    if kind == "push" or (cond.get("target") == "goal" and kind not in ("open", "close", "turn")):
+        return src + _PUSH.format(fail=fail, obj=obj)
+    if kind in ("open", "close", "turn"):
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
         progress = ('(1.0 - info["open_fraction"]) / (1.0 - OPEN_FRACTION)' if kind == "close"
@@ -155,6 +177,10 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
     src = _HEADER.format(title=f"{spec['name']}: {spec['instruction']}")
     obj = cond["object"]
     if cond["type"] == "joint_open":
+        # a shut joint (negated condition) progresses from open (0) to shut past the fraction (1)
+        frac = float(cond.get("min_fraction") or 0.8)
+        progress = (f'(1.0 - info["open_fraction"]) / {1.0 - frac!r}' if cond.get("negate")
+                    else 'info["open_fraction"]')
         src += f'''REWARD_MAX = 4.0
 
 
@@ -164,7 +190,7 @@ def evaluate(env):
 
 def compute_dense_reward(env, obs, action, info):
     reach = rt.reach(torch.linalg.norm(env.palm_pose.p - env.handle_pos({obj!r}), dim=-1))
-    reward = reach + 2.0 * rt.fraction(info["open_fraction"])
+    reward = reach + 2.0 * rt.fraction({progress})
     return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
 
 
@@ -173,8 +199,10 @@ def _get_obs_extra(env, info):
 '''
         return src
     target = cond.get("target")
+    if target == "goal":  # a push: the object towards the goal mark, never lifted
+        return src + _PUSH.format(fail=fail, obj=obj)
     carry = (f'    carry = rt.place(p, env.obj_pose({target!r}).p) * (lifted > 0.5)\n'
-             if target and target != "goal" else "    carry = torch.zeros_like(reach)\n")
+             if target else "    carry = torch.zeros_like(reach)\n")
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1
 

@@ -3,8 +3,9 @@
 A stage's success is data in the spec (``stages[k].success``, :mod:`gendex_envs.success`). The templates below
 follow the reference tasks: a grasp holds the target with the thumb against two fingers (a hook on a handle: three
 fingers, no thumb), a lift holds it at the task's lift height, a release leaves the task's success met with the hand
-let go, an open or close moves the joint past the task's fraction. Skills without a template (reach, carry, place,
-push, turn, reorient) declare nothing, so the stage succeeds with the task.
+let go, an open, close or turn moves the joint past the task's fraction, a push meets the task's condition on the pushed
+object. Skills without a template (reach, carry, place, reorient) declare nothing, so the stage succeeds with the
+task.
 """
 
 from __future__ import annotations
@@ -42,8 +43,10 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         return [dict(HELD, object=target), {"type": "lifted", "object": target, "min_height_m": h}]
     if skill == "release":
         return [*(dict(c) for c in task_conditions), {"type": "grasped", "object": target, "negate": True}]
-    if skill in ("open", "close"):
+    if skill in ("open", "close", "turn"):
         frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
         cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
         return [cond | {"negate": True}] if skill == "close" else [cond]
+    if skill == "push":  # the task's own condition on the pushed object (near the goal mark)
+        return [dict(c) for c in task_conditions if c.get("object") == target] or None
     return None

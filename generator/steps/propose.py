@@ -7,19 +7,31 @@ condition is one GenDex can evaluate. A failed check is fed back to the backend,
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 from gendex_envs.errors import suggest
-from gendex_envs.spec import CONTROL_JOINT_MODES, SKILL_MEANINGS, SKILLS, SNAKE_NAME_RE, TASK_NAME_RE
+from gendex_envs.spec import (
+    CONTROL_JOINT_MODES,
+    GOAL_TARGET,
+    SKILL_MEANINGS,
+    SKILLS,
+    SNAKE_NAME_RE,
+    TASK_NAME_RE,
+)
 from generator.backends.base import Backend
 from generator.catalog_view import asset_dicts, guidance
 from generator.errors import ProposalError, RetriesExhaustedError
+from generator.instruction import Reading, skill_vocabulary
 from generator.records import PROPOSAL_CONDITION_TYPES, ROLES, Proposal, ProposedObject, ProposedStep
 from generator.steps.common import ask, parse_json_block
 
 log = logging.getLogger(__name__)
 
 MAX_OBJECTS = 3
+SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
+                "min_dz_m", "max_dz_m")
+"""Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut)."""
 
 
 def skill_list() -> str:
@@ -83,34 +95,56 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
                             f"{list(PROPOSAL_CONDITION_TYPES)}")
     if succ.get("object") not in names:
         raise ProposalError(f"success.object {succ.get('object')!r} is not a proposed object; objects: {names}")
-    if succ["type"] in ("inside", "near") and succ.get("target") not in names:
+    targets = names + [GOAL_TARGET] if succ["type"] == "near" else names
+    if succ["type"] in ("inside", "near", "over") and succ.get("target") not in targets:
         raise ProposalError(f"success.target {succ.get('target')!r} must name a proposed object for a "
-                            f"{succ['type']!r} condition; objects: {names}")
+                            f"{succ['type']!r} condition; allowed: {targets}")
     if succ["type"] == "joint_open" and not assets[objects[names.index(succ["object"])].asset]["joints"]:
         raise ProposalError(f"success: joint_open needs an articulated object, {succ['object']!r} is rigid")
     subs = raw.get("substitutions") or {}
     return Proposal(name=name, description=str(raw["description"]), objects=tuple(objects), steps=tuple(steps),
-                    success={k: v for k, v in succ.items() if k in ("type", "object", "target", "min_height_m",
-                                                                      "min_fraction", "max_dist_m")},
+                    success={k: v for k, v in succ.items() if k in SUCCESS_KEYS},
                     success_text=str(raw["success_text"]), instruction=instruction,
                     substitutions={str(k): str(v) for k, v in subs.items()} if isinstance(subs, dict) else {})
 
 
+def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
+    """``proposal`` with the reading recorded and every substitution named: the reading's own (objects the catalog
+    lacks, kinds it chose from) and any object the backend used instead of the one the person named."""
+    subs = dict(reading.substitutions)
+    used = [o.asset for o in proposal.objects]
+    for m in reading.objects:
+        if not m.substituted and m.asset and not set(m.options or (m.asset,)) & set(used):
+            other = [a for a in used if a not in {x.asset for x in reading.objects}]
+            subs[m.phrase] = other[0] if other else "(left out)"
+    for phrase, asset in proposal.substitutions.items():
+        subs.setdefault(phrase, asset)
+    return dataclasses.replace(proposal, substitutions=subs, reading=reading.to_dict())
+
+
 def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (), instruction: str | None = None,
-            max_attempts: int = 3) -> tuple[Proposal, list[str]]:
-    """Ask for a proposal until one passes :func:`parse_proposal`; returns it and the rejection reasons on the way."""
+            reading: Reading | None = None, max_attempts: int = 3) -> tuple[Proposal, list[str]]:
+    """Ask for a proposal until one passes :func:`parse_proposal`; returns it and the rejection reasons on the way.
+    With an ``instruction``, pass its ``reading`` (:func:`generator.instruction.read_instruction`; read here when
+    not given): the backend sees it, and the proposal records it with every substitution."""
     prompt = "propose" if instruction is None else "propose_guided"
     variables = dict(asset_guidance=guidance(), existing_tasks="\n".join(f"- {n}" for n in existing) or "- (none)",
                      skills=skill_list(), condition_types=", ".join(PROPOSAL_CONDITION_TYPES),
                      control_joints=", ".join(CONTROL_JOINT_MODES))
     if instruction is not None:
-        variables["instruction"] = instruction
+        if reading is None:
+            from generator.instruction import read_instruction
+
+            reading = read_instruction(instruction, asset_dicts())
+        variables |= dict(instruction=instruction, task_skills=skill_vocabulary(),
+                          reading="\n".join(reading.lines()))
     reasons: list[str] = []
     for attempt in range(max_attempts):
         context = {"assets": list(asset_dicts()), "existing_tasks": list(existing), "index": index,
                    "attempt": attempt}
         if instruction is not None:
             context["instruction"] = instruction
+            context["reading"] = reading.to_dict()
         answer = ask(backend, prompt, context=context, feedback=reasons[-1] if reasons else "", **variables)
         try:
             proposal = parse_proposal(answer, instruction)
@@ -121,6 +155,8 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
         if proposal.name in existing:
             reasons.append(f"task name {proposal.name!r} already exists; choose a new task or name")
             continue
+        if reading is not None:
+            proposal = with_reading(proposal, reading)
         return proposal, reasons
     raise RetriesExhaustedError(f"no valid proposal after {max_attempts} attempts; last reason: {reasons[-1]}")
 

@@ -42,8 +42,14 @@ def test_manifest_that_disagrees_with_its_template_is_rejected(tmp_path):
         load_manifest(tmp_path)
 
 
-def test_rendered_guided_prompt_carries_the_instruction_and_the_library():
+def test_rendered_guided_prompt_carries_the_instruction_the_skills_the_reading_and_the_library():
+    from generator.catalog_view import asset_dicts
+    from generator.instruction import read_instruction, skill_vocabulary
+
+    reading = "\n".join(read_instruction("grab the apple", asset_dicts()).lines())
     text = render("propose_guided", instruction="grab the apple", asset_guidance="- apple | apple",
                   existing_tasks="- (none)", skills="  - reach: ...", condition_types="lifted",
-                  control_joints="arm, hand")
+                  control_joints="arm, hand", task_skills=skill_vocabulary(), reading=reading)
     assert '"grab the apple"' in text and "- apple | apple" in text and "{{" not in text
+    assert "'apple' is apple" in text  # the reading
+    assert "close: close, shut" in text and "turn on the faucet" in text  # the vocabulary of every task skill

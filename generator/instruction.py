@@ -1,0 +1,430 @@
+"""Reading a person's request: which task skill it asks for, and which catalog objects it names.
+
+``gendex generate --instruction "..."`` starts here, before any backend is asked anything. :func:`read_instruction`
+finds the skill from the verb (and its preposition: *put X in Y* is not *put X on Y*) and resolves every object
+phrase against the catalog — multi-word names (*tuna can*, *trash can*), plurals, synonyms (*fridge*, *cupboard*,
+*bin*, *tap*), parts (*the top drawer*) and kinds (*a fruit*, *a ball*). Nothing is silent:
+
+- a phrase resolved to a catalog object is recorded with how it was resolved (:class:`Mention`);
+- a named object the catalog lacks is replaced by the closest one that can play its role, and the replacement is a
+  *substitution*: the CLI prints it and the task's proposal record keeps it;
+- a verb GenDex has no skill for, or an object that cannot play the part the verb needs (*open the apple*), raises
+  :class:`InstructionError` listing what is possible; ``gendex generate`` exits non-zero with that message.
+
+The skills are those of the solver (:data:`TASK_SKILLS`, the thirteen of ``docs/solving.md``); the same vocabulary
+goes into the language-model backend's proposal prompt (:func:`skill_vocabulary`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+from generator.errors import GeneratorError
+
+
+class InstructionError(GeneratorError, ValueError):
+    """A request GenDex cannot turn into a task: a verb outside its skills, or an object that cannot play the part
+    the verb needs. The message lists what is possible."""
+
+
+@dataclass(frozen=True)
+class TaskSkill:
+    """One thing a person can ask for."""
+
+    name: str
+    verbs: tuple[str, ...]
+    """Verb phrases that ask for it (lower case, matched on word boundaries)."""
+    objects: str
+    """What it acts on, in words (for messages and prompts)."""
+    example: str
+
+
+TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
+    TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get"),
+              "a graspable object", "pick up the apple"),
+    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer"),
+              "a graspable object and a container (bowl, pot, mug), with 'in' or 'into'", "put the lemon in the bowl"),
+    TaskSkill("place_on", ("set", "put", "place", "lay", "move"),
+              "a graspable object and a plate, with 'on' or 'onto'", "set the bottle on the plate"),
+    TaskSkill("stack", ("stack", "pile"), "two blocks", "stack the small block on the large block"),
+    TaskSkill("push", ("push", "slide", "shove", "nudge"), "an object on the table, pushed to a goal mark",
+              "push the block to the goal"),
+    TaskSkill("open", ("open", "pull open", "lift open", "unlatch", "raise the lid"),
+              "a door, drawer or lid (cabinet, microwave, refrigerator, drawer chest, trash can, box with lid)",
+              "open the top drawer"),
+    TaskSkill("close", ("close", "shut", "push shut", "push closed"),
+              "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
+    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing"), "a faucet lever",
+              "turn on the faucet"),
+    TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
+              "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
+)}
+"""The task skills a request may ask for, in the order verbs are tried (earlier skills win ties)."""
+
+SYNONYMS: dict[str, str] = {
+    # phrase -> catalog category (or id)
+    "fridge": "refrigerator", "refrigerator": "refrigerator", "cupboard": "cabinet", "cabinet": "cabinet",
+    "closet": "cabinet", "trash can": "trash_can", "trashcan": "trash_can", "trash bin": "trash_can",
+    "bin": "trash_can", "garbage can": "trash_can", "dustbin": "trash_can", "waste bin": "trash_can",
+    "tap": "faucet", "faucet": "faucet", "mixer tap": "faucet", "drawer": "drawer_chest", "drawers": "drawer_chest",
+    "dresser": "drawer_chest", "chest of drawers": "drawer_chest", "microwave oven": "microwave",
+    "coffee mug": "mug", "cup": "cup", "glass": "wine_glass", "wineglass": "wine_glass", "jug": "pitcher",
+    "saucepan": "pot", "pan": "pot", "cooking pot": "pot", "dish": "plate", "saucer": "plate", "cube": "block",
+    "brick": "foam_brick", "die": "dice", "notebook": "laptop", "computer": "laptop", "lidded box": "box_with_lid",
+    "box with a lid": "box_with_lid", "rubik's cube": "rubiks_cube", "rubik cube": "rubiks_cube",
+    "bottle of mustard": "mustard_bottle", "soup can": "can", "tin": "can", "tin can": "can", "duck": "toy_duck",
+    "rubber duck": "toy_duck", "pen": "marker", "felt pen": "marker", "dial": "knob",
+}
+"""Words people use for catalog objects: phrase -> catalog category or id."""
+
+KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block": "block", "food": "food",
+                         "tool": "tool", "utensil": "utensil", "container": "container", "box": "box",
+                         "thing": "graspable", "object": "graspable", "item": "graspable"}
+"""Words naming a kind of object (a catalog tag): 'a fruit' is any fruit; which one is a recorded choice."""
+
+PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab")
+"""Words naming the part of an articulated object a skill acts on (recorded, never an object on their own)."""
+ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom", "first": "top", "second": "second"}
+
+_STOP = frozenset("a an the this that these those its it of to from with by and then please robot hand your my "
+                  "up down off out over at for some one".split())
+_INTO = ("into", "in", "inside")
+_ONTO = ("onto", "on", "on top of", "upon")
+
+
+@dataclass(frozen=True)
+class Mention:
+    """An object phrase of the request and the catalog asset it stands for."""
+
+    phrase: str
+    """The words as the person wrote them (lower case, articles dropped)."""
+    asset: str
+    how: str
+    """``id`` (a catalog id), ``name`` (a catalog name: multi-word, plural), ``synonym``, ``kind`` (a kind of object:
+    the asset is a choice) or ``substitute`` (the catalog lacks it: the closest object that can play the part)."""
+    part: str | None = None
+    """The part named with it (``door``, ``drawer``, ``lid``; ``top drawer`` -> ``drawer``), if any."""
+    detail: str = ""
+    options: tuple[str, ...] = ()
+    """Every asset the phrase names that can play its part (``fridge``: both refrigerators); :attr:`asset` is the
+    first. A task using another of them keeps the person's meaning; any other asset is a substitution."""
+
+    @property
+    def substituted(self) -> bool:
+        return self.how in ("substitute", "kind")
+
+
+@dataclass(frozen=True)
+class Reading:
+    """What a request asks for."""
+
+    instruction: str
+    skill: str
+    """A key of :data:`TASK_SKILLS`."""
+    objects: tuple[Mention, ...]
+    """In the order of their roles (the thing acted on first, then the container, plate or base)."""
+    notes: tuple[str, ...] = field(default=())
+    """Parts of the request that shape nothing (``the top drawer``: the drawer the solver opens is the first)."""
+
+    @property
+    def substitutions(self) -> dict[str, str]:
+        """Phrase -> asset for every object the catalog lacked (or a kind that was chosen from)."""
+        return {m.phrase: m.asset for m in self.objects if m.substituted}
+
+    def lines(self) -> list[str]:
+        """Human-readable account of the reading (what the CLI prints)."""
+        out = [f'"{self.instruction}" -> skill {self.skill!r}']
+        for m in self.objects:
+            verb = {"id": "is", "name": "is", "synonym": "means", "kind": "chose", "substitute": "SUBSTITUTED"}[m.how]
+            out.append(f"  {m.phrase!r} {verb} {m.asset}" + (f" ({m.detail})" if m.detail else ""))
+        out += [f"  note: {n}" for n in self.notes]
+        return out
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self) | {"substitutions": self.substitutions}
+
+
+def skill_vocabulary() -> str:
+    """The task skills with their verbs, objects and an example (one per line, for prompts and messages)."""
+    return "\n".join(f"  - {s.name}: {', '.join(s.verbs[:5])} — {s.objects} (e.g. \"{s.example}\")"
+                     for s in TASK_SKILLS.values())
+
+
+# ---------------------------------------------------------------------------------------------- roles
+def is_graspable(a: dict) -> bool:
+    return "graspable" in a["tags"] and not a.get("joints")
+
+
+def is_container(a: dict) -> bool:
+    return "container" in a["tags"] and not a.get("joints") and a["category"] not in ("cup", "wine_glass", "jar")
+
+
+def is_plate(a: dict) -> bool:
+    return a["category"] == "plate"
+
+
+def is_block(a: dict) -> bool:
+    return "block" in a["tags"] and not a.get("joints")
+
+
+def part_kinds(a: dict) -> tuple[str, ...]:
+    """The kinds of movable part an articulated asset has (``door``, ``drawer``, ``lid``, ``lever``, ``knob``)."""
+    kinds = []
+    for j in a.get("joints") or []:
+        link = j.get("handle_link") or j["name"]
+        kinds.append(next((p for p in ("door", "drawer", "lid", "lever", "knob", "rack") if p in link), "part"))
+    return tuple(kinds)
+
+
+ROLE_TESTS = {
+    "graspable": is_graspable, "container": is_container, "plate": is_plate, "block": is_block,
+    "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
+    "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
+    "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
+    "ball": lambda a: "ball" in a["tags"] and not a.get("joints"),
+}
+"""What an object must be to play each role."""
+
+SKILL_ROLES: dict[str, tuple[str, ...]] = {
+    "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "plate"),
+    "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
+    "turn": ("turnable",), "reorient": ("ball",),
+}
+"""The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
+
+
+# ---------------------------------------------------------------------------------------------- reading
+def _words(text: str) -> list[str]:
+    return re.findall(r"[a-z0-9']+", text.lower().replace("-", " "))
+
+
+def _find(words: Sequence[str], phrase: str, start: int = 0) -> int:
+    """Index of ``phrase`` (words) in ``words`` at or after ``start``, else -1."""
+    p = phrase.split()
+    for i in range(start, len(words) - len(p) + 1):
+        if list(words[i:i + len(p)]) == p:
+            return i
+    return -1
+
+
+def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
+    """Phrase -> (how, assets it names): ids and categories with their words spaced, plurals, synonyms."""
+    assets = sorted(assets, key=lambda a: (a["id"] != a["category"], a["id"]))
+    out: dict[str, tuple[str, list[dict]]] = {}
+
+    def add(phrase: str, how: str, match: list[dict]) -> None:
+        if match and phrase not in out:
+            out[phrase] = (how, match)
+
+    for a in assets:
+        add(a["id"].replace("_", " "), "id", [a])
+        cat, aid = a["category"], a["id"]
+        if aid.startswith(cat + "_"):  # block_small -> 'small block', trash_can_tall -> 'tall trash can'
+            add(f"{aid[len(cat) + 1:].replace('_', ' ')} {cat.replace('_', ' ')}", "id", [a])
+    for a in assets:
+        cat = a["category"]
+        same = [b for b in assets if b["category"] == cat]
+        for phrase in (cat.replace("_", " "), cat.replace("_", "")):
+            add(phrase, "name", same)
+            add(phrase + ("es" if phrase.endswith(("s", "x", "ch")) else "s"), "name", same)
+    for phrase, target in SYNONYMS.items():
+        match = [b for b in assets if target in (b["category"], b["id"])]
+        add(phrase, "synonym", match)
+    return out
+
+
+def _spans(words: list[str], names: dict[str, tuple[str, list[dict]]]) -> list[tuple[int, int, str]]:
+    """Non-overlapping (start, end, phrase) of catalog phrases in ``words``, longest first."""
+    taken = [False] * len(words)
+    found = []
+    for phrase in sorted(names, key=lambda p: -len(p.split())):
+        n = len(phrase.split())
+        i = _find(words, phrase)
+        while i >= 0:
+            if not any(taken[i:i + n]):
+                found.append((i, i + n, phrase))
+                taken[i:i + n] = [True] * n
+            i = _find(words, phrase, i + 1)
+    return sorted(found)
+
+
+def _skill(words: list[str], text: str) -> tuple[str, int] | None:
+    """The skill the request's verb asks for and where the verb ends; None when no verb of any skill is there."""
+    hits = []
+    for s in TASK_SKILLS.values():
+        for v in s.verbs:
+            i = _find(words, v)
+            if i >= 0:
+                hits.append((i, -len(v.split()), s.name, i + len(v.split())))
+    if not hits:
+        return None
+    hits.sort()
+    first = hits[0][0]
+    names = [h[2] for h in hits if h[0] == first]
+    end = hits[0][3]
+    rest = " " + " ".join(words[end:]) + " "
+    if "close" in names or " shut " in rest or rest.rstrip().endswith(" closed"):
+        return "close", end
+    if "put_in" in names or "place_on" in names:
+        into = any(f" {p} " in rest for p in _INTO)
+        onto = any(f" {p} " in rest for p in _ONTO)
+        if "on top of" in rest or (onto and not into):
+            return "place_on", end
+        if into:
+            return "put_in", end
+        return ("place_on" if "place_on" in names else "put_in"), end
+    if "turn" in names and "reorient" in names:
+        return "turn", end
+    return names[0], end
+
+
+def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
+    """Read ``instruction`` against the catalog ``assets`` (see the module docstring); :class:`InstructionError`
+    when it asks for something outside the skills or names objects that cannot play their parts."""
+    text = " ".join(instruction.split())
+    if not text:
+        raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
+                               + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
+    words = _words(text)
+    found = _skill(words, text)
+    if found is None:
+        raise InstructionError(f'"{text}" names no skill GenDex can perform. Possible requests:\n'
+                               + skill_vocabulary())
+    skill, verb_end = found
+    in_hand = _find(words, "in the hand") >= 0 or _find(words, "in hand") >= 0 or _find(words, "in its hand") >= 0
+    names = _names(assets)
+    spans = _spans(words, names)
+    notes: list[str] = []
+    mentions: list[Mention] = []
+    used = [False] * len(words)
+    for i, j, phrase in spans:
+        used[i:j] = [True] * (j - i)
+        how, match = names[phrase]
+        part = next((w for w in words[j:j + 2] if w in PARTS), None) or next(
+            (w for w in words[max(0, i - 1):i] if w in PARTS), None)
+        if phrase in ("drawer", "drawers"):
+            part = "drawer"
+        ordinal = next((ORDINALS[w] for w in words[max(0, i - 2):i] if w in ORDINALS), None)
+        if ordinal:
+            notes.append(f"'{ordinal} {phrase}': the solver acts on the {part or 'part'} the task's first joint "
+                         "moves; which one is not chosen by its place")
+        mentions.append(Mention(phrase, match[0]["id"], how, part, _choice(match), tuple(a["id"] for a in match)))
+    # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
+    unknown = []
+    for k, w in enumerate(words):
+        if used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or len(w) < 3:
+            continue
+        if any(w in v.split() for s in TASK_SKILLS.values() for v in s.verbs):
+            continue
+        if w in ("into", "inside", "onto", "top", "hand", "goal", "mark", "table", "shut", "closed", "open",
+                 "side", "around", "across", "onto", "upright", "away", "back", "there", "here"):
+            continue
+        if w in KINDS and not (unknown and unknown[-1][0] == k - 1):
+            mentions.append(Mention(w, "", "kind", None, f"any {KINDS[w]}"))
+        else:  # an unknown word, or a kind word after one ('dragon fruit': a fruit the catalog lacks)
+            unknown.append((k, w))
+    roles = SKILL_ROLES[skill]
+    if skill == "reorient" and not in_hand and not any(ROLE_TESTS["ball"](_by_id(assets, m.asset))
+                                                       for m in mentions if m.asset):
+        # 'rotate the faucet' is a turn; 'rotate the ball' (or anything 'in the hand') is a reorientation
+        skill, roles = "turn", SKILL_ROLES["turn"]
+    if skill == "place_on" and len(mentions) >= 2 and all(m.asset and is_block(_by_id(assets, m.asset))
+                                                          for m in mentions[:2]):
+        skill, roles = "stack", SKILL_ROLES["stack"]
+    runs: list[list[tuple[int, str]]] = []
+    for k, w in unknown:  # unknown words next to each other are one phrase ('dragon fruit')
+        if runs and runs[-1][-1][0] == k - 1:
+            runs[-1].append((k, w))
+        else:
+            runs.append([(k, w)])
+    for run in runs:
+        phrase = " ".join(w for _, w in run)
+        kind = KINDS.get(run[-1][1])
+        mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", ()))
+    mentions.sort(key=lambda m: _find(words, m.phrase))
+    resolved = _assign(skill, roles, mentions, assets, text)
+    return Reading(text, skill, tuple(resolved), tuple(notes))
+
+
+def _by_id(assets: Sequence[dict], asset_id: str) -> dict:
+    return next(a for a in assets if a["id"] == asset_id)
+
+
+def _choice(match: list[dict]) -> str:
+    return "" if len(match) == 1 else f"one of {', '.join(a['id'] for a in match)}"
+
+
+def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets: Sequence[dict],
+            text: str) -> list[Mention]:
+    """Give each role of ``skill`` an object: the named ones in order when they can play it, else the closest
+    catalog object that can (a substitution); :class:`InstructionError` when a named object cannot play its part."""
+    out: list[Mention] = []
+    pending = list(mentions)
+    for role in roles:
+        test = ROLE_TESTS[role]
+        able = [a for a in assets if test(a)]
+        m = pending.pop(0) if pending else None
+        if m is None:
+            choice = sorted(able, key=lambda a: a["id"])[0]
+            out.append(Mention(f"(a {role} object)", choice["id"], "kind", None,
+                               f"the request names no {role} object; chose {choice['id']}",
+                               tuple(sorted(a["id"] for a in able))))
+            continue
+        if m.how == "kind":
+            tag = KINDS[m.phrase]
+            kind = [a for a in able if tag in a["tags"] or tag == "graspable"]
+            if not kind:
+                raise InstructionError(f"no {m.phrase} in the catalog can be the {role} object of '{skill}' "
+                                       f"({TASK_SKILLS[skill].objects}); {role} objects: "
+                                       + ", ".join(a["id"] for a in able))
+            ids = tuple(sorted(a["id"] for a in kind))
+            out.append(dataclasses.replace(m, asset=ids[0], options=ids, detail=f"a {m.phrase}: chose from "
+                                                                                 f"{len(ids)}"))
+            continue
+        if m.how == "substitute":
+            kind = KINDS.get(m.phrase.split()[-1])
+            pool = [a for a in able if kind in a["tags"]] or able
+            if not pool:
+                raise InstructionError(f"nothing in the catalog can be the {role} object of '{skill}'")
+            best = _closest(m.phrase, pool)
+            out.append(dataclasses.replace(m, asset=best["id"], options=(best["id"],),
+                                           detail=f"not in the catalog; the closest {role} object"
+                                                  + (f" among the {kind} objects" if pool is not able else "")))
+            continue
+        named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and (
+            a["category"] == _by_id(assets, m.asset)["category"]))]
+        fit = [a for a in named if test(a)]
+        if m.part is not None and role in ("openable",):
+            fit = [a for a in fit if m.part in part_kinds(a)] or fit
+        if not fit:
+            raise InstructionError(
+                f"'{skill}' needs {TASK_SKILLS[skill].objects}, and '{m.phrase}' ({m.asset}) cannot be its {role} "
+                f"object. Objects that can: {', '.join(sorted(a['id'] for a in able)) or 'none'}.\n"
+                f"Possible requests:\n{skill_vocabulary()}")
+        chosen = fit[0] if m.asset not in {a["id"] for a in fit} else _by_id(assets, m.asset)
+        ids = tuple(a["id"] for a in fit)
+        out.append(dataclasses.replace(m, asset=chosen["id"], options=ids,
+                                       detail=f"one of {', '.join(ids)}" if len(ids) > 1 else ""))
+    for m in pending:
+        if m.how == "substitute":
+            raise InstructionError(f"'{m.phrase}' in \"{text}\" is not an object of the catalog and has no part in "
+                                   f"'{skill}' ({TASK_SKILLS[skill].objects})")
+    return out
+
+
+def _closest(phrase: str, able: Sequence[dict]) -> dict:
+    """The asset whose id, category or tags read most like ``phrase`` (string similarity; ties by id)."""
+    keys: dict[str, dict] = {}
+    for a in sorted(able, key=lambda a: a["id"]):
+        for k in (a["id"].replace("_", " "), a["category"].replace("_", " ")):
+            keys.setdefault(k, a)
+    match = difflib.get_close_matches(phrase, list(keys), n=1, cutoff=0.0)
+    return keys[match[0]] if match else sorted(able, key=lambda a: a["id"])[0]
+
+
+__all__ = ["KINDS", "SKILL_ROLES", "SYNONYMS", "TASK_SKILLS", "InstructionError", "Mention", "Reading", "TaskSkill",
+           "read_instruction", "skill_vocabulary"]

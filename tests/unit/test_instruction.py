@@ -1,0 +1,120 @@
+"""Reading a person's request: skills from verbs, catalog objects from multi-word names, synonyms and kinds,
+substitutions that are recorded, and requests outside the skills refused with what is possible."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from gendex.cli import app
+from generator.backends.offline import OfflineBackend
+from generator.catalog_view import asset_dicts
+from generator.instruction import TASK_SKILLS, InstructionError, read_instruction
+from generator.steps.propose import propose
+
+A = asset_dicts()
+
+
+def read(text):
+    return read_instruction(text, A)
+
+
+@pytest.mark.parametrize(("text", "skill", "assets"), [
+    ("pick up the tuna can", "lift", ["tuna_can"]),
+    ("grab the rubik's cube", "lift", ["rubiks_cube"]),
+    ("lift the coffee mug", "lift", ["mug"]),
+    ("put the lemon into the bowl", "put_in", ["lemon", "bowl"]),
+    ("set the mustard bottle on the plate", "place_on", ["mustard_bottle", "plate"]),
+    ("put the pear on top of the plate", "place_on", ["pear", "plate"]),
+    ("stack the small block on the large block", "stack", ["block_small", "block_large"]),
+    ("put the medium block on the large block", "stack", ["block_medium", "block_large"]),
+    ("slide the block to the goal", "push", ["block_large"]),
+    ("open the top drawer", "open", ["drawer_chest_1"]),
+    ("close the cabinet door", "close", ["cabinet_left_hinge"]),
+    ("push the drawer shut", "close", ["drawer_chest_1"]),
+    ("shut the fridge", "close", ["refrigerator_left_hinge"]),
+    ("open the trash can", "open", ["trash_can_small"]),
+    ("turn on the tap", "turn", ["faucet_lever_lift"]),
+    ("rotate the tennis ball in the hand", "reorient", ["tennis_ball"]),
+])
+def test_verbs_map_to_skills_and_names_to_catalog_objects(text, skill, assets):
+    r = read(text)
+    assert r.skill == skill and [m.asset for m in r.objects] == assets
+    assert r.substitutions == {}  # every object was named as the catalog has it
+
+
+def test_synonyms_and_variants_are_recorded_with_every_asset_they_may_mean():
+    [m] = read("shut the fridge").objects
+    assert m.how == "synonym" and set(m.options) == {"refrigerator_left_hinge", "refrigerator_right_hinge"}
+    [m] = read("open the top drawer").objects
+    assert m.part == "drawer" and len(m.options) == 3
+    assert any("top drawer" in n for n in read("open the top drawer").notes)
+
+
+def test_objects_the_catalog_lacks_are_substituted_and_said_so():
+    r = read("grab the mango")
+    assert r.substitutions == {"mango": r.objects[0].asset}
+    assert "SUBSTITUTED" in "\n".join(r.lines())
+    r = read("put the dragon fruit in the bowl")  # one phrase, replaced by a fruit
+    assert list(r.substitutions) == ["dragon fruit"]
+    fruit = next(a for a in A if a["id"] == r.substitutions["dragon fruit"])
+    assert "fruit" in fruit["tags"] and r.objects[1].asset == "bowl"
+    r = read("pick up a fruit")  # a kind: which one is a recorded choice
+    assert r.objects[0].how == "kind" and r.substitutions == {"fruit": r.objects[0].asset}
+
+
+@pytest.mark.parametrize("text", ["throw the ball", "cut the apple", "wipe the table", ""])
+def test_a_request_outside_the_skills_is_refused_with_what_is_possible(text):
+    with pytest.raises(InstructionError) as e:
+        read(text)
+    for s in TASK_SKILLS.values():
+        assert s.example in str(e.value)
+
+
+def test_an_object_that_cannot_play_its_part_is_refused_naming_those_that_can():
+    with pytest.raises(InstructionError, match=r"'apple' \(apple\) cannot be its openable object.*cabinet_left_hinge"):
+        read("open the apple")
+    with pytest.raises(InstructionError, match="container"):
+        read("put the lemon into the apple")
+
+
+def test_the_proposal_records_the_reading_and_the_offline_author_keeps_to_it():
+    p, _ = propose(OfflineBackend(seed=0), instruction="close the lid of the trash can")
+    assert p.reading["skill"] == "close" and [o.asset for o in p.objects] == ["trash_can_small"]
+    assert p.success["type"] == "joint_open" and p.success["negate"] is True
+    assert p.substitutions == {}
+    p, _ = propose(OfflineBackend(seed=0), instruction="grab the mango")
+    assert p.substitutions == {"mango": p.objects[0].asset} and p.reading["substitutions"] == p.substitutions
+    # 'tap' means either faucet: the one the solver was measured on is used, no substitution
+    p, _ = propose(OfflineBackend(seed=0), instruction="turn on the tap")
+    assert [o.asset for o in p.objects] == ["faucet_lever_swivel"] and p.substitutions == {}
+    # a variant named by its id that the solver was not measured on: the measured one, recorded
+    p, _ = propose(OfflineBackend(seed=0), instruction="turn on the faucet_lever_lift")
+    assert [o.asset for o in p.objects] == ["faucet_lever_swivel"]
+    assert p.substitutions == {"faucet lever lift": "faucet_lever_swivel"}
+    with pytest.raises(InstructionError, match="not measured to close 'fridge'"):
+        propose(OfflineBackend(seed=0), instruction="shut the fridge")
+
+
+def test_a_backend_that_swaps_the_named_object_is_caught():
+    """A model that ignores the reading (asked for the apple, wrote a task with the orange) gets a recorded
+    substitution, not a silent one."""
+    class Swapping(OfflineBackend):
+        def complete(self, request):
+            r = super().complete(request)
+            return type(r)(text=r.text.replace('"apple"', '"orange"'), backend=r.backend, model=r.model)
+
+    p, _ = propose(Swapping(seed=0), instruction="grab the apple")
+    assert [o.asset for o in p.objects] == ["orange"] and p.substitutions == {"apple": "orange"}
+
+
+def test_cli_refuses_an_impossible_request_non_zero_and_writes_nothing(tmp_path):
+    out = tmp_path / "tasks"
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "throw the ball",
+                                 "--out", str(out)])
+    assert r.exit_code == 2 and "names no skill" in r.output and "push the block to the goal" in r.output
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_reading_is_json_able():
+    assert json.loads(json.dumps(read("put the lemon in the bowl").to_dict()))["skill"] == "put_in"
