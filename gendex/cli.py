@@ -52,8 +52,14 @@ def list_tasks() -> None:
         origin = version.provenance()
         made = ("promoted from " + origin["promotion"]["source"] if "promotion" in origin
                 else f"generated ({origin['generation']['backend']})" if "generation" in origin else "hand-written")
+        gate = origin.get("solvability")
+        solved = ("not measured by the solvability gate" if gate is None else
+                  f"{gate['successes']}/{gate['attempts']} solved by the {gate['solver_version']} on seeds "
+                  f"{gate['seeds'][0]}..{gate['seeds'][-1]}"
+                  + (f", {gate['env_steps_per_success']:.0f} env steps per success"
+                     if gate.get("env_steps_per_success") else ""))
         typer.echo(f"{env_id}\n    {spec.instruction}\n    objects:  {objects}\n    stages:   {stages}\n"
-                   f"    policies: {policies}; {made}\n    folder:   {version.root}")
+                   f"    policies: {policies}; {made}\n    solved:   {solved}\n    folder:   {version.root}")
 
 
 def _save_png(rgb, path: Path) -> Path:
@@ -245,6 +251,9 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              model: str = typer.Option(None, "--model", help="Model id for the anthropic backend."),
              candidates: int = typer.Option(3, "--candidates", min=1, help="Scene candidates per task; the best "
                                                                            "one is refined."),
+             gate_attempts: int = typer.Option(10, "--gate-attempts", min=0,
+                                               help="Solver attempts (unseen seeds) a drafted task must pass at >= "
+                                                    "80 % before it is committed; 0 skips the solvability gate."),
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a recorded transcript (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
@@ -299,7 +308,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
             run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
-                         candidates=candidates)
+                         candidates=candidates, gate_attempts=gate_attempts)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")
@@ -307,6 +316,11 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         dropped = f" ({s.proposals_tried - 1} earlier proposal(s) dropped)" if s.proposals_tried > 1 else ""
         typer.echo(f"  {s.committed.env_id}: {s.violations_before} -> {s.violations_after} violations in "
                    f"{s.refine_rounds} round(s){dropped}, {s.seconds:.1f} s; folder {s.committed.root}")
+        if s.gate is not None:
+            typer.echo(f"    solvability gate: {s.gate.summary()}, "
+                       f"{s.gate.env_steps_per_success or 0:.0f} env steps per success")
+        for reason in s.dropped:
+            typer.secho(f"    rejected before it: {reason}", fg=typer.colors.YELLOW)
         for phrase, asset in s.substitutions.items():
             typer.secho(f"    substituted: {phrase!r} -> {asset} (recorded in the task's proposal record)",
                         fg=typer.colors.YELLOW)

@@ -103,3 +103,5 @@ class GenerationInfo:
     index: int
     instruction: str | None
     command: str
+    dropped: tuple[str, ...] = ()
+    """Proposals dropped before this one, each with its reason (unsound scene, failed solvability gate)."""

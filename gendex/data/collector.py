@@ -26,9 +26,9 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
+from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
 from gendex_envs.atomic_io import write_json
-from gendex_envs.errors import ExecutionError
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex.solve import Solver
@@ -250,37 +250,18 @@ def _exported(writer) -> int:
 
 def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int, cameras: tuple[str, ...]
              ) -> tuple[Episode | None, dict[str, np.ndarray], Failure | None]:
-    """Run one attempt; the recorded episode (None if no step was taken), camera frames, and why it failed (None
-    when it may have succeeded: the caller checks)."""
-    obs, info = recorder.begin(seed)
-    solver.reset(env, obs)
-    frames = {c: [_image(obs, c)] for c in cameras}
-    failure: Failure | None = None
-    terminated = truncated = False
-    while True:
-        try:
-            action = solver.act(env, obs)
-        except ExecutionError as exc:  # the solver gave up on this attempt: a failed attempt, not a crash
-            failure = Failure.of_error(exc)
-            log.info("attempt with seed %d: %s", seed, failure)
-            break
-        if action is None:
-            break
-        obs, _, terminated, truncated, info = recorder.step(action)
+    """Run one attempt (:func:`gendex.solve.attempt.run_attempt`, recorded); the recorded episode (None if no step
+    was taken), camera frames, and why it failed (None when it may have succeeded: the caller checks)."""
+    frames: dict[str, list[np.ndarray]] = {c: [] for c in cameras}
+
+    def see(obs) -> None:
         for c in cameras:
             frames[c].append(_image(obs, c))
-        if terminated or truncated:
-            break
-    if failure is None and not _succeeded(info):
-        failure = Failure.of_ending(solver, env, bool(terminated), bool(truncated))
+
+    failure = run_attempt(env, solver, seed, begin=recorder.begin, step=recorder.step, on_obs=see).failure
     if recorder.steps == 0:
         return None, {}, failure or Failure("target_not_reached", detail="the solver took no step")
     return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}, failure
-
-
-def _succeeded(info: dict) -> bool:
-    value = info.get("success", False)
-    return bool(np.asarray(value.cpu() if hasattr(value, "cpu") else value).reshape(-1)[0])
 
 
 def _image(obs, camera: str) -> np.ndarray:

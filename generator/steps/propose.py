@@ -123,10 +123,11 @@ def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
 
 
 def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (), instruction: str | None = None,
-            reading: Reading | None = None, max_attempts: int = 3) -> tuple[Proposal, list[str]]:
+            reading: Reading | None = None, feedback: str = "", max_attempts: int = 3) -> tuple[Proposal, list[str]]:
     """Ask for a proposal until one passes :func:`parse_proposal`; returns it and the rejection reasons on the way.
     With an ``instruction``, pass its ``reading`` (:func:`generator.instruction.read_instruction`; read here when
-    not given): the backend sees it, and the proposal records it with every substitution."""
+    not given): the backend sees it, and the proposal records it with every substitution. ``feedback``: why earlier
+    proposals of this task were dropped (shown to the backend with the first request)."""
     prompt = "propose" if instruction is None else "propose_guided"
     variables = dict(asset_guidance=guidance(), existing_tasks="\n".join(f"- {n}" for n in existing) or "- (none)",
                      skills=skill_list(), condition_types=", ".join(PROPOSAL_CONDITION_TYPES),
@@ -145,7 +146,7 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
         if instruction is not None:
             context["instruction"] = instruction
             context["reading"] = reading.to_dict()
-        answer = ask(backend, prompt, context=context, feedback=reasons[-1] if reasons else "", **variables)
+        answer = ask(backend, prompt, context=context, feedback=reasons[-1] if reasons else feedback, **variables)
         try:
             proposal = parse_proposal(answer, instruction)
         except ProposalError as exc:

@@ -21,6 +21,7 @@ from generator.backends.offline import OfflineBackend
 from generator.backends.transcript import ReplayBackend
 from generator.errors import RetriesExhaustedError
 from generator.pipeline import generate
+from generator.steps.gate import gate_seeds
 
 
 def _offline(seed: int = 0):
@@ -54,6 +55,11 @@ def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
             assert version.files.render(f"{when}_{view}").read_bytes()[:4] == b"\x89PNG"
     info = version.provenance()["generation"]
     assert info["backend"] == "offline" and info["is_language_model"] is False and info["seed"] == 0
+    # it passed the solvability gate: the solver's attempts on the task's own unseen seeds, stored with it
+    gate = version.provenance()["solvability"]
+    assert gate["passed"] and gate["successes"] >= 0.8 * gate["planned_attempts"] == 8
+    assert gate["seeds"] == gate_seeds(version.name)[:gate["attempts"]] and "stage executor" in gate["solver_version"]
+    assert summaries[0].gate is not None and summaries[0].gate.successes == gate["successes"]
     assert not list((root / DRAFTS).iterdir())  # nothing left half-written
     # every RL stage declares its goal (the skill's standard one), and its module does not decide success
     for stage in version.spec.stages:
@@ -73,11 +79,17 @@ def test_replayed_transcript_reproduces_the_task_files(offline_run, tmp_path):
     root, summaries = offline_run
     src = summaries[0].committed
     replay = generate(lambda: ReplayBackend(src.files.transcript), tmp_path, n=1, seed=0, command="test")
-    assert _tree(replay[0].committed.root) == _tree(src.root)
+    # every file but the gate's measurement is byte-identical; the measurement is re-taken and passes again (its
+    # env step counts vary by a few steps between processes: the solver's physics is not yet bit-reproducible
+    # across processes, which the datasets issue tracks)
+    gate = TaskLayout(".").record("solvability").name
+    a, b = _tree(replay[0].committed.root), _tree(src.root)
+    assert {k: v for k, v in a.items() if k != gate} == {k: v for k, v in b.items() if k != gate}
+    assert json.loads(a[gate])["passed"] and json.loads(b[gate])["passed"]
 
 
 def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path):
-    [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction="grab the apple", command="test")
+    [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction="grab the apple", command="test", gate_attempts=0)
     spec = s.committed.provenance()["proposal"]
     assert [o["asset"] for o in spec["objects"]] == ["apple"]
     assert any(st["skill"] == "grasp" for st in spec["steps"])
@@ -125,7 +137,7 @@ def _assert_nothing_committed(root: Path) -> None:
 def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(tmp_path):
     b = Scripted(propose=_APPLE % "golden_apple_9000")
     with pytest.raises(RetriesExhaustedError, match="golden_apple_9000.*not in the catalog"):
-        generate(lambda: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     assert b.seen == ["propose"] * 3  # bounded retries
     _assert_nothing_committed(tmp_path)
 
@@ -133,7 +145,7 @@ def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(t
 def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
     b = Scripted(propose=_APPLE % "apple", scene="```yaml\nname: LiftTheApple\nobjects: [\n  - {name: apple\n```")
     with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
-        generate(lambda: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
 
 
@@ -142,7 +154,7 @@ def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path)
            "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
     b = Scripted(propose=_APPLE % "apple", reward=bad)
     with pytest.raises(RetriesExhaustedError, match="os"):
-        generate(lambda: b, tmp_path, n=1, command="test")
+        generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
 
 
@@ -161,7 +173,7 @@ def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path
         return offline.complete(request).text
 
     b = Scripted(propose=_APPLE % "apple", reward=reward)
-    [s] = generate(lambda: b, tmp_path, n=1, command="test")
+    [s] = generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     attempts = s.committed.provenance()["reward_attempts"]["attempts"]
     assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
     assert "rejected" in calls[-1] or any("nan" in c.lower() for c in calls[1:])
@@ -197,7 +209,7 @@ def test_five_offline_tasks_are_distinct_reproducible_and_pass_check_env(tmp_pat
     runs = []
     for k in range(2):
         root = tmp_path / f"run{k}"
-        runs.append((root, generate(_offline(0), root, n=5, seed=0, command="test")))
+        runs.append((root, generate(_offline(0), root, n=5, seed=0, command="test", gate_attempts=0)))
     (root_a, a), (root_b, b) = runs
     assert len({s.committed.name for s in a}) == 5
     assert [s.committed.name for s in a] == [s.committed.name for s in b]
@@ -297,7 +309,7 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     monkeypatch.setenv("ANTHROPIC_API_KEY", "sk-ant-test")
     factory = lambda: AnthropicBackend(model="claude-test", http_client=httpx2.Client(  # noqa: E731
         transport=httpx2.MockTransport(api)), sleep=lambda s: None)
-    [s] = generate(factory, tmp_path, n=1, command="test", candidates=1)
+    [s] = generate(factory, tmp_path, n=1, command="test", candidates=1, gate_attempts=0)
     version = s.committed
     folder = version.root
     vision = [b for b in bodies if any(c["type"] == "image" for c in b["messages"][0]["content"])]
@@ -313,5 +325,5 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     assert info["backend"] == "anthropic" and info["model"] == "claude-test" and info["is_language_model"]
     # the recorded transcript replays to the same files without the API
     again = generate(lambda: ReplayBackend(version.files.transcript), tmp_path / "replay", n=1, command="test",
-                     candidates=1)
+                     candidates=1, gate_attempts=0)
     assert _tree(again[0].committed.root) == _tree(folder)

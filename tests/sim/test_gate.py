@@ -1,0 +1,76 @@
+"""The solvability gate: a drafted task is committed only when the solver solves it on unseen seeds; a task it
+cannot solve is dropped with its reason and the next proposal is asked for."""
+
+import json
+import shutil
+
+import pytest
+import yaml
+
+from gendex_envs.task_version import TaskLayout
+from generator.backends.offline import OfflineBackend
+from generator.errors import GeneratorError
+from generator.pipeline import generate
+from generator.steps import gate as gate_mod
+from generator.steps.gate import GATE_SEED_BASE, GateResult, gate_seeds, measure
+
+
+def test_gate_seeds_are_stable_per_task_and_far_from_every_other_seed():
+    a, b = gate_seeds("LiftApple"), gate_seeds("PutAppleBowl")
+    assert a == gate_seeds("LiftApple") and len(a) == 10 and a != b
+    assert min(a + b) >= GATE_SEED_BASE and not set(a) & set(b)
+
+
+def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path, repo_root):
+    """LiftApple asking for a 60 cm lift, which its lift stage never makes. The gate stops as soon as 80 % can no
+    longer be reached (3 failures of 10) and names the cause."""
+    folder = tmp_path / "FarApple" / "v0"
+    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
+    spec_path = TaskLayout(folder).spec
+    spec = yaml.safe_load(spec_path.read_text())
+    spec["name"] = "FarApple"
+    spec["success"]["conditions"][0]["min_height_m"] = 0.6
+    spec["max_episode_steps"] = 150
+    spec_path.write_text(yaml.safe_dump(spec, sort_keys=False))
+    r = measure(folder, attempts=10, min_rate=0.8)
+    assert not r.passed and r.successes == 0 and r.attempts == 3 and r.planned_attempts == 10
+    assert r.seeds == gate_seeds("FarApple")[:3]
+    assert sum(r.failures.values()) == 3, r.failures
+
+
+def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_committed(tmp_path, monkeypatch):
+    """The gate's verdicts are scripted here (the real gate runs in tests/sim/test_generate.py's offline run): the
+    first proposal fails, the second passes; only the second is committed, the first is reported with why."""
+    verdicts = iter([GateResult(3, 0, 300, [1, 2, 3], {"reach_x/reach/no_ik": 3}, planned_attempts=10),
+                     GateResult(10, 9, 900, list(range(10)), {"grasp_x/grasp/slipped": 1})])
+    seen = []
+
+    def fake_gate(draft, name, attempts):
+        seen.append((name, sorted(p.name for p in draft.iterdir())))
+        return next(verdicts)
+
+    monkeypatch.setattr("generator.pipeline.run_gate", fake_gate)
+    [s] = generate(lambda: OfflineBackend(seed=11), tmp_path, n=1, seed=0, command="test")
+    (first, files_first), (second, _) = seen
+    assert TaskLayout(".").spec.name in files_first  # the gate runs on the written draft
+    assert s.committed.name == second != first
+    assert not (tmp_path / first).exists()
+    assert len(s.dropped) == 1 and first in s.dropped[0] and "no_ik" in s.dropped[0] and "0/3" in s.dropped[0]
+    record = s.committed.provenance()
+    assert record["solvability"]["successes"] == 9 and record["solvability"]["passed"] is True
+    assert record["generation"]["dropped"] == list(s.dropped)
+    # nothing of the dropped proposal's files survives in the committed folder
+    assert json.loads(s.committed.files.record("proposal").read_text())["name"] == second
+
+
+def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reason_is_given(tmp_path, monkeypatch):
+    monkeypatch.setattr("generator.pipeline.run_gate",
+                        lambda draft, name, attempts: GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3}))
+    with pytest.raises(GeneratorError, match="no proposal passed after 3 attempts.*solvability gate"):
+        generate(lambda: OfflineBackend(seed=11), tmp_path, n=1, seed=0, command="test")
+    assert [p for p in tmp_path.iterdir() if not p.name.startswith(".")] == []
+
+
+def test_the_gate_child_reports_a_crash_as_a_named_error(tmp_path):
+    with pytest.raises(gate_mod.GateError, match="crashed"):
+        gate_mod.run_gate(tmp_path, "Nothing", attempts=1)  # an empty draft: no task spec
