@@ -62,6 +62,24 @@ def list_tasks() -> None:
                    f"    policies: {policies}; {made}\n    solved:   {solved}\n    folder:   {version.root}")
 
 
+@app.command()
+def stats(as_json: bool = typer.Option(False, "--json", help="Print the numbers as JSON."),
+          all_versions: bool = typer.Option(False, "--all-versions", help="Count every version, not only the "
+                                                                           "latest of each task."),
+          diversity: bool = typer.Option(True, "--diversity/--no-diversity",
+                                         help="Embed the instructions with all-MiniLM-L6-v2 (the 'stats' extra).")
+          ) -> None:
+    """What the task library holds: tasks per skill, assets, stages, articulated vs rigid, instruction and scene
+    diversity."""
+    import json
+
+    from gendex_envs.registry import registered_tasks
+    from generator.stats import format_stats, library_stats
+
+    numbers = library_stats(registered_tasks(), all_versions=all_versions, diversity=diversity)
+    typer.echo(json.dumps(numbers, indent=1) if as_json else format_stats(numbers))
+
+
 def _save_png(rgb, path: Path) -> Path:
     from PIL import Image
 

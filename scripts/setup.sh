@@ -34,7 +34,7 @@ install_python_env() {
   log "installing torch==2.13.0 (CPU)"
   "$VENV/bin/python" -m pip install -q "torch==2.13.0"
   log "installing gendex and pinned dependencies"
-  "$VENV/bin/python" -m pip install -q -c "$ROOT/constraints.txt" -e "$ROOT[dev]"
+  "$VENV/bin/python" -m pip install -q -c "$ROOT/constraints.txt" -e "$ROOT[dev,stats]"
   want_hash > "$STAMP"
 }
 

@@ -1,0 +1,63 @@
+"""`gendex stats`: tasks per skill, assets, stages, articulated vs rigid, instruction and scene diversity."""
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from gendex.cli import app
+from gendex_envs.registry import registered_tasks
+from generator.stats import TASK_SKILLS, instruction_diversity, jaccard, library_stats, task_skills
+
+EXPECTED = {
+    "PutAppleBowl": ("put_in",), "PickUpBottle": ("lift",), "OpenCabinet": ("open_door",),
+    "CloseCabinet": ("close_door",), "CloseMicrowave": ("close_door",), "OpenDrawer": ("open_drawer",),
+    "CloseDrawer": ("close_drawer",), "OpenTrashCan": ("open_lid",), "OpenBoxLid": ("open_lid",),
+    "CloseTrashCan": ("close_lid",), "TurnFaucet": ("turn",), "StackBlocks": ("stack",),
+    "PushBlockToGoal": ("push",), "SetBottleOnPlate": ("place_on",), "RotateTennisBall": ("reorient",),
+}
+
+
+@pytest.fixture(scope="module")
+def tasks():
+    return registered_tasks()
+
+
+def test_each_reference_task_is_counted_under_its_skill(tasks):
+    latest = {}
+    for v in tasks.values():
+        if v.name in EXPECTED and v.version >= latest.get(v.name, (-1, None))[0]:
+            latest[v.name] = (v.version, v)
+    assert set(latest) == set(EXPECTED)
+    for name, (_, v) in latest.items():
+        assert task_skills(v.spec) == EXPECTED[name], name
+
+
+def test_library_numbers_add_up(tasks):
+    s = library_stats(tasks, diversity=False)
+    names = {v.name for v in tasks.values()}
+    assert s["tasks"] == len(names) and s["versions"] == "latest"
+    assert s["skills_covered"] == len(TASK_SKILLS) == 13  # a reference task for every skill
+    assert sum(s["stages_per_task"]["histogram"].values()) == s["tasks"]
+    assert s["articulated_tasks"] + s["rigid_tasks"] == s["tasks"]
+    assert s["assets_used"] == len(s["assets"]) and "apple" in s["assets"]
+    assert library_stats(tasks, all_versions=True, diversity=False)["tasks"] == len(tasks) > s["tasks"]
+    assert 0.0 < s["scene_diversity"]["mean_pairwise_category_jaccard"] < 0.5
+    assert 0.5 < s["scene_diversity"]["skill_entropy"] <= 1.0
+
+
+def test_instruction_diversity_is_the_mean_pairwise_minilm_cosine():
+    same, source = instruction_diversity(["Open the drawer."] * 3)
+    assert same == pytest.approx(1.0, abs=1e-4) and "all-MiniLM-L6-v2" in source
+    near, _ = instruction_diversity(["Put the apple into the bowl.", "Put the lemon into the bowl."])
+    far, _ = instruction_diversity(["Put the apple into the bowl.", "Turn the faucet lever to the side."])
+    assert 1.0 > near > far > -1.0
+    assert instruction_diversity(["one"]) == (None, "fewer than two tasks")
+    assert jaccard({"apple", "bowl"}, {"apple"}) == 0.5
+
+
+def test_cli_stats_json():
+    r = CliRunner().invoke(app, ["stats", "--json", "--no-diversity"])
+    assert r.exit_code == 0, r.output
+    s = json.loads(r.output[r.output.index("{"):])
+    assert s["skills_covered"] == 13 and s["instruction_diversity"]["published"]["GenDexHand"] == 0.288
