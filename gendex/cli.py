@@ -80,6 +80,23 @@ def stats(as_json: bool = typer.Option(False, "--json", help="Print the numbers 
     typer.echo(json.dumps(numbers, indent=1) if as_json else format_stats(numbers))
 
 
+@app.command("tasks-doc")
+def tasks_doc(out: Path = typer.Option(Path("docs/tasks.md"), "--out", help="The gallery Markdown file."),
+              all_versions: bool = typer.Option(False, "--all-versions", help="A row per version, not per task."),
+              size: int = typer.Option(192, "--size", min=64, help="Thumbnail size (px).")) -> None:
+    """Write the task gallery (picture, instruction, skills, objects, stages, measured success) to docs/tasks.md,
+    with a thumbnail of every task beside it."""
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.registry import registered_tasks
+    from generator.task_gallery import write_task_gallery
+
+    try:
+        path = write_task_gallery(registered_tasks(), out, all_versions=all_versions, size=size)
+    except GenDexError as exc:
+        _die(exc)
+    typer.echo(f"wrote {path}")
+
+
 def _save_png(rgb, path: Path) -> Path:
     from PIL import Image
 

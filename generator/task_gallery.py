@@ -1,0 +1,74 @@
+"""The task gallery: ``docs/tasks.md``, one row per task with its picture, written by ``gendex tasks-doc``.
+
+Each row: a thumbnail of the task at reset (seed 0, the left-overhead view, rendered by the task's own env), the
+Gymnasium id, the instruction, its task skills (:func:`generator.stats.task_skills`), objects, stages, and what the
+solvability gate measured (success and env steps per success; "—" for a task that has no gate record).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from pathlib import Path
+
+from PIL import Image
+from tqdm import tqdm
+
+from gendex_envs.task_version import TaskVersion
+from generator.stats import latest_versions, task_skills
+
+log = logging.getLogger(__name__)
+
+THUMB_PX = 192
+
+
+def thumbnail(version: TaskVersion, size: int = THUMB_PX):
+    """[size, size, 3] uint8: the task at reset (seed 0), left-overhead view."""
+    from gendex_envs.registry import make_task_env
+
+    env = make_task_env(version, render_mode="rgb_array", render_backend="cpu", view_resolution=size)
+    try:
+        env.reset(seed=0)
+        return env.render_views(("left_overhead",))["left_overhead"][0]
+    finally:
+        env.close()
+
+
+def _row(env_id: str, version: TaskVersion, picture: str) -> str:
+    spec = version.spec
+    gate = version.provenance().get("solvability")
+    measured = "—" if gate is None else f"{gate['successes']}/{gate['attempts']}"
+    per = "—" if not gate or not gate.get("env_steps_per_success") else f"{gate['env_steps_per_success']:.0f}"
+    skills = ", ".join(task_skills(spec)) or "—"
+    objects = ", ".join(f"`{o.asset}`" for o in spec.objects)
+    stages = " → ".join(s.skill for s in spec.stages)
+    return (f"| ![{version.name}]({picture}) | `{env_id}` | {spec.instruction} | {skills} | {objects} | {stages} | "
+            f"{measured} | {per} |")
+
+
+def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures: Path | None = None,
+                       all_versions: bool = False, size: int = THUMB_PX) -> Path:
+    """Write the gallery Markdown to ``out`` and a thumbnail per task into ``pictures`` (default: a folder named
+    after ``out`` beside it); returns ``out``."""
+    chosen = dict(versions) if all_versions else latest_versions(versions)
+    pictures = pictures or out.with_suffix("")
+    pictures.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for env_id, version in tqdm(sorted(chosen.items()), desc="task pictures", unit="task"):
+        png = pictures / f"{version.name}-v{version.version}.png"
+        Image.fromarray(thumbnail(version, size)).save(png)
+        rows.append(_row(env_id, version, png.relative_to(out.parent).as_posix()))
+    head = ["# Task library", "",
+            f"{len(rows)} tasks ({'every version' if all_versions else 'the latest version of each'}), written by "
+            "`gendex tasks-doc`. Picture: the task at reset (seed 0). *Solved*: what the solvability gate measured "
+            "when the task was generated (successes / attempts on the task's own unseen seeds); — where the task "
+            "predates the gate (the reference tasks' rates are in [solving](solving.md)). `gendex stats` gives "
+            "the numbers over the library.", "",
+            "| picture | task | instruction | skills | objects | stages | solved | env steps / success |",
+            "|---|---|---|---|---|---|---|---|"]
+    out.write_text("\n".join(head + rows) + "\n")
+    log.info("wrote %s (%d tasks)", out, len(rows))
+    return out
+
+
+__all__ = ["thumbnail", "write_task_gallery"]

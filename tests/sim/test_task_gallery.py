@@ -1,0 +1,33 @@
+"""`gendex tasks-doc`: a gallery row and a picture for every task, with what the solvability gate measured."""
+
+import json
+import shutil
+
+from PIL import Image
+
+from gendex_envs.registry import registered_tasks
+from gendex_envs.task_version import TaskLayout, TaskVersion
+from generator.task_gallery import write_task_gallery
+
+
+def test_gallery_has_a_row_and_a_real_picture_per_task_and_shows_gate_results(tmp_path, repo_root):
+    # two tasks: a reference task, and a copy of it carrying a solvability record
+    ref = next(v for v in registered_tasks().values() if v.name == "LiftApple")
+    folder = tmp_path / "tasks" / "LiftAppleGated" / "v0"
+    shutil.copytree(ref.root, folder)
+    spec = TaskLayout(folder).spec
+    spec.write_text(spec.read_text().replace("name: LiftApple", "name: LiftAppleGated"))
+    (folder / TaskLayout(".").record("solvability").name).write_text(json.dumps(
+        {"attempts": 10, "successes": 9, "env_steps_per_success": 123.4, "planned_attempts": 10}))
+    versions = {ref.env_id: ref, "GenDex/LiftAppleGated-v0": TaskVersion.at(folder)}
+    out = write_task_gallery(versions, tmp_path / "docs" / "tasks.md", size=96)
+    text = out.read_text()
+    rows = [ln for ln in text.splitlines() if ln.startswith("| ![")]
+    assert len(rows) == 2
+    gated = next(r for r in rows if "LiftAppleGated" in r)
+    assert "| 9/10 | 123 |" in gated and "lift" in gated and "`apple`" in gated
+    assert "| — | — |" in next(r for r in rows if "LiftAppleGated" not in r)
+    pic = tmp_path / "docs" / "tasks" / "LiftApple-v0.png"
+    assert f"](tasks/{pic.name})" in text
+    img = Image.open(pic)
+    assert img.size == (96, 96) and len(set(img.getdata())) > 50  # a rendered scene, not a blank frame
