@@ -15,7 +15,8 @@ validators as a model's:
     passed in the request's context), built from the same templates; a request this grammar has no task for
     raises :class:`~generator.instruction.InstructionError` saying what it can write instead.
 ``scene``
-    a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1. It checks
+    a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1, and in
+    :data:`DISTRACTOR_P` of the scenes with movable objects one object of clutter (``distractor: true``). It checks
     nothing on purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
 ``plan``
     one stage per proposal step, with its skill (reach / carry -> motion planning; finger and contact work -> RL);
@@ -74,6 +75,8 @@ STACK_PAIRS = (("block_medium", "block_large"),)
 """(top, base) blocks the autonomous grammar stacks: the pair StackBlocks measured (93-100 % on unseen seeds). The
 small block on the large one was 6/10 (it lands more than 3 cm off the base's centre): written only when asked for."""
 PUSHED = ("block_large", "block_medium")
+DISTRACTOR_P = 0.4
+"""Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
 """Blocks the autonomous grammar pushes (PushBlockToGoal: the large one, 50/50; a generated push of it 10/10)."""
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
@@ -452,6 +455,8 @@ class OfflineBackend:
                     gy = y - np.sign(y or 1.0) * PUSH_M
                     goal = {"pos_m": [round(x, 3), round(float(gy), 3), 0.0], "radius_m": 0.03}
             objects.append(entry)
+        if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P:
+            objects.append(self._distractor(proposal, assets, rng))
         stages = []
         for i, s in enumerate(proposal["steps"]):
             method = "motion_planning" if s["skill"] in ("reach", "carry") else "RL"
@@ -467,6 +472,22 @@ class OfflineBackend:
                 # room for a re-planned approach, a regrasp or a slow door: twice the stages' horizons
                 "max_episode_steps": max(250, 2 * sum(st["horizon"] for st in stages))}
         return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
+
+    @staticmethod
+    def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator) -> dict:
+        """One object of clutter: a graspable catalog object the task does not use, somewhere on the table front
+        (the critic moves it if it overlaps; the solver avoids it)."""
+        from generator.catalog_view import asset_dicts
+
+        used = {o["asset"] for o in proposal["objects"]}
+        pool = sorted((a for a in asset_dicts() if graspable(a) and a["id"] not in used
+                       and a["category"] not in {assets[i]["category"] for i in used if i in assets}),
+                      key=lambda a: a["id"])
+        a = pool[int(rng.integers(len(pool)))]
+        (x0, x1), (y0, y1) = MOVABLE_REGION_M
+        return {"name": f"distractor_{a['category']}", "asset": a["id"], "distractor": True,
+                "pos_m": [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0],
+                "randomize": {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}}
 
     # ------------------------------------------------------------------ plan
     _PLAN = {"reach": ("motion_planning", "arm", 60), "carry": ("motion_planning", "arm", 60),

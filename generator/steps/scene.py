@@ -26,6 +26,8 @@ from generator.steps.common import ask, parse_yaml_block
 log = logging.getLogger(__name__)
 
 N_CANDIDATES = 3
+MAX_DISTRACTORS = 2
+"""Clutter a scene may add beside the proposal's objects (``distractor: true``: no stage or condition names it)."""
 MAX_ARTICULATED_HEIGHT_M = 0.6
 """Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach."""
 CONTAINER_MARGIN = 1 / 0.7
@@ -69,9 +71,13 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     except TaskSpecError as exc:
         raise SceneError(str(exc)) from None
     want = {(o.name, o.asset) for o in proposal.objects}
-    got = {(o.name, o.asset) for o in spec.objects}
+    got = {(o.name, o.asset) for o in spec.objects if not o.distractor}
     if want != got:
-        raise SceneError(f"the scene must use exactly the proposal's objects {sorted(want)}; it has {sorted(got)}")
+        raise SceneError(f"the scene must use exactly the proposal's objects {sorted(want)} (plus at most "
+                         f"{MAX_DISTRACTORS} with distractor: true); it has {sorted(got)}")
+    extra = [o.name for o in spec.objects if o.distractor]
+    if len(extra) > MAX_DISTRACTORS:
+        raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
     if spec.name != proposal.name:
         spec = dataclasses.replace(spec, name=proposal.name)
     return spec

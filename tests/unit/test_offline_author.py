@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import json
 
+import pytest
+
 from gendex_envs.spec import spec_to_dict
 from generator.backends.base import ModelRequest
 from generator.backends.offline import OfflineBackend
@@ -153,3 +155,34 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
                 assert abs(obj["pos_m"][0] - layout["pos_m"][0]) <= 0.02 + 1e-9
                 laid_out += 1
     assert laid_out == len(ARTICULATED_LAYOUTS)
+
+
+def test_scenes_may_carry_clutter_that_no_stage_or_condition_names():
+    """About 40 % of the offline author's scenes with movable objects get one distractor: another kind of object
+    the solver holds, marked ``distractor: true``; the scene step accepts up to MAX_DISTRACTORS of them and no more."""
+    import yaml
+
+    from generator.errors import SceneError
+    from generator.steps.scene import MAX_DISTRACTORS
+
+    b = OfflineBackend(seed=5)
+    p = next(p for p in _proposals(5, 10) if p.success["type"] == "inside")
+    ids = {o.asset for o in p.objects}
+    seen = 0
+    for k in range(12):
+        context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+                   "candidate_index": k, "index": 0, "attempt": 0}
+        text = b.complete(ModelRequest(step="scene", prompt="", context=context)).text
+        spec = parse_scene(text, p)
+        extra = [o for o in spec.objects if o.distractor]
+        if extra:
+            seen += 1
+            [d] = extra
+            assert d.asset not in ids and d.name.startswith("distractor_")
+            assert all(s.target != d.name for s in spec.stages)
+    assert 2 <= seen <= 10, seen
+    raw = yaml.safe_load(text.split("```yaml\n", 1)[1].split("```", 1)[0])
+    clutter = {"asset": "dice", "distractor": True, "pos_m": [0.0, 0.2, 0.0]}
+    raw["objects"] += [dict(clutter, name=f"d{i}") for i in range(MAX_DISTRACTORS + 1)]
+    with pytest.raises(SceneError, match="at most 2"):
+        parse_scene("```yaml\n" + yaml.safe_dump(raw) + "```\n", p)
