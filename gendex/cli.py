@@ -80,6 +80,40 @@ def stats(as_json: bool = typer.Option(False, "--json", help="Print the numbers 
     typer.echo(json.dumps(numbers, indent=1) if as_json else format_stats(numbers))
 
 
+@app.command()
+def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. GenDex/PutAppleBowl-v1."),
+         attempts: int = typer.Option(10, "--attempts", min=1, help="Solver attempts (the task's gate seeds)."),
+         write: bool = typer.Option(False, "--write", help="Store each measurement as the version's solvability "
+                                                          "record (shown by list, stats and tasks-doc).")) -> None:
+    """Run the solvability gate on committed task versions: the stage executor on the task's own unseen seeds, in
+    a child process; exits 1 when any task is below 80 %."""
+    import json
+
+    from gendex_envs.atomic_io import write_json
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.registry import resolve_task
+    from generator.steps.gate import run_gate
+
+    failed = []
+    for task_id in task_ids:
+        try:
+            version = resolve_task(task_id)
+            result = run_gate(version.root, version.name, attempts)
+        except GenDexError as exc:
+            _die(exc)
+        typer.echo(f"{version.env_id}: {result.summary()}"
+                   + (f", {result.env_steps_per_success:.0f} env steps per success"
+                      if result.env_steps_per_success else ""))
+        if write:
+            write_json(version.files.record("solvability"), json.loads(json.dumps(result.to_dict())), indent=2,
+                       sort_keys=True)
+        if not result.passed:
+            failed.append(version.env_id)
+    if failed:
+        typer.secho(f"below {80}%: {', '.join(failed)}", fg=typer.colors.RED, err=True)
+        raise typer.Exit(code=1)
+
+
 @app.command("tasks-doc")
 def tasks_doc(out: Path = typer.Option(Path("docs/tasks.md"), "--out", help="The gallery Markdown file."),
               all_versions: bool = typer.Option(False, "--all-versions", help="A row per version, not per task."),

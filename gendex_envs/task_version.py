@@ -319,11 +319,14 @@ class TaskVersion:
         return out
 
     def file_digest(self) -> str:
-        """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version."""
+        """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version. The
+        ``solvability`` record is left out: it is a measurement of the version (``gendex gate --write`` may add or
+        renew it), not part of it."""
         import hashlib
 
         h = hashlib.sha256()
-        for p in sorted(q for q in self.root.rglob("*") if q.is_file()):
+        skip = self.files.record("solvability")
+        for p in sorted(q for q in self.root.rglob("*") if q.is_file() and q != skip):
             h.update(p.relative_to(self.root).as_posix().encode() + b"\0")
             h.update(p.read_bytes())
         return h.hexdigest()

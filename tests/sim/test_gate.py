@@ -74,3 +74,22 @@ def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reaso
 def test_the_gate_child_reports_a_crash_as_a_named_error(tmp_path):
     with pytest.raises(gate_mod.GateError, match="crashed"):
         gate_mod.run_gate(tmp_path, "Nothing", attempts=1)  # an empty draft: no task spec
+
+
+def test_gate_command_measures_a_committed_version_and_stores_the_record_without_changing_its_digest(
+        tmp_path, repo_root):
+    from typer.testing import CliRunner
+
+    from gendex.cli import app
+    from gendex_envs.task_version import TaskVersion
+
+    folder = tmp_path / "LiftApple" / "v0"
+    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
+    version = TaskVersion.at(folder)
+    digest = version.file_digest()
+    r = CliRunner().invoke(app, ["gate", str(folder), "--attempts", "2", "--write"])
+    assert r.exit_code == 0, r.output
+    assert "GenDex/LiftApple-v0: 2/2 solved" in r.output
+    record = json.loads(version.files.record("solvability").read_text())
+    assert record["successes"] == 2 and record["seeds"] == gate_seeds("LiftApple", 2)
+    assert version.file_digest() == digest  # a measurement of the version, not part of it
