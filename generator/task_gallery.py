@@ -60,10 +60,11 @@ def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures:
         rows.append(_row(env_id, version, png.relative_to(out.parent).as_posix()))
     head = ["# Task library", "",
             f"{len(rows)} tasks ({'every version' if all_versions else 'the latest version of each'}), written by "
-            "`gendex tasks-doc`. Picture: the task at reset (seed 0). *Solved*: what the solvability gate measured "
-            "when the task was generated (successes / attempts on the task's own unseen seeds); — where the task "
-            "predates the gate (the reference tasks' rates are in [solving](solving.md)). `gendex stats` gives "
-            "the numbers over the library.", "",
+            "`gendex tasks-doc`. Picture: the task at reset (seed 0). *Solved*: the version's solvability record "
+            "(successes / attempts of the stage executor on the task's own unseen seeds; the gate stops after 3 "
+            "failures of 10), written when the task was generated or by `gendex gate --write`; — where there is "
+            "none. The larger measurements are in [solving](solving.md); `gendex stats` gives the numbers over "
+            "the library.", "",
             "| picture | task | instruction | skills | objects | stages | solved | env steps / success |",
             "|---|---|---|---|---|---|---|---|"]
     out.write_text("\n".join(head + rows) + "\n")

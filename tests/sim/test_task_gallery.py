@@ -11,15 +11,18 @@ from generator.task_gallery import write_task_gallery
 
 
 def test_gallery_has_a_row_and_a_real_picture_per_task_and_shows_gate_results(tmp_path, repo_root):
-    # two tasks: a reference task, and a copy of it carrying a solvability record
-    ref = next(v for v in registered_tasks().values() if v.name == "LiftApple")
+    # two copies of a library task: one without a solvability record, one with a given one
+    src = next(v for v in registered_tasks().values() if v.name == "LiftApple")
+    plain = tmp_path / "tasks" / "LiftApple" / "v0"
+    shutil.copytree(src.root, plain)
+    TaskLayout(plain).record("solvability").unlink(missing_ok=True)
     folder = tmp_path / "tasks" / "LiftAppleGated" / "v0"
-    shutil.copytree(ref.root, folder)
+    shutil.copytree(plain, folder)
     spec = TaskLayout(folder).spec
     spec.write_text(spec.read_text().replace("name: LiftApple", "name: LiftAppleGated"))
-    (folder / TaskLayout(".").record("solvability").name).write_text(json.dumps(
+    TaskLayout(folder).record("solvability").write_text(json.dumps(
         {"attempts": 10, "successes": 9, "env_steps_per_success": 123.4, "planned_attempts": 10}))
-    versions = {ref.env_id: ref, "GenDex/LiftAppleGated-v0": TaskVersion.at(folder)}
+    versions = {"GenDex/LiftApple-v0": TaskVersion.at(plain), "GenDex/LiftAppleGated-v0": TaskVersion.at(folder)}
     out = write_task_gallery(versions, tmp_path / "docs" / "tasks.md", size=96)
     text = out.read_text()
     rows = [ln for ln in text.splitlines() if ln.startswith("| ![")]
