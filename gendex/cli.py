@@ -92,7 +92,7 @@ def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. 
     from gendex_envs.atomic_io import write_json
     from gendex_envs.errors import GenDexError
     from gendex_envs.registry import resolve_task
-    from generator.steps.gate import run_gate
+    from generator.steps.gate import GATE_MIN_RATE, run_gate
 
     failed = []
     for task_id in task_ids:
@@ -110,7 +110,7 @@ def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. 
         if not result.passed:
             failed.append(version.env_id)
     if failed:
-        typer.secho(f"below {80}%: {', '.join(failed)}", fg=typer.colors.RED, err=True)
+        typer.secho(f"below {GATE_MIN_RATE:.0%}: {', '.join(failed)}", fg=typer.colors.RED, err=True)
         raise typer.Exit(code=1)
 
 

@@ -122,7 +122,7 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
                                          instruction=instruction, reading=reading,
                                          feedback="; ".join(dropped[-2:]))
             for phrase, asset in proposal.substitutions.items():
-                log.warning("task %d: %r is not in the catalog as asked; using %s instead", index, phrase, asset)
+                log.warning("task %d: substituted %s for %r (recorded with the proposal)", index, asset, phrase)
             reasons += rejected
             spec, scenes = write_scene(backend, proposal, index=index + 1000 * attempt, n_candidates=candidates)
             before = render_spec(spec, seed=seed)

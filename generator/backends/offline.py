@@ -74,10 +74,10 @@ PUSH_M = 0.22
 STACK_PAIRS = (("block_medium", "block_large"),)
 """(top, base) blocks the autonomous grammar stacks: the pair StackBlocks measured (93-100 % on unseen seeds). The
 small block on the large one was 6/10 (it lands more than 3 cm off the base's centre): written only when asked for."""
-PUSHED = ("block_large", "block_medium")
+PUSHED = ("block_large",)
+"""Blocks the autonomous grammar pushes (PushBlockToGoal: the large one, 50/50; a generated push of it 10/10)."""
 DISTRACTOR_P = 0.4
 """Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
-"""Blocks the autonomous grammar pushes (PushBlockToGoal: the large one, 50/50; a generated push of it 10/10)."""
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
 
@@ -206,8 +206,8 @@ class OfflineBackend:
         out += [self._plate_task(a, b) for a in g for b in p]
         out += [self._open_task(a) for a in o]
         blocks = [a for a in g if "block" in a["tags"] and a["category"] == "block"]
-        out += [self._stack_task(by[0], by[1]) for pair in STACK_PAIRS
-                if len(by := [next((a for a in blocks if a["id"] == i), None) for i in pair]) == 2 and all(by)]
+        usable = {a["id"]: a for a in blocks}
+        out += [self._stack_task(usable[t], usable[b]) for t, b in STACK_PAIRS if t in usable and b in usable]
         out += [self._push_task(a) for a in blocks if a["id"] in PUSHED]
         by_id = {a["id"]: a for a in assets}
         out += [self._articulated_task(skill, by_id[i]) for (skill, i) in ARTICULATED_LAYOUTS if i in by_id]

@@ -145,8 +145,11 @@ def run_gate(draft: Path, name: str, attempts: int = GATE_ATTEMPTS, min_rate: fl
         if out.returncode != 0:
             tail = "\n".join(out.stderr.strip().splitlines()[-5:])
             raise GateError(f"the solvability gate of {name!r} crashed (exit {out.returncode}): {tail}")
-        result = GateResult(**{k: v for k, v in json.loads(out.stdout.strip().splitlines()[-1]).items()
-                               if k in GateResult.__dataclass_fields__})
+        try:
+            answer = json.loads(out.stdout.strip().splitlines()[-1])
+        except (IndexError, ValueError):
+            raise GateError(f"the solvability gate of {name!r} printed no result: {out.stdout[-300:]!r}") from None
+        result = GateResult(**{k: v for k, v in answer.items() if k in GateResult.__dataclass_fields__})
         log.info("gate of %s: %s in %.0f s", name, result.summary(), time.perf_counter() - t0)
         return result
 
