@@ -87,7 +87,6 @@ def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. 
                                                           "record (shown by list, stats and tasks-doc).")) -> None:
     """Run the solvability gate on committed task versions: the stage executor on the task's own unseen seeds, in
     a child process; exits 1 when any task is below 80 %."""
-    import json
 
     from gendex_envs.atomic_io import write_json
     from gendex_envs.errors import GenDexError
@@ -105,8 +104,7 @@ def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. 
                    + (f", {result.env_steps_per_success:.0f} env steps per success"
                       if result.env_steps_per_success else ""))
         if write:
-            write_json(version.files.record("solvability"), json.loads(json.dumps(result.to_dict())), indent=2,
-                       sort_keys=True)
+            write_json(version.files.record("solvability"), result.to_dict(), indent=2, sort_keys=True)
         if not result.passed:
             failed.append(version.env_id)
     if failed:
@@ -357,6 +355,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
             return ReplayBackend(pending.pop(0))
         return make_backend(name, seed=seed, model=model)
 
+    reading = None
     if instruction is not None:  # how the request was read, before anything runs: substitutions are never silent
         from generator.catalog_view import asset_dicts
         from generator.instruction import read_instruction
@@ -377,7 +376,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
             run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
-                         candidates=candidates, gate_attempts=gate_attempts)
+                         candidates=candidates, gate_attempts=gate_attempts, reading=reading)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")

@@ -92,6 +92,10 @@ ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom",
 
 _STOP = frozenset("a an the this that these those its it of to from with by and then please robot hand your my "
                   "up down off out over at for some one".split())
+_FILLER = frozenset("into inside onto top hand goal mark table shut closed open side around across upright away back "
+                    "there here".split())
+"""Words after the verb that name no object."""
+_VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
 _INTO = ("into", "in", "inside")
 _ONTO = ("onto", "on", "on top of", "upon")
 
@@ -252,7 +256,7 @@ def _spans(words: list[str], names: dict[str, tuple[str, list[dict]]]) -> list[t
     return sorted(found)
 
 
-def _skill(words: list[str], text: str) -> tuple[str, int] | None:
+def _skill(words: list[str]) -> tuple[str, int] | None:
     """The skill the request's verb asks for and where the verb ends; None when no verb of any skill is there."""
     hits = []
     for s in TASK_SKILLS.values():
@@ -290,7 +294,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
     words = _words(text)
-    found = _skill(words, text)
+    found = _skill(words)
     if found is None:
         raise InstructionError(f'"{text}" names no skill GenDex can perform. Possible requests:\n'
                                + skill_vocabulary())
@@ -312,16 +316,13 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         if ordinal:
             notes.append(f"'{ordinal} {phrase}': the solver acts on the {part or 'part'} the task's first joint "
                          "moves; which one is not chosen by its place")
-        mentions.append(Mention(phrase, match[0]["id"], how, part, _choice(match), tuple(a["id"] for a in match)))
+        mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
     # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
     unknown = []
     for k, w in enumerate(words):
         if used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or len(w) < 3:
             continue
-        if any(w in v.split() for s in TASK_SKILLS.values() for v in s.verbs):
-            continue
-        if w in ("into", "inside", "onto", "top", "hand", "goal", "mark", "table", "shut", "closed", "open",
-                 "side", "around", "across", "onto", "upright", "away", "back", "there", "here"):
+        if w in _VERB_WORDS or w in _FILLER:
             continue
         if w in KINDS and not (unknown and unknown[-1][0] == k - 1):
             mentions.append(Mention(w, "", "kind", None, f"any {KINDS[w]}"))
@@ -352,10 +353,6 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
 
 def _by_id(assets: Sequence[dict], asset_id: str) -> dict:
     return next(a for a in assets if a["id"] == asset_id)
-
-
-def _choice(match: list[dict]) -> str:
-    return "" if len(match) == 1 else f"one of {', '.join(a['id'] for a in match)}"
 
 
 def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets: Sequence[dict],

@@ -192,9 +192,12 @@ def _clear_draft(draft: Path, keep: Path) -> None:
 
 def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, seed: int = 0,
              instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None,
-             candidates: int = N_CANDIDATES, gate_attempts: int = GATE_ATTEMPTS) -> list[TaskSummary]:
-    """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again."""
-    reading = None if instruction is None else read_instruction(instruction, asset_dicts())
+             candidates: int = N_CANDIDATES, gate_attempts: int = GATE_ATTEMPTS,
+             reading: Reading | None = None) -> list[TaskSummary]:
+    """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again.
+    ``reading``: the instruction's reading when the caller has it already (read here otherwise)."""
+    if instruction is not None and reading is None:
+        reading = read_instruction(instruction, asset_dicts())
     root.mkdir(parents=True, exist_ok=True)
     clean_drafts(root)
     out: list[TaskSummary] = []

@@ -40,7 +40,7 @@ import yaml
 
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
-from generator.instruction import InstructionError
+from generator.instruction import InstructionError, is_plate
 
 MODEL_ID = "gendex-offline-1"
 
@@ -143,10 +143,6 @@ def container(a: dict) -> bool:
     return "container" in a["tags"] and a["size_m"][2] <= 0.12 and _min_xy(a) >= 0.14 and not a.get("joints")
 
 
-def plate_like(a: dict) -> bool:
-    return a["category"] == "plate"
-
-
 def openable(a: dict) -> bool:
     """Fixed articulated objects with a door or drawer handle, of a kind the solver's handle primitives open."""
     from gendex.solve.articulated import SOLVED_CATEGORIES
@@ -199,7 +195,7 @@ class OfflineBackend:
     def _task_options(self, assets: list[dict]) -> list[dict]:
         g = [a for a in assets if graspable(a)]
         c = [a for a in assets if container(a)]
-        p = [a for a in assets if plate_like(a)]
+        p = [a for a in assets if is_plate(a)]
         o = [a for a in assets if openable(a)]
         out = [self._lift_task(a) for a in g]
         out += [self._put_task(a, b) for a in g for b in c if fits_in(a, b)]
@@ -374,7 +370,7 @@ class OfflineBackend:
             g = pick(0, graspable, "object to put in")
             proposal = self._put_task(g, pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in"))
         elif skill == "place_on":
-            proposal = self._plate_task(pick(0, graspable, "object to set down"), pick(1, plate_like, "plate"))
+            proposal = self._plate_task(pick(0, graspable, "object to set down"), pick(1, is_plate, "plate"))
         elif skill == "stack":
             a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack")
             proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a),
