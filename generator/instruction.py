@@ -44,16 +44,17 @@ class TaskSkill:
 
 
 TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
-    TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get"),
+    TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get",
+                       "hoist"),
               "a graspable object", "pick up the apple"),
-    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer"),
+    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck"),
               "a graspable object and a container (bowl, pot, mug), with 'in' or 'into'", "put the lemon in the bowl"),
-    TaskSkill("place_on", ("set", "put", "place", "lay", "move"),
+    TaskSkill("place_on", ("set", "put", "place", "lay", "move", "rest"),
               "a graspable object and a plate, with 'on' or 'onto'", "set the bottle on the plate"),
-    TaskSkill("stack", ("stack", "pile"), "two blocks", "stack the small block on the large block"),
+    TaskSkill("stack", ("stack", "pile", "balance"), "two blocks", "stack the small block on the large block"),
     TaskSkill("push", ("push", "slide", "shove", "nudge"), "an object on the table, pushed to a goal mark",
               "push the block to the goal"),
-    TaskSkill("open", ("open", "pull open", "lift open", "unlatch", "raise the lid"),
+    TaskSkill("open", ("open", "pull open", "lift open", "unlatch", "raise the lid", "pull", "flip up", "flip open"),
               "a door, drawer or lid (cabinet, microwave, refrigerator, drawer chest, trash can, box with lid)",
               "open the top drawer"),
     TaskSkill("close", ("close", "shut", "push shut", "push closed"),
@@ -78,6 +79,9 @@ SYNONYMS: dict[str, str] = {
     "box with a lid": "box_with_lid", "rubik's cube": "rubiks_cube", "rubik cube": "rubiks_cube",
     "bottle of mustard": "mustard_bottle", "soup can": "can", "tin": "can", "tin can": "can", "duck": "toy_duck",
     "rubber duck": "toy_duck", "pen": "marker", "felt pen": "marker", "dial": "knob",
+    "tin of tuna": "tuna_can", "serving bowl": "bowl", "mixing bowl": "bowl", "dinner plate": "plate",
+    "teacup": "cup", "soft brick": "foam_brick", "puzzle cube": "rubiks_cube", "drawer unit": "drawer_chest",
+    "storage box": "box_with_lid", "notebook computer": "laptop", "stove knob": "knob_stove",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 
@@ -91,10 +95,15 @@ PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab")
 ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom", "first": "top", "second": "second"}
 
 _STOP = frozenset("a an the this that these those its it of to from with by and then please robot hand your my "
-                  "up down off out over at for some one".split())
+                  "up down off out over at for some one along until toward towards near beside behind below above "
+                  "under between while without through so".split())
 _FILLER = frozenset("into inside onto top hand goal mark table shut closed open side around across upright away back "
-                    "there here".split())
-"""Words after the verb that name no object."""
+                    "there here target spot marked place position edge middle centre center surface counter worktop "
+                    "tabletop air way width tower floor".split())
+"""Words after the verb that name no object (places on the table among them)."""
+_DETERMINERS = frozenset("a an the its my your our their his her some this these those".split())
+"""Words that start a noun phrase: an unknown word names an object (the catalog lacks) only in such a phrase
+(*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
 _INTO = ("into", "in", "inside")
 _ONTO = ("onto", "on", "on top of", "upon")
@@ -116,6 +125,9 @@ class Mention:
     options: tuple[str, ...] = ()
     """Every asset the phrase names that can play its part (``fridge``: both refrigerators); :attr:`asset` is the
     first. A task using another of them keeps the person's meaning; any other asset is a substitution."""
+    qualifier: str = ""
+    """Words the person put next to a catalog name that are not catalog words themselves (``left fridge``,
+    ``three drawer chest``): they choose among the name's models where they match a model's id."""
 
     @property
     def substituted(self) -> bool:
@@ -203,7 +215,9 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
 
 # ---------------------------------------------------------------------------------------------- reading
 def _words(text: str) -> list[str]:
-    return re.findall(r"[a-z0-9']+", text.lower().replace("-", " "))
+    """Lower-case words; a possessive is its noun (*the cabinet's door* -> *the cabinet door*)."""
+    words = re.findall(r"[a-z0-9']+", text.lower().replace("-", " "))
+    return [w for w in (re.sub(r"'s?$", "", w) for w in words) if w]
 
 
 def _find(words: Sequence[str], phrase: str, start: int = 0) -> int:
@@ -271,7 +285,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
     names = [h[2] for h in hits if h[0] == first]
     end = hits[0][3]
     rest = " " + " ".join(words[end:]) + " "
-    if "close" in names or " shut " in rest or rest.rstrip().endswith(" closed"):
+    if ("close" in names or re.search(r" (shut|shuts|closed) ", rest)
+            or (" back in " in rest and "push" in names)):
         return "close", end
     if "put_in" in names or "place_on" in names:
         into = any(f" {p} " in rest for p in _INTO)
@@ -281,6 +296,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
         if into:
             return "put_in", end
         return ("place_on" if "place_on" in names else "put_in"), end
+    if names[0] in ("lift", "push", "turn") and " open " in rest:  # lift the lid open, swing the door open
+        return "open", end
     if "turn" in names and "reorient" in names:
         return "turn", end
     return names[0], end
@@ -304,6 +321,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     spans = _spans(words, names)
     notes: list[str] = []
     mentions: list[Mention] = []
+    at: list[int] = []  # where each mention starts in the words
     used = [False] * len(words)
     for i, j, phrase in spans:
         used[i:j] = [True] * (j - i)
@@ -317,6 +335,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
             notes.append(f"'{ordinal} {phrase}': the solver acts on the {part or 'part'} the task's first joint "
                          "moves; which one is not chosen by its place")
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
+        at.append(i)
     # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
     unknown = []
     for k, w in enumerate(words):
@@ -324,8 +343,18 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
             continue
         if w in _VERB_WORDS or w in _FILLER:
             continue
+        in_phrase = k > 0 and (words[k - 1] in _DETERMINERS or (unknown and unknown[-1][0] == k - 1)
+                               or used[k - 1] or (k + 1 < len(words) and used[k + 1]))
+        if not in_phrase:  # not in a noun phrase: 'keep hold of it', 'without lifting it'
+            continue
+        after = next((mentions[n] for n, (i, _, _) in enumerate(spans) if i == k + 1), None)
+        if w in KINDS and after is not None and (KINDS[w] in _by_id(assets, after.asset)["tags"]
+                                                 or KINDS[w] == "graspable"):
+            used[k] = True  # a kind word that says what the next name is: "the toy block" (its qualifier may
+            continue        # come before it: "the large toy block")
         if w in KINDS and not (unknown and unknown[-1][0] == k - 1):
             mentions.append(Mention(w, "", "kind", None, f"any {KINDS[w]}"))
+            at.append(k)
         else:  # an unknown word, or a kind word after one ('dragon fruit': a fruit the catalog lacks)
             unknown.append((k, w))
     roles = SKILL_ROLES[skill]
@@ -342,13 +371,69 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
             runs[-1].append((k, w))
         else:
             runs.append([(k, w)])
-    for run in runs:
+    starts = {i: n for n, (i, _, _) in enumerate(spans)}
+    for n, (i, _, _) in enumerate(spans):  # a name led by a kind word starts at the kind word
+        while i > 0 and used[i - 1] and words[i - 1] in KINDS and i - 1 not in starts:
+            i -= 1
+            starts[i] = n
+    ends = {j: n for n, (_, j, _) in enumerate(spans)}
+    free = []
+    for run in runs:  # a word right before or after a catalog name qualifies it ('left fridge'), it is no object
+        n = starts.get(run[-1][0] + 1, ends.get(run[0][0]))
+        if n is None or mentions[n].how not in ("id", "name", "synonym"):
+            free.append(run)
+            continue
+        mentions[n], note = _qualified(mentions[n], [w for _, w in run], run[0][0] < spans[n][0], assets)
+        at[n] = min(at[n], run[0][0])
+        if note:
+            notes.append(note)
+    for run in free:
         phrase = " ".join(w for _, w in run)
         kind = KINDS.get(run[-1][1])
         mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", ()))
-    mentions.sort(key=lambda m: _find(words, m.phrase))
+        at.append(run[0][0])
+    mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
     resolved = _assign(skill, roles, mentions, assets, text)
     return Reading(text, skill, tuple(resolved), tuple(notes))
+
+
+QUALIFIER_WORDS = {"one": "1", "two": "2", "three": "3", "four": "4", "single": "1", "double": "2", "triple": "3",
+                   "big": "large", "huge": "large", "little": "small", "tiny": "small", "tallest": "tall"}
+"""Qualifier words as catalog ids spell them (`drawer_chest_3`, `bowl_large`)."""
+
+
+def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict]) -> tuple[Mention, str]:
+    """``m`` with the qualifying ``words`` a person put next to it: the models of its name whose id has one of them
+    (``left`` -> ``refrigerator_left_hinge``; ``three`` -> ``drawer_chest_3``), or, when none has, the same models
+    and a note saying the words chose nothing."""
+    qualifier = " ".join(words)
+    phrase = f"{qualifier} {m.phrase}" if before else f"{m.phrase} {qualifier}"
+    category = _by_id(assets, m.asset)["category"]
+    models = [a for a in assets if a["id"] == m.asset or ((m.how != "id" or m.asset == category)
+                                                            and a["category"] == category)]
+    keys = {QUALIFIER_WORDS.get(w, w) for w in words}
+    chosen = [a for a in models if keys & set(a["id"].split("_"))]
+    if not chosen:
+        return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), (
+            f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
+            f"({', '.join(a['id'] for a in models)}); read as '{m.phrase}'")
+    ids = tuple(a["id"] for a in chosen)
+    return dataclasses.replace(m, phrase=phrase, asset=ids[0], options=ids, qualifier=qualifier), ""
+
+
+def _one_per_object(mentions: list[Mention]) -> list[Mention]:
+    """One mention per object named twice (*the drawer of the dresser*: both words name the drawer chests); the
+    more specific wording is kept (an id before a name before a synonym)."""
+    rank = {"id": 0, "name": 1, "synonym": 2}
+    out: list[Mention] = []
+    for m in mentions:
+        same = next((k for k, o in enumerate(out) if m.how in rank and o.how in rank and o.options
+                     and set(o.options) == set(m.options)), None)
+        if same is None:
+            out.append(m)
+        elif rank[m.how] < rank[out[same].how]:
+            out[same] = m
+    return out
 
 
 def _by_id(assets: Sequence[dict], asset_id: str) -> dict:
@@ -394,6 +479,8 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
             continue
         named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and (
             a["category"] == _by_id(assets, m.asset)["category"]))]
+        if m.qualifier and m.options:  # 'the right fridge': only the models the qualifier chose
+            named = [a for a in named if a["id"] in m.options]
         fit = [a for a in named if test(a)]
         if m.part is not None and role in ("openable",):
             fit = [a for a in fit if m.part in part_kinds(a)] or fit
@@ -410,6 +497,8 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
         if m.how == "substitute":
             raise InstructionError(f"'{m.phrase}' in \"{text}\" is not an object of the catalog and has no part in "
                                    f"'{skill}' ({TASK_SKILLS[skill].objects})")
+        raise InstructionError(f"'{m.phrase}' ({m.asset}) in \"{text}\" has no part in a '{skill}' task, which acts "
+                               f"on {TASK_SKILLS[skill].objects}; ask for one task at a time")
     return out
 
 

@@ -25,6 +25,7 @@ from generator.backends.transcript import RecordingBackend
 from generator.catalog_view import asset_dicts
 from generator.errors import GeneratorError
 from generator.instruction import Reading, read_instruction
+from generator.novelty import ExistingTask, Novelty, existing_tasks, spec_signature
 from generator.records import GenerationInfo, to_json
 from generator.render import render_spec
 from generator.steps.gate import GATE_ATTEMPTS, GateResult, run_gate
@@ -85,11 +86,16 @@ def _write(path: Path, data: str | bytes) -> None:
         path.write_text(data)
 
 
-def _existing_names(root: Path) -> tuple[str, ...]:
+def _task_roots(root: Path) -> list[Path]:
+    """The output folder and the repository's task folder: where existing tasks live."""
     from gendex_envs.registry import REPO_TASKS_DIR
 
+    return sorted({Path(root), REPO_TASKS_DIR})
+
+
+def _existing_names(root: Path) -> tuple[str, ...]:
     names = set()
-    for r in {root, REPO_TASKS_DIR}:
+    for r in _task_roots(root):
         if r.is_dir():
             names |= {p.name for p in r.iterdir() if p.is_dir() and not p.name.startswith(".")}
     return tuple(sorted(names))
@@ -98,14 +104,15 @@ def _existing_names(root: Path) -> tuple[str, ...]:
 def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: int, seed: int,
                   instruction: str | None, command: str, existing: tuple[str, ...] = (),
                   candidates: int = N_CANDIDATES, reading: Reading | None = None,
-                  gate_attempts: int = GATE_ATTEMPTS) -> TaskSummary:
+                  gate_attempts: int = GATE_ATTEMPTS, novelty: Novelty | None = None) -> TaskSummary:
     """Generate, validate, gate and commit one task with a fresh ``backend_factory()``, recording every exchange.
 
     With an ``instruction``: its ``reading`` (read here when not given; :class:`~generator.instruction.
     InstructionError` before anything is written when it asks for what GenDex cannot do). A proposal whose scene
     cannot be refined clean, or whose draft the solver does not solve on ``gate_attempts`` unseen seeds
     (:mod:`generator.steps.gate`; 0 skips the gate), is dropped with its reason and the next one is asked for, told
-    what failed; after :data:`MAX_TASK_ATTEMPTS` proposals :class:`GeneratorError` lists every reason."""
+    what failed; after :data:`MAX_TASK_ATTEMPTS` proposals :class:`GeneratorError` lists every reason.
+    ``novelty``: the existing tasks an autonomous proposal may not duplicate (:mod:`generator.novelty`)."""
     t0 = time.perf_counter()
     if instruction is not None and reading is None:
         reading = read_instruction(instruction, asset_dicts())
@@ -120,7 +127,7 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
             _clear_draft(draft, keep=files.transcript)
             proposal, rejected = propose(backend, index=index + 1000 * attempt, existing=existing,
                                          instruction=instruction, reading=reading,
-                                         feedback="; ".join(dropped[-2:]))
+                                         feedback="; ".join(dropped[-2:]), novelty=novelty)
             for phrase, asset in proposal.substitutions.items():
                 log.warning("task %d: substituted %s for %r (recorded with the proposal)", index, asset, phrase)
             reasons += rejected
@@ -202,11 +209,15 @@ def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, 
     clean_drafts(root)
     out: list[TaskSummary] = []
     existing = _existing_names(root)
+    novelty = Novelty(existing_tasks(_task_roots(root))) if instruction is None else None
     for i in range(n):
         summary = generate_task(backend_factory, root, index=i, seed=seed, instruction=instruction,
                                 command=command, existing=existing, candidates=candidates, reading=reading,
-                                gate_attempts=gate_attempts)
+                                gate_attempts=gate_attempts, novelty=novelty)
         existing = (*existing, summary.committed.name)
+        if novelty is not None:
+            spec = summary.committed.spec
+            novelty.add(ExistingTask(summary.committed.env_id, spec_signature(spec), spec.instruction))
         out.append(summary)
         if progress is not None:
             progress(summary)

@@ -15,6 +15,7 @@ thirteen of ``docs/solving.md``), its objects and stages. Over the library:
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections import Counter
@@ -48,36 +49,49 @@ class TaskFacts:
     """The solvability gate's measured rate, when the task has one."""
 
 
-def _part(spec: TaskSpec, obj: str, joint: str | None) -> str:
-    a = asset_dict(next(o.asset for o in spec.objects if o.name == obj))
-    kinds = part_kinds(a)
-    names = [j["name"] for j in a.get("joints") or []]
+def part_of(asset: dict, joint: str | None = None) -> str:
+    """The kind of part ``joint`` (default: the main joint) of an articulated asset moves, in task-skill words:
+    ``door``, ``drawer``, ``lid`` or ``lever`` (a knob turns like a lever)."""
+    kinds = part_kinds(asset)
+    names = [j["name"] for j in asset.get("joints") or []]
     kind = kinds[names.index(joint)] if joint in names else (kinds[0] if kinds else "door")
     return {"rack": "drawer", "knob": "lever"}.get(kind, kind)
+
+
+def condition_skill(kind: str, *, target_category: str | None = None, target_is_goal: bool = False,
+                    part: str | None = None, negate: bool = False) -> str | None:
+    """The task skill a success condition of type ``kind`` asks for (None for conditions that name none)."""
+    if kind == "lifted":
+        return "lift"
+    if kind == "inside":
+        return "put_in"
+    if kind == "near":
+        return "push" if target_is_goal else "place_on"
+    if kind == "over":
+        return "stack" if target_category == "block" else "place_on"
+    if kind == "joint_open" and part is not None:
+        return "turn" if part == "lever" else f"{'close' if negate else 'open'}_{part}"
+    if kind == "rotated":
+        return "reorient"
+    return None
+
+
+STAGE_TASK_SKILLS = ("reorient", "push", "turn")
+"""Stage skills that are task skills by themselves, whatever the success condition."""
 
 
 def task_skills(spec: TaskSpec) -> tuple[str, ...]:
     """The task skills ``spec`` exercises, from its success conditions and stage skills (in :data:`TASK_SKILLS`
     order)."""
     found = set()
-    categories = {o.name: asset_dict(o.asset)["category"] for o in spec.objects}
+    assets = {o.name: asset_dict(o.asset) for o in spec.objects}
     for c in spec.success.conditions:
-        if c.type == "lifted":
-            found.add("lift")
-        elif c.type == "inside":
-            found.add("put_in")
-        elif c.type == "near":
-            found.add("push" if c.target == GOAL_TARGET else "place_on")
-        elif c.type == "over":
-            found.add("stack" if categories.get(c.target) == "block" else "place_on")
-        elif c.type == "joint_open" and c.object is not None:
-            part = _part(spec, c.object, c.joint)
-            found.add("turn" if part == "lever" else f"{'close' if c.negate else 'open'}_{part}")
-        elif c.type == "rotated":
-            found.add("reorient")
-    for s in spec.stages:
-        if s.skill in ("reorient", "push", "turn"):
-            found.add(s.skill)
+        obj = assets.get(c.object) if c.object is not None else None
+        target = assets.get(c.target) if c.target is not None else None
+        found.add(condition_skill(c.type, target_category=target["category"] if target else None,
+                                  target_is_goal=c.target == GOAL_TARGET, negate=bool(c.negate),
+                                  part=part_of(obj, c.joint) if obj and obj.get("joints") else None))
+    found |= {s.skill for s in spec.stages if s.skill in STAGE_TASK_SKILLS}
     return tuple(k for k in TASK_SKILLS if k in found)
 
 
@@ -109,28 +123,42 @@ def jaccard(a: Iterable, b: Iterable) -> float:
     return len(a & b) / len(a | b) if a | b else 1.0
 
 
+@functools.cache
+def _minilm():
+    """The all-MiniLM-L6-v2 sentence encoder from the optional ``stats`` extra, and where it came from; ImportError
+    when the extra is not installed."""
+    import importlib
+    import os
+
+    model_pkg = importlib.import_module(MODEL_PACKAGE)
+    from sentence_transformers import SentenceTransformer
+
+    os.environ.setdefault("HF_HUB_OFFLINE", "1")  # the model is in the wheel: never reach the network
+    model = SentenceTransformer(str(model_pkg.get_model_path()), device="cpu")
+    return model, f"all-MiniLM-L6-v2 ({MODEL_PACKAGE} {getattr(model_pkg, '__version__', '?')})"
+
+
+def embed(texts: list[str]):
+    """Unit-length all-MiniLM-L6-v2 embeddings of ``texts`` (``[len(texts), 384]`` numpy) and the model's source;
+    ImportError (with ``name`` set) when the optional ``stats`` extra is not installed."""
+    model, source = _minilm()
+    return model.encode(texts, normalize_embeddings=True, show_progress_bar=False), source
+
+
 def instruction_diversity(texts: list[str]) -> tuple[float | None, str]:
     """Mean pairwise cosine similarity of ``texts``' all-MiniLM-L6-v2 embeddings, and where the model came from
     (or, when the ``stats`` extra is not installed, None and why)."""
     if len(texts) < 2:
         return None, "fewer than two tasks"
     try:
-        import importlib
-
-        model_pkg = importlib.import_module(MODEL_PACKAGE)
-        from sentence_transformers import SentenceTransformer
+        emb, source = embed(texts)
     except ImportError as exc:
         return None, f"not measured: the optional 'stats' extra is not installed ({exc.name}); " \
                      "pip install -e '.[stats]'"
-    import os
-
-    os.environ.setdefault("HF_HUB_OFFLINE", "1")  # the model is in the wheel: never reach the network
-    model = SentenceTransformer(str(model_pkg.get_model_path()), device="cpu")
-    emb = model.encode(texts, normalize_embeddings=True, show_progress_bar=False)
     sims = emb @ emb.T
     n = len(texts)
     value = float((sims.sum() - sims.trace()) / (n * (n - 1)))
-    return value, f"all-MiniLM-L6-v2 ({MODEL_PACKAGE} {getattr(model_pkg, '__version__', '?')})"
+    return value, source
 
 
 def library_stats(versions: Mapping[str, TaskVersion], all_versions: bool = False,
@@ -194,5 +222,5 @@ def format_stats(s: dict) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["DIVERSITY_GOAL", "PUBLISHED_DIVERSITY", "TASK_SKILLS", "format_stats", "instruction_diversity",
-           "library_stats", "task_skills"]
+__all__ = ["DIVERSITY_GOAL", "PUBLISHED_DIVERSITY", "TASK_SKILLS", "condition_skill", "embed", "format_stats",
+           "instruction_diversity", "library_stats", "part_of", "task_skills"]

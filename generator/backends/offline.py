@@ -33,6 +33,7 @@ from __future__ import annotations
 import functools
 import json
 import re
+import zlib
 from typing import Any
 
 import numpy as np
@@ -41,6 +42,7 @@ import yaml
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_plate
+from generator.phrasing import phrase
 
 MODEL_ID = "gendex-offline-1"
 
@@ -60,14 +62,40 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
                                      "measured": "OpenBoxLid 50/50", "fixed": False},
     ("turn", "faucet_lever_swivel"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
                                       "measured": "TurnFaucet 50/50"},
+    # the layout of a sibling model, measured by the solvability gate of a guided generation (seeds 911-9113)
+    ("close", "cabinet_right_hinge"): {"pos_m": (0.62, -0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
+                                       "measured": "gate 10/10 (guided generation)"},
+    ("close", "microwave_standard"): {"pos_m": (0.6, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
+                                      "measured": "gate 10/10 (guided generation)"},
+    ("close", "drawer_chest_2"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
+                                  "measured": "gate 9/10 (guided generation)"},
+    ("close", "drawer_chest_3"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
+                                  "measured": "gate 10/10 (guided generation)"},
+    ("open", "trash_can_tall"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                                 "measured": "gate 10/10 (guided generation)"},
+    ("close", "trash_can_tall"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
+                                  "measured": "gate 10/10 (guided generation)"},
+    ("close", "box_with_lid_large"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
+                                      "measured": "gate 10/10 (guided generation)"},
+    ("close", "box_with_lid_small"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
+                                      "measured": "gate 10/10 (guided generation)"},
+    ("close", "laptop_13in"): {"pos_m": (0.45, 0.0), "yaw_deg": 0.0, "start": 1.2, "grasp": False,
+                               "measured": "gate 10/10 (guided generation)"},
+    ("close", "laptop_15in"): {"pos_m": (0.45, 0.0), "yaw_deg": 0.0, "start": 1.2, "grasp": False,
+                               "measured": None},
+    ("turn", "faucet_lever_lift"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                                    "measured": "gate 10/10 (guided generation)"},
+    ("close", "refrigerator_left_hinge"): {"pos_m": (0.65, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
+                                           "measured": "gate 10/10 (guided generation)"},
 }
-"""Articulated objects the offline author closes, opens by pressing (lids) or turns, with the layout of the reference
-task that measured the skill on them (``benchmarks/collect.py``, 50 unseen seeds; the pose is jittered by at most
-:data:`LAYOUT_JITTER_M`, and randomized ±5 cm / ±15° at reset). Opening a door or drawer by its handle works across
-:data:`ARTICULATED_REGION_M` for every solved category and needs no entry. The variants not listed (right-hinged
-cabinet, standard microwave, two-drawer chests, tall trash can, laptops) were not measured with these skills: the
-author does not propose them, and a request for one gets the measured variant of the same object as a recorded
-substitution."""
+"""Articulated objects the offline author closes, opens by pressing (lids) or turns, with a layout the skill was
+measured in: the reference task's (``benchmarks/collect.py``, 50 unseen seeds), or a sibling model's layout that the
+solvability gate passed on this model (``measured`` says which; ``None`` would be a candidate the gate has yet to
+judge). The pose is jittered by at most :data:`LAYOUT_JITTER_M`, and randomized ±5 cm / ±15° at reset. Opening a door
+or drawer by its handle works across :data:`ARTICULATED_REGION_M` for every solved category and needs no entry.
+Tried and left out: opening the small lidded box by its lid (no arm pose reaches its tab: ``no_ik`` 9/9) and
+turning a stove knob (no primitive twists a knob: ``unsupported``). A request for a variant not listed gets a
+listed variant of the same object as a recorded substitution."""
 LAYOUT_JITTER_M = 0.02
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
@@ -97,6 +125,19 @@ def _fence(lang: str, body: str) -> str:
 
 def _camel(*words: str) -> str:
     return "".join(w[:1].upper() + w[1:] for part in words for w in re.split(r"[_\s]+", part) if w)
+
+
+def _part(a: dict) -> str:
+    """The kind of part an articulated asset's main joint moves: ``door``, ``drawer``, ``lid`` or ``lever``."""
+    return a["joints"][0]["handle_link"].split("_")[0]
+
+
+def _qualifiers(a: dict, b: dict | None) -> dict[str, str]:
+    """Words that tell two objects of one category apart in a sentence (*the medium block on the large block*),
+    taken from their ids; none when the categories differ."""
+    if b is None or a["category"] != b["category"]:
+        return {}
+    return {"main_qualifier": a["id"].split("_")[-1], "other_qualifier": b["id"].split("_")[-1]}
 
 
 MOVABLE_REGION_M = ((-0.02, 0.18), (-0.26, 0.26))
@@ -181,39 +222,59 @@ class OfflineBackend:
 
     # ------------------------------------------------------------------ proposals
     def _propose(self, request: ModelRequest, ctx: dict) -> str:
-        assets = ctx["assets"]
+        """A task of a skill drawn evenly from those with a task left to write (so a batch is not six "put X into
+        Y"), then one of that skill's tasks: never an existing name, nor a task with the skills and object kinds of
+        an existing one (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`)."""
         existing = set(ctx.get("existing_tasks", []))
+        taken = {tuple(map(tuple, s)) for s in ctx.get("existing_signatures", [])}
         rng = self._rng(request, ctx.get("index", 0), ctx.get("attempt", 0))
-        options = self._task_options(assets)
-        order = rng.permutation(len(options))
-        for i in order:
-            proposal = options[i]
-            if proposal["name"] not in existing:
-                return _fence("json", json.dumps(proposal, indent=2))
-        raise BackendError(f"the offline task grammar is exhausted: all {len(options)} tasks it can write exist")
+        from generator.novelty import proposal_signature
 
-    def _task_options(self, assets: list[dict]) -> list[dict]:
+        by_skill: dict[str, list[dict]] = {}
+        options = self._task_options(ctx["assets"])
+        for skill, proposal in options:
+            if proposal["name"] not in existing and proposal_signature(proposal) not in taken:
+                by_skill.setdefault(skill, []).append(proposal)
+        if not by_skill:
+            raise BackendError(f"the offline task grammar is exhausted: all {len(options)} tasks it can write "
+                               "exist, or duplicate an existing task's skills and objects")
+        skills = sorted(by_skill)
+        pool = by_skill[skills[int(rng.integers(len(skills)))]]
+        return _fence("json", json.dumps(pool[int(rng.integers(len(pool)))], indent=2))
+
+    def _words(self, name: str) -> np.random.Generator:
+        """The generator that words task ``name`` (:func:`generator.phrasing.phrase`): the same seed and task, the
+        same sentence, whatever else the author was asked."""
+        return np.random.default_rng([self.seed, zlib.crc32(name.encode())])
+
+    def _task_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
+        """Every task this grammar can write from ``assets``, each with its task skill."""
         g = [a for a in assets if graspable(a)]
         c = [a for a in assets if container(a)]
         p = [a for a in assets if is_plate(a)]
         o = [a for a in assets if openable(a)]
-        out = [self._lift_task(a) for a in g]
-        out += [self._put_task(a, b) for a in g for b in c if fits_in(a, b)]
-        out += [self._plate_task(a, b) for a in g for b in p]
-        out += [self._open_task(a) for a in o]
+        out = [("lift", self._lift_task(a)) for a in g]
+        out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
+        out += [("place_on", self._plate_task(a, b)) for a in g for b in p]
+        out += [("open_" + _part(a), self._open_task(a)) for a in o]
         blocks = [a for a in g if "block" in a["tags"] and a["category"] == "block"]
         usable = {a["id"]: a for a in blocks}
-        out += [self._stack_task(usable[t], usable[b]) for t, b in STACK_PAIRS if t in usable and b in usable]
-        out += [self._push_task(a) for a in blocks if a["id"] in PUSHED]
+        out += [("stack", self._stack_task(usable[t], usable[b])) for t, b in STACK_PAIRS
+                if t in usable and b in usable]
+        out += [("push", self._push_task(a)) for a in blocks if a["id"] in PUSHED]
         by_id = {a["id"]: a for a in assets}
-        out += [self._articulated_task(skill, by_id[i]) for (skill, i) in ARTICULATED_LAYOUTS if i in by_id]
+        for (skill, i) in ARTICULATED_LAYOUTS:
+            if i in by_id:
+                part = _part(by_id[i])
+                kind = "turn" if skill == "turn" else f"{skill}_{'lid' if part == 'lid' else part}"
+                out.append((kind, self._articulated_task(skill, by_id[i])))
         return out
 
-    @staticmethod
-    def _lift_task(a: dict) -> dict:
+    def _lift_task(self, a: dict) -> dict:
         n = a["category"]
+        name = _camel("lift", a["id"])
         return {
-            "name": _camel("lift", a["id"]), "description": f"Grasp the {_w(n)} and lift it off the table.",
+            "name": name, "description": phrase("lift", a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [
                 _step("reach", n, "arm", f"Bring the open hand to the {_w(n)}."),
@@ -237,8 +298,9 @@ class OfflineBackend:
     def _put_task(self, a: dict, b: dict) -> dict:
         n, t = a["category"], b["category"]
         t = t if t != n else t + "_2"
+        name = _camel("put", a["id"], "in", b["id"])
         return {
-            "name": _camel("put", a["id"], "in", b["id"]), "description": f"Put the {_w(n)} into the {_w(t)}.",
+            "name": name, "description": phrase("put_in", a, self._words(name), other=b, **_qualifiers(a, b)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "container"}],
             "steps": self._carry_steps(n, t, "above"),
@@ -249,8 +311,9 @@ class OfflineBackend:
 
     def _plate_task(self, a: dict, b: dict) -> dict:
         n, t = a["category"], b["category"]
+        name = _camel("set", a["id"], "on", b["id"])
         return {
-            "name": _camel("set", a["id"], "on", b["id"]), "description": f"Set the {_w(n)} down on the {_w(t)}.",
+            "name": name, "description": phrase("place_on", a, self._words(name), other=b, **_qualifiers(a, b)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "support"}],
             "steps": self._carry_steps(n, t, "over"),
@@ -259,12 +322,12 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} lies on the {_w(t)}.",
         }
 
-    @staticmethod
-    def _open_task(a: dict) -> dict:
+    def _open_task(self, a: dict) -> dict:
         n = a["category"]
-        part = a["joints"][0]["handle_link"].split("_")[0]
+        part = _part(a)
+        name = _camel("open", a["id"])
         return {
-            "name": _camel("open", a["id"]), "description": f"Open the {_w(n)}'s {part} by its handle.",
+            "name": name, "description": phrase(f"open_{part}", a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": [
                 _step("reach", n, "arm", f"Bring the open hand to the {part} handle."),
@@ -276,16 +339,15 @@ class OfflineBackend:
             "success_text": f"The {part} is open to at least 80 % of its opening.",
         }
 
-    @staticmethod
-    def _stack_task(a: dict, b: dict) -> dict:
+    def _stack_task(self, a: dict, b: dict) -> dict:
         n, t = a["id"], b["id"]
         h = float(b["size_m"][2])
+        name = _camel("stack", a["id"], "on", b["id"])
         return {
-            "name": _camel("stack", a["id"], "on", b["id"]),
-            "description": f"Stack the {_w(n)} on top of the {_w(t)}.",
+            "name": name, "description": phrase("stack", a, self._words(name), other=b, **_qualifiers(a, b)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "support"}],
-            "steps": [*OfflineBackend._carry_steps(n, t, "above")[:3],
+            "steps": [*self._carry_steps(n, t, "above")[:3],
                       _step("place", t, "arm", f"Set the {_w(n)} down on the {_w(t)}'s top."),
                       _step("release", n, "hand", f"Open the hand and leave the {_w(n)} on the {_w(t)}.")],
             "success": {"type": "over", "object": n, "target": t, "max_xy_m": 0.03,
@@ -293,42 +355,41 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} rests on top of the {_w(t)}.",
         }
 
-    @staticmethod
-    def _push_task(a: dict) -> dict:
+    def _push_task(self, a: dict) -> dict:
         n = a["category"]
+        name = _camel("push", a["id"], "to", "goal")
         return {
-            "name": _camel("push", a["id"], "to", "goal"),
-            "description": f"Push the {_w(n)} across the table onto the goal mark without picking it up.",
+            "name": name, "description": phrase("push", a, self._words(name), **_qualifiers(a, None)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [_step("push", n, "arm", f"Push the {_w(n)} onto the goal mark.")],
             "success": {"type": "near", "object": n, "target": "goal", "max_dist_m": 0.04},
             "success_text": f"The {_w(n)}'s centre is within 4 cm of the goal mark.",
         }
 
-    @staticmethod
-    def _articulated_task(skill: str, a: dict) -> dict:
+    def _articulated_task(self, skill: str, a: dict) -> dict:
         """Close a door or drawer, open or close a lid, turn a lever: one of :data:`ARTICULATED_LAYOUTS`."""
         layout = ARTICULATED_LAYOUTS[skill, a["id"]]
         n = a["category"]
-        part = a["joints"][0]["handle_link"].split("_")[0]
+        part = _part(a)
         steps = [_step("reach", n, "arm", f"Bring the open hand to the {_w(n)}'s {part}.")]
         if layout["grasp"]:
             steps.append(_step("grasp", n, "hand", "Hook the fingers around the handle."))
         if skill == "close":
             steps.append(_step("close", n, "both", f"Push the {part} along its path until it is shut."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
-            text, verb = f"The {part} is shut to less than 10 % of its opening.", "Close"
+            text = f"The {part} is shut to less than 10 % of its opening."
         elif skill == "turn":
             steps.append(_step("turn", n, "both", f"Push the {part} round until it is fully turned."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.8}
-            text, verb = f"The {part} is turned to at least 80 % of its range.", "Turn"
+            text = f"The {part} is turned to at least 80 % of its range."
         else:
             steps.append(_step("open", n, "both", f"Lift the {part} along its arc until it is open."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.5}
-            text, verb = f"The {part} is open to at least half of its opening.", "Open"
-        what = f"the {_w(n)}" if part == "lid" and skill != "turn" else f"the {_w(n)}'s {part}"
+            text = f"The {part} is open to at least half of its opening."
+        name = _camel(skill, a["id"])
+        kind = "turn" if skill == "turn" else f"{skill}_{part}"
         return {
-            "name": _camel(skill, a["id"]), "description": f"{verb} {what}.",
+            "name": name, "description": phrase(kind, a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": steps, "success": success, "success_text": text,
         }
@@ -402,17 +463,17 @@ class OfflineBackend:
         """The asset of ``mention`` this author has a measured layout for ``skill`` of (:data:`ARTICULATED_LAYOUTS`),
         a same-category variant recorded as a substitution, or :class:`InstructionError` naming what it has."""
         options = mention["options"] or [mention["asset"]]
-        for i in options:
-            if (skill, i) in ARTICULATED_LAYOUTS and i in assets:
-                return assets[i]
+        laid_out = [i for i in options if (skill, i) in ARTICULATED_LAYOUTS and i in assets]
+        for i in sorted(laid_out, key=lambda i: ARTICULATED_LAYOUTS[skill, i]["measured"] is None):
+            return assets[i]  # a measured layout before a candidate one
         category = assets[mention["asset"]]["category"] if mention["asset"] in assets else None
         for (s, i) in ARTICULATED_LAYOUTS:
             if s == skill and i in assets and assets[i]["category"] == category:
                 subs[mention["phrase"]] = i
                 return assets[i]
         have = sorted(i for (s, i) in ARTICULATED_LAYOUTS if s == skill)
-        raise InstructionError(f"the solver was not measured to {skill} '{mention['phrase']}' ({mention['asset']}); "
-                               f"measured {skill} tasks: {', '.join(have)}")
+        raise InstructionError(f"the offline author has no layout to {skill} '{mention['phrase']}' "
+                               f"({mention['asset']}) in; it lays out {skill} tasks for: {', '.join(have)}")
 
     # ------------------------------------------------------------------ scene
     def _scene(self, request: ModelRequest, ctx: dict) -> str:

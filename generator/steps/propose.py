@@ -23,6 +23,7 @@ from generator.backends.base import Backend
 from generator.catalog_view import asset_dicts, guidance
 from generator.errors import ProposalError, RetriesExhaustedError
 from generator.instruction import Reading, skill_vocabulary
+from generator.novelty import Novelty, proposal_signature
 from generator.records import PROPOSAL_CONDITION_TYPES, ROLES, Proposal, ProposedObject, ProposedStep
 from generator.steps.common import ask, parse_json_block
 
@@ -123,11 +124,14 @@ def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
 
 
 def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (), instruction: str | None = None,
-            reading: Reading | None = None, feedback: str = "", max_attempts: int = 3) -> tuple[Proposal, list[str]]:
+            reading: Reading | None = None, feedback: str = "", max_attempts: int = 3,
+            novelty: Novelty | None = None) -> tuple[Proposal, list[str]]:
     """Ask for a proposal until one passes :func:`parse_proposal`; returns it and the rejection reasons on the way.
     With an ``instruction``, pass its ``reading`` (:func:`generator.instruction.read_instruction`; read here when
     not given): the backend sees it, and the proposal records it with every substitution. ``feedback``: why earlier
-    proposals of this task were dropped (shown to the backend with the first request)."""
+    proposals of this task were dropped (shown to the backend with the first request). ``novelty``: the existing
+    tasks an autonomous proposal must not duplicate (:mod:`generator.novelty`; a near-duplicate is rejected with
+    its reason, like a malformed answer). A human-guided proposal is what the person asked for and is not tested."""
     prompt = "propose" if instruction is None else "propose_guided"
     variables = dict(asset_guidance=guidance(), existing_tasks="\n".join(f"- {n}" for n in existing) or "- (none)",
                      skills=skill_list(), condition_types=", ".join(PROPOSAL_CONDITION_TYPES),
@@ -143,6 +147,9 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
     for attempt in range(max_attempts):
         context = {"assets": list(asset_dicts()), "existing_tasks": list(existing), "index": index,
                    "attempt": attempt}
+        if novelty is not None and instruction is None:
+            context["existing_signatures"] = [[list(t.signature[0]), list(t.signature[1])]
+                                              for t in novelty.existing]
         if instruction is not None:
             context["instruction"] = instruction
             context["reading"] = reading.to_dict()
@@ -156,6 +163,12 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
         if proposal.name in existing:
             reasons.append(f"task name {proposal.name!r} already exists; choose a new task or name")
             continue
+        if novelty is not None and instruction is None:
+            why = novelty.near_duplicate(proposal_signature(dataclasses.asdict(proposal)), proposal.description)
+            if why is not None:
+                log.info("proposal %s rejected as a near-duplicate: %s", proposal.name, why)
+                reasons.append(f"{proposal.name}: {why}")
+                continue
         if reading is not None:
             proposal = with_reading(proposal, reading)
         return proposal, reasons

@@ -121,12 +121,12 @@ class Scripted:
         return ModelResponse(text=text, backend=self.name, model=self.model)
 
 
-_APPLE = ('```json\n{"name": "LiftTheApple", "description": "Lift the apple.", '
-          '"objects": [{"name": "apple", "asset": "%s", "role": "graspable"}], '
-          '"steps": [{"skill": "reach", "target": "apple", "control_joint": "arm", "instruction": "Reach."}, '
-          '{"skill": "grasp", "target": "apple", "control_joint": "hand", "instruction": "Grasp."}], '
-          '"success": {"type": "lifted", "object": "apple", "target": null, "min_height_m": 0.1}, '
-          '"success_text": "The apple is lifted."}\n```')
+_LEMON = ('```json\n{"name": "LiftTheLemon", "description": "Lift the lemon.", '
+          '"objects": [{"name": "lemon", "asset": "%s", "role": "graspable"}], '
+          '"steps": [{"skill": "reach", "target": "lemon", "control_joint": "arm", "instruction": "Reach."}, '
+          '{"skill": "grasp", "target": "lemon", "control_joint": "hand", "instruction": "Grasp."}], '
+          '"success": {"type": "lifted", "object": "lemon", "target": null, "min_height_m": 0.1}, '
+          '"success_text": "The lemon is lifted."}\n```')
 
 
 def _assert_nothing_committed(root: Path) -> None:
@@ -135,7 +135,7 @@ def _assert_nothing_committed(root: Path) -> None:
 
 
 def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(tmp_path):
-    b = Scripted(propose=_APPLE % "golden_apple_9000")
+    b = Scripted(propose=_LEMON % "golden_apple_9000")
     with pytest.raises(RetriesExhaustedError, match="golden_apple_9000.*not in the catalog"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     assert b.seen == ["propose"] * 3  # bounded retries
@@ -143,7 +143,7 @@ def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(t
 
 
 def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
-    b = Scripted(propose=_APPLE % "apple", scene="```yaml\nname: LiftTheApple\nobjects: [\n  - {name: apple\n```")
+    b = Scripted(propose=_LEMON % "lemon", scene="```yaml\nname: LiftTheLemon\nobjects: [\n  - {name: lemon\n```")
     with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
@@ -152,7 +152,7 @@ def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
 def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path):
     bad = ("```python\nimport os\n\ndef evaluate(env):\n    os.remove('x')\n\n"
            "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
-    b = Scripted(propose=_APPLE % "apple", reward=bad)
+    b = Scripted(propose=_LEMON % "lemon", reward=bad)
     with pytest.raises(RetriesExhaustedError, match="os"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
@@ -172,7 +172,7 @@ def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path
             return nan
         return offline.complete(request).text
 
-    b = Scripted(propose=_APPLE % "apple", reward=reward)
+    b = Scripted(propose=_LEMON % "lemon", reward=reward)
     [s] = generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     attempts = s.committed.provenance()["reward_attempts"]["attempts"]
     assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
@@ -237,23 +237,23 @@ def test_five_offline_tasks_are_distinct_reproducible_and_pass_check_env(tmp_pat
 
 # ---------------------------------------------------------------- the anthropic backend through the whole pipeline
 _SCENE = """```yaml
-name: LiftTheApple
-instruction: Lift the apple.
+name: LiftTheLemon
+instruction: Lift the lemon.
 objects:
-  - {name: apple, asset: apple, pos_m: [0.1, 0.0, 0.0]}
+  - {name: lemon, asset: lemon, pos_m: [0.1, 0.0, 0.0]}
 stages:
-  - {name: approach_apple, instruction: Reach., skill: reach, method: motion_planning, control_joint: arm,
-     target: apple}
-  - {name: grasp_apple, instruction: Grasp., skill: grasp, method: RL, control_joint: hand, target: apple}
+  - {name: approach_lemon, instruction: Reach., skill: reach, method: motion_planning, control_joint: arm,
+     target: lemon}
+  - {name: grasp_lemon, instruction: Grasp., skill: grasp, method: RL, control_joint: hand, target: lemon}
 success:
-  description: The apple is lifted.
-  conditions: [{type: lifted, object: apple, min_height_m: 0.1}]
+  description: The lemon is lifted.
+  conditions: [{type: lifted, object: lemon, min_height_m: 0.1}]
 ```"""
 _PLAN = """```yaml
-- {name: approach_apple, instruction: Reach the apple., skill: reach, method: motion_planning, control_joint: arm,
-   target: apple}
-- {name: grasp_apple, instruction: Grasp the apple., skill: grasp, method: RL, control_joint: hand, horizon: 40,
-   target: apple, success: [{type: grasped, object: apple, min_fingers: 3}]}
+- {name: approach_lemon, instruction: Reach the lemon., skill: reach, method: motion_planning, control_joint: arm,
+   target: lemon}
+- {name: grasp_lemon, instruction: Grasp the lemon., skill: grasp, method: RL, control_joint: hand, horizon: 40,
+   target: lemon, success: [{type: grasped, object: lemon, min_fingers: 3}]}
 ```"""
 _REWARD = """```python
 import torch
@@ -268,11 +268,11 @@ def evaluate(env):
 
 
 def compute_dense_reward(env, obs, action, info):
-    return rt.reach(torch.linalg.norm(env.palm_pose.p - env.obj_pose("apple").p, dim=-1))
+    return rt.reach(torch.linalg.norm(env.palm_pose.p - env.obj_pose("lemon").p, dim=-1))
 
 
 def _get_obs_extra(env, info):
-    return {"apple": env.obj_pose("apple").p}
+    return {"lemon": env.obj_pose("lemon").p}
 ```"""
 
 
@@ -282,15 +282,15 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     from generator.backends.anthropic_backend import AnthropicBackend
 
     bodies: list[dict] = []
-    analyses = iter(["Scene looks fine but the apple could sit a bit to the left.\nDirectives:\n"
-                     "Position_Action: apple - move_y 0.05", "All good.\nDirectives: none"])
+    analyses = iter(["Scene looks fine but the lemon could sit a bit to the left.\nDirectives:\n"
+                     "Position_Action: lemon - move_y 0.05", "All good.\nDirectives: none"])
 
     def api(request):
         body = json.loads(request.content)
         bodies.append(body)
         prompt = body["messages"][0]["content"][-1]["text"]
         if "Propose ONE" in prompt:
-            text = _APPLE % "apple"
+            text = _LEMON % "lemon"
         elif "Write the scene file" in prompt:
             text = _SCENE
         elif "renders of a robot task scene" in prompt:
@@ -317,7 +317,7 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     images = [c for c in vision[0]["messages"][0]["content"] if c["type"] == "image"]
     assert len(images) == 3 and all(i["source"]["media_type"] == "image/png" for i in images)
     critique = version.provenance()["critique"]
-    assert "Position_Action: apple - move_y 0.05" in critique["rounds"][0]["directives"]
+    assert "Position_Action: lemon - move_y 0.05" in critique["rounds"][0]["directives"]
     assert "pos_m: [0.1, 0.05, 0.0]" in version.files.spec.read_text()
     # the model's own stage goal is kept (a stage without one would get the skill's standard goal)
     assert version.spec.stages[1].success[0].min_fingers == 3

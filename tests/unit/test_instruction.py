@@ -85,15 +85,18 @@ def test_the_proposal_records_the_reading_and_the_offline_author_keeps_to_it():
     assert p.substitutions == {}
     p, _ = propose(OfflineBackend(seed=0), instruction="grab the mango")
     assert p.substitutions == {"mango": p.objects[0].asset} and p.reading["substitutions"] == p.substitutions
-    # 'tap' means either faucet: the one the solver was measured on is used, no substitution
+    # 'tap' means either faucet: one with a measured layout is used, no substitution
     p, _ = propose(OfflineBackend(seed=0), instruction="turn on the tap")
-    assert [o.asset for o in p.objects] == ["faucet_lever_swivel"] and p.substitutions == {}
-    # a variant named by its id that the solver was not measured on: the measured one, recorded
+    assert p.objects[0].asset in ("faucet_lever_swivel", "faucet_lever_lift") and p.substitutions == {}
+    # a variant named by its id that has a candidate layout (the gate decides): that one
     p, _ = propose(OfflineBackend(seed=0), instruction="turn on the faucet_lever_lift")
-    assert [o.asset for o in p.objects] == ["faucet_lever_swivel"]
-    assert p.substitutions == {"faucet lever lift": "faucet_lever_swivel"}
-    with pytest.raises(InstructionError, match="not measured to close 'fridge'"):
-        propose(OfflineBackend(seed=0), instruction="shut the fridge")
+    assert [o.asset for o in p.objects] == ["faucet_lever_lift"] and p.substitutions == {}
+    # a variant with no layout of its own: its laid-out sibling, recorded as a substitution
+    p, _ = propose(OfflineBackend(seed=0), instruction="shut the right fridge")
+    assert [o.asset for o in p.objects] == ["refrigerator_left_hinge"]
+    assert p.substitutions == {"right fridge": "refrigerator_left_hinge"}
+    with pytest.raises(InstructionError, match="no layout to close 'oven'"):
+        propose(OfflineBackend(seed=0), instruction="shut the oven")
 
 
 def test_a_backend_that_swaps_the_named_object_is_caught():
@@ -118,3 +121,31 @@ def test_cli_refuses_an_impossible_request_non_zero_and_writes_nothing(tmp_path)
 
 def test_reading_is_json_able():
     assert json.loads(json.dumps(read("put the lemon in the bowl").to_dict()))["skill"] == "put_in"
+
+
+@pytest.mark.parametrize("text, skill, assets", [
+    ("close the left fridge", "close", ["refrigerator_left_hinge"]),
+    ("shut the right fridge", "close", ["refrigerator_right_hinge"]),
+    ("close the three-drawer chest", "close", ["drawer_chest_3"]),
+    ("put the apple in the big bowl", "put_in", ["apple", "bowl_large"]),
+    ("pull the cabinet's door open by its handle", "open", ["cabinet_left_hinge"]),
+    ("close the drawer sticking out of the dresser", "close", ["drawer_chest_1"]),
+    ("pick up the apple and hold it a hand's width above the table", "lift", ["apple"]),
+    ("stack the medium toy block on top of the large toy block", "stack", ["block_medium", "block_large"]),
+    ("lift the trash can's lid open", "open", ["trash_can_small"]),
+    ("push the dresser's open drawer back in", "close", ["drawer_chest_1"]),
+])
+def test_qualifiers_possessives_and_words_outside_noun_phrases(text, skill, assets):
+    """A word next to a catalog name chooses among its models ('left fridge'); a possessive is its noun; words
+    outside a noun phrase ('keep hold of it') name no object; one object named twice is one object."""
+    r = read_instruction(text, asset_dicts())
+    assert r.skill == skill and [m.asset for m in r.objects] == assets, r.lines()
+    assert not r.substitutions
+
+
+def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused():
+    r = read_instruction("put the red apple in the bowl", asset_dicts())
+    assert [m.asset for m in r.objects] == ["apple", "bowl"]
+    assert any("'red'" in n and "matches none" in n for n in r.notes)
+    with pytest.raises(InstructionError, match="has no part in a 'close' task"):
+        read_instruction("close the fridge and the cabinet", asset_dicts())

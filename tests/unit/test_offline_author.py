@@ -125,7 +125,7 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=3)
-    options = b._task_options(list(asset_dicts()))
+    options = [o for _, o in b._task_options(list(asset_dicts()))]
     picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn"))
               or (o["name"].startswith("Open") and o["objects"][0]["asset"] in {i for _, i in ARTICULATED_LAYOUTS})]
     kinds = {o["name"][:4] for o in picked}
@@ -163,10 +163,12 @@ def test_scenes_may_carry_clutter_that_no_stage_or_condition_names():
     import yaml
 
     from generator.errors import SceneError
+    from generator.steps.propose import parse_proposal
     from generator.steps.scene import MAX_DISTRACTORS
 
     b = OfflineBackend(seed=5)
-    p = next(p for p in _proposals(5, 10) if p.success["type"] == "inside")
+    raw = next(o for skill, o in b._task_options(list(asset_dicts())) if skill == "put_in")
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
     ids = {o.asset for o in p.objects}
     seen = 0
     for k in range(12):

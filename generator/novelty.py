@@ -1,0 +1,114 @@
+"""Is a proposed task new? Near-duplicates of the tasks that exist are skipped before any scene is built.
+
+Two tests, either of which makes a proposal a near-duplicate of an existing task (the latest version of each task in
+the output folder and the repository):
+
+- **the same task in other words**: the same task skills (:func:`generator.stats.task_skills`) on the same kinds of
+  object (clutter left out): the catalog category of a rigid object, the model of an articulated one (a
+  right-hinged cabinet's door is another mechanism than a left-hinged one's). ``PutAppleScanInBowl`` next to
+  ``PutAppleBowl`` is one; putting the apple into a pot is not;
+- **the same instruction**: the all-MiniLM-L6-v2 cosine similarity of the two instructions is at least
+  :data:`NEAR_DUPLICATE_COSINE` (the embedding the library's diversity figure uses; from the optional ``stats``
+  extra — without it only the first test runs, and the log says so once).
+
+:func:`near_duplicate` gives the reason in words; the propose step hands it back to the backend as feedback.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from gendex_envs.spec import GOAL_TARGET, TaskSpec
+from generator.catalog_view import asset_dict
+from generator.stats import STAGE_TASK_SKILLS, TASK_SKILLS, condition_skill, embed, part_of, task_skills
+
+log = logging.getLogger(__name__)
+
+NEAR_DUPLICATE_COSINE = 0.9
+"""Instructions at least this similar (MiniLM cosine) ask for the same task. For scale: two wordings of one put
+task score 0.7-0.9, the same wording with another fruit about 0.8, different skills 0.3-0.5."""
+
+Signature = tuple[tuple[str, ...], tuple[str, ...]]
+"""(task skills, sorted object kinds) of a task: see :func:`kind`."""
+
+
+def kind(asset: dict) -> str:
+    """What counts as the same object: a rigid object's category, an articulated object's model (its id)."""
+    return asset["id"] if asset.get("joints") else asset["category"]
+
+
+@dataclass(frozen=True)
+class ExistingTask:
+    env_id: str
+    signature: Signature
+    instruction: str
+
+
+def spec_signature(spec: TaskSpec) -> Signature:
+    cats = sorted({kind(asset_dict(o.asset)) for o in spec.objects if not o.distractor})
+    return task_skills(spec), tuple(cats)
+
+
+def proposal_signature(proposal: dict) -> Signature:
+    """The signature of a proposal as a backend writes it (the JSON object the propose step parses)."""
+    objects = {o["name"]: asset_dict(o["asset"]) for o in proposal["objects"]}
+    succ = proposal["success"]
+    obj, target = objects.get(succ.get("object")), objects.get(succ.get("target"))
+    found = {condition_skill(succ["type"], target_category=target["category"] if target else None,
+                             target_is_goal=succ.get("target") == GOAL_TARGET, negate=bool(succ.get("negate")),
+                             part=part_of(obj) if obj and obj.get("joints") else None)}
+    found |= {s["skill"] for s in proposal["steps"] if s["skill"] in STAGE_TASK_SKILLS}
+    return tuple(k for k in TASK_SKILLS if k in found), tuple(sorted({kind(a) for a in objects.values()}))
+
+
+def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:
+    """The latest version of every task under ``roots`` (a missing root holds none)."""
+    from gendex_envs.registry import discover_tasks
+    from generator.stats import latest_versions
+
+    found = discover_tasks([r for r in roots if Path(r).is_dir()])
+    return [ExistingTask(env_id, spec_signature(v.spec), v.spec.instruction)
+            for env_id, v in sorted(latest_versions(found).items())]
+
+
+class Novelty:
+    """Near-duplicate tests against a fixed set of existing tasks (instructions embedded once)."""
+
+    def __init__(self, existing: list[ExistingTask]):
+        self.existing = list(existing)
+        self._emb = None
+        self.embedding = "not loaded"
+        if self.existing:
+            try:
+                self._emb, self.embedding = embed([t.instruction for t in self.existing])
+            except ImportError as exc:
+                self.embedding = f"none ({exc.name} missing: the optional 'stats' extra)"
+                log.info("near-duplicate test by skills and object kinds only: %s", self.embedding)
+
+    def add(self, task: ExistingTask) -> None:
+        self.existing.append(task)
+        if self._emb is not None:
+            import numpy as np
+
+            self._emb = np.vstack([self._emb, embed([task.instruction])[0]])
+
+    def near_duplicate(self, signature: Signature, instruction: str) -> str | None:
+        """Why a task of ``signature`` worded ``instruction`` duplicates an existing one, or None."""
+        for t in self.existing:
+            if t.signature == signature:
+                return (f"it duplicates {t.env_id}: the same skills ({', '.join(signature[0])}) on the same kinds of "
+                        f"object ({', '.join(signature[1])}); propose another skill or other objects")
+        if self._emb is not None and len(self.existing):
+            sims = self._emb @ embed([instruction])[0][0]
+            i = int(sims.argmax())
+            if sims[i] >= NEAR_DUPLICATE_COSINE:
+                return (f"its instruction reads like {self.existing[i].env_id}'s ('{self.existing[i].instruction}', "
+                        f"MiniLM cosine {sims[i]:.2f} >= {NEAR_DUPLICATE_COSINE}); propose a different task")
+        return None
+
+
+__all__ = ["ExistingTask", "NEAR_DUPLICATE_COSINE", "Novelty", "existing_tasks", "kind", "proposal_signature",
+           "spec_signature"]

@@ -1,0 +1,67 @@
+"""Near-duplicate proposals are skipped: same skills on the same kinds of object, or an instruction that reads the
+same (MiniLM cosine >= NEAR_DUPLICATE_COSINE)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from gendex_envs.registry import REPO_TASKS_DIR, resolve_task
+from generator.backends.offline import OfflineBackend
+from generator.novelty import Novelty, existing_tasks, proposal_signature, spec_signature
+from generator.steps.propose import propose
+
+
+@pytest.fixture(scope="module")
+def novelty() -> Novelty:
+    return Novelty(existing_tasks([REPO_TASKS_DIR]))
+
+
+def _put(obj: str, into: str, text: str) -> dict:
+    return {"name": "X", "description": text,
+            "objects": [{"name": "a", "asset": obj, "role": "graspable"},
+                        {"name": "b", "asset": into, "role": "container"}],
+            "steps": [{"skill": "reach", "target": "a"}, {"skill": "grasp", "target": "a"},
+                      {"skill": "carry", "target": "b"}, {"skill": "release", "target": "a"}],
+            "success": {"type": "inside", "object": "a", "target": "b"}}
+
+
+def test_signatures_of_a_proposal_and_of_its_committed_spec_agree():
+    spec = resolve_task("GenDex/PutAppleBowl-v1").spec
+    assert spec_signature(spec) == (("put_in",), ("apple", "bowl"))
+    assert proposal_signature(_put("apple", "bowl", "")) == spec_signature(spec)
+    # a rigid object is its category (the scanned apple is an apple); an articulated one is its model
+    assert proposal_signature(_put("apple_scan", "bowl", ""))[1] == ("apple", "bowl")
+    assert spec_signature(resolve_task("GenDex/CloseCabinet-v0").spec) == (("close_door",), ("cabinet_left_hinge",))
+
+
+def test_near_duplicates_are_named_with_the_task_they_duplicate(novelty):
+    same = _put("apple_scan", "bowl", "Drop the scanned apple in the bowl, for a healthy snack.")
+    why = novelty.near_duplicate(proposal_signature(same), same["description"])
+    assert why is not None and "GenDex/PutAppleBowl-v1" in why and "same skills" in why
+    other = _put("apple", "pot", "Drop the apple in the pot, for a healthy snack.")
+    assert novelty.near_duplicate(proposal_signature(other), other["description"]) is None
+
+
+def test_an_instruction_that_reads_like_an_existing_one_is_a_near_duplicate(novelty):
+    if novelty._emb is None:
+        pytest.skip(f"MiniLM not installed ({novelty.embedding}): only the signature test runs")
+    text = resolve_task("GenDex/PutAppleBowl-v1").spec.instruction
+    why = novelty.near_duplicate((("lift",), ("lemon",)), text)  # another task, worded exactly like one that exists
+    assert why is not None and "reads like GenDex/PutAppleBowl-v1" in why
+
+
+def test_the_offline_author_proposes_no_duplicate_of_the_library_or_of_its_own_batch():
+    from generator.novelty import ExistingTask
+
+    novelty = Novelty(existing_tasks([REPO_TASKS_DIR]))
+    taken = {t.signature for t in novelty.existing}
+    b, names = OfflineBackend(seed=11), ()
+    for i in range(12):
+        p, rejected = propose(b, index=i, existing=names, novelty=novelty)
+        sig = proposal_signature(dataclasses.asdict(p))
+        assert sig not in taken and not rejected, (p.name, rejected)
+        names += (p.name,)
+        taken.add(sig)
+        novelty.add(ExistingTask(f"GenDex/{p.name}-v0", sig, p.description))
