@@ -46,6 +46,7 @@ from gendex.solve.grasp import (
 from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand
 from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
+from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import ConditionSpec
 from gendex_envs.success import conditions_hold
@@ -194,7 +195,7 @@ class RigidPrimitives:
         self._synth = synth
         m.avoid_objects(exclude=(name,))
         q0 = m.target()
-        reachable, results = 0, []
+        reachable, results, helped_trials = 0, [], 0
         for plan in synth.candidates():
             open_q = m.with_hand(q0, plan.open_hand)
             q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
@@ -211,7 +212,19 @@ class RigidPrimitives:
             if result.held:
                 log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
                 return plan, q_pre
-            if len(results) >= c.max_trials:
+            # it held, but the grasp stage wants more fingers on the object: the middle finger joins the index (trials
+            # of these come on top of max_trials, at most half as many)
+            helped = with_middle_finger(plan, require) if missed_only_conditions(result, c.motion.lift_m) else None
+            if helped is not None and synth.hand_clear(helped) and 2 * helped_trials < c.max_trials:
+                helped_trials += 1
+                q_helped = m.with_hand(q_pre, helped.open_hand)
+                result = self.trials.trial(helped, q_helped, name, require)
+                results.append(result)
+                self.trial_log.append(result)
+                if result.held:
+                    log.info("grasp of %r: %s (trial %d)", name, helped, len(results))
+                    return helped, q_helped
+            if len(results) - helped_trials >= c.max_trials:
                 break
         if not reachable:
             raise ExecutionError(f"no grasp of {name!r} that the arm reaches without collision (families "
