@@ -26,6 +26,10 @@ its target raises :class:`~gendex_envs.errors.ExecutionError` naming what exists
 Every ``ExecutionError`` that ends an attempt carries its cause (:data:`~gendex_envs.errors.FAILURE_CAUSES`) and
 the stage and skill it happened in; ``gendex collect`` counts them.
 
+The executor knows the episode's step limit and the steps used (:meth:`ArmHandMotion.set_budget`); before each
+stage it tells the motions how many steps the stages after it usually take (:data:`SKILL_STEPS`), and a motion that
+would not leave them runs faster, up to :data:`~gendex.solve.motion.MAX_PACE` times its nominal speed.
+
 A stage whose trained policy is present (in the task version, or in the policy folders given) runs the policy
 instead — for RL stages, or for every stage with ``policy_stages="all"`` — until the stage's success conditions
 hold or its horizon ends (:mod:`gendex.solve.policy`). The executor is a :class:`~gendex.solve.Solver`: it emits
@@ -47,10 +51,11 @@ from gendex.solve.grasp import GraspPlan
 from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.press import PressPrimitives
-from gendex.solve.rigid import RigidConfig, RigidPrimitives
+from gendex.solve.rigid import CARRY_M_PER_STEP, RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.task_version import Artifacts, PolicyFiles
+from gendex_envs.wrappers import time_limit
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +66,14 @@ ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "
 """Skill -> primitive for an articulated target that a stage grasps (hooks by its handle)."""
 PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press"}
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
+SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
+               "open": 50, "close": 50, "turn": 40}
+"""Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
+sets its object down first takes a place's more; a carry is estimated from how far it goes,
+:data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
+CARRY_EXTRA_STEPS = 15
+"""A level carry takes its length over :data:`~gendex.solve.rigid.CARRY_M_PER_STEP` plus about this many steps
+(easing in and out, rising to the carry height)."""
 
 
 @dataclass
@@ -110,6 +123,8 @@ class StageExecutor:
         self.logs: list[StageLog] = []
         self._handles = HandlePrimitives(self.motion)
         self._presses = PressPrimitives(self.motion, self._hand_cover)
+        limit = [n for n in (time_limit(env), getattr(u, "horizon", None)) if n is not None]
+        self.motion.set_budget(min(limit) if limit else None, int(u.elapsed_steps[0]))
         self.stage_index = -1
         """Index of the stage being executed (-1 before the first)."""
         self.finished = False
@@ -168,6 +183,23 @@ class StageExecutor:
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
         return table[stage.skill]
 
+    def _reserve(self, index: int) -> int:
+        """Steps the stages after stage ``index`` are expected to take (:data:`SKILL_STEPS`; a skill not listed: its
+        horizon; a carry: from how far the object it carries is from its target now), and the success's hold."""
+        env, spec = self._env, self._env.task_spec
+        total = spec.success.hold_steps
+        for k in range(index + 1, len(spec.stages)):
+            stage = spec.stages[k]
+            steps = SKILL_STEPS.get(stage.skill, stage.horizon)
+            held = next((s.target for s in reversed(spec.stages[:k]) if s.skill == "grasp"), None)
+            if stage.skill == "carry" and held in env.objects and stage.target in env.objects:
+                d = env.obj_pose(held).p[0, :2] - env.obj_pose(stage.target).p[0, :2]
+                steps = int(float(d.norm()) / CARRY_M_PER_STEP) + CARRY_EXTRA_STEPS
+            if stage.skill == "release" and self._set_down_on(stage, stage.target) is not None:
+                steps += SKILL_STEPS["place"]
+            total += steps
+        return total
+
     def _grasped(self, name: str) -> bool:
         """Whether a stage of the task grasps ``name`` (an articulated target: hooks its handle)."""
         return any(s.skill == "grasp" and s.target == name for s in self._env.task_spec.stages)
@@ -189,6 +221,7 @@ class StageExecutor:
                 self.finished = True
                 return
             self.stage_index = i
+            self.motion.reserve = self._reserve(i)
             files = self._policy_files(stage)
             if files is not None:
                 self.logs.append(StageLog(stage.name, "policy", str(files.model)))
@@ -255,7 +288,13 @@ class StageExecutor:
         return ()
 
     def _grasp(self, stage) -> Iterator[np.ndarray]:
-        yield from self.rigid.grasp(stage.target)
+        """Grasp and lift; only to the carry's height when a carry of the object comes next."""
+        stages = self._env.task_spec.stages
+        after = stages[self.stage_index + 1] if self.stage_index + 1 < len(stages) else None
+        lift_to = None
+        if after is not None and after.skill == "carry" and after.target in self._env.objects:
+            lift_to = self.rigid.carry_bottom(after.target)
+        yield from self.rigid.grasp(stage.target, lift_to)
 
     def _lift(self, stage) -> Iterator[np.ndarray]:
         heights = [cond.min_height_m for cond in self._env.task_spec.success.conditions
@@ -281,17 +320,21 @@ class StageExecutor:
         goal = env.goal_pos if c.target == GOAL_TARGET else env.obj_pose(c.target).p
         yield from self.rigid.push(stage.target, goal[0, :2].cpu().numpy().astype(np.float64), c.max_dist_m)
 
+    def _set_down_on(self, stage, held: str | None) -> str | None:
+        """The object an ``inside`` or ``over`` condition (the stage's, else the task's) wants ``held`` in or on."""
+        conds = (*(stage.success or ()), *self._env.task_spec.success.conditions)
+        return next((c.target for c in conds if c.type in ("inside", "over") and c.object == held and not c.negate
+                     and c.target in self._env.objects and c.target not in self._env.articulations), None)
+
     def _release(self, stage) -> Iterator[np.ndarray]:
         """Let go; an object held over what a condition wants it in or on is first set down there (a dropped tall
         object topples out of a bowl)."""
         held = self.rigid.held
-        conds = (*(stage.success or ()), *self._env.task_spec.success.conditions)
-        onto = next((c.target for c in conds if c.type in ("inside", "over") and c.object == held and not c.negate
-                     and c.target in self._env.objects and c.target not in self._env.articulations), None)
+        onto = self._set_down_on(stage, held)
         if held is not None and onto is not None and self.rigid.placed_on != onto:
             yield from self.rigid.place(onto)
         yield from self.rigid.release()
 
 
-__all__ = ["ARTICULATED_PRIMITIVES", "PRESS_PRIMITIVES", "RIGID_PRIMITIVES", "ExecutionError", "ExecutorConfig",
-           "StageExecutor", "StageLog"]
+__all__ = ["ARTICULATED_PRIMITIVES", "PRESS_PRIMITIVES", "RIGID_PRIMITIVES", "SKILL_STEPS", "ExecutionError",
+           "ExecutorConfig", "StageExecutor", "StageLog"]

@@ -5,6 +5,11 @@ planned arm motions (OMPL through :class:`~gendex.solve.planner.ArmPlanner`, col
 objects), straight palm translations (IK per step), hand ramps with *guarded* closing (each step a finger target
 stays within :data:`~gendex.solve.grasp.GUARD_RAD` of the measured angle, so fingers stop on contact), and the
 objects' measured geometry. Each yielded action is the full ``pd_joint_pos`` / ``both`` action (every free joint).
+
+**The episode's budget.** A motion knows the step at which the episode's time limit ends it (:meth:`set_budget`)
+and how many steps the stages after the current one are expected to need (:attr:`ArmHandMotion.reserve`). A
+motion that would not leave that reserve runs faster (:meth:`ArmHandMotion.pace`, at most :data:`MAX_PACE` times
+its nominal speed); with room to spare every motion keeps its nominal speed.
 """
 
 from __future__ import annotations
@@ -23,6 +28,10 @@ from gendex_envs.errors import ExecutionError
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
+
+MAX_PACE = 1.6
+"""Largest speed-up of a paced motion over its nominal speed (a short budget): planned arm paths at up to 0.1
+rad per joint and step, a carry at up to 19 mm a step."""
 
 
 class ArmHandMotion:
@@ -48,6 +57,32 @@ class ArmHandMotion:
                                  "control_mode='pd_joint_pos', control_joint='both'", cause="unsupported")
         self.steps = 0
         """Actions emitted so far."""
+        self.deadline: int | None = None
+        """Value of :attr:`steps` at which the episode's time limit ends it (None: no limit)."""
+        self.reserve = 0
+        """Steps the stages after the current one are expected to need (set by the executor per stage)."""
+
+    # ------------------------------------------------------------------ budget
+    def set_budget(self, limit: int | None, used: int = 0) -> None:
+        """The episode may take ``limit`` steps (None: any number), ``used`` of which are already taken."""
+        self.deadline = None if limit is None else self.steps - used + limit
+        self.reserve = 0
+
+    def left(self) -> int | None:
+        """Steps left in the episode (None: no limit)."""
+        return None if self.deadline is None else self.deadline - self.steps
+
+    def pace(self, need: int, after: int = 0) -> float:
+        """Speed factor (1 to :data:`MAX_PACE`) of a motion that takes ``need`` steps at its nominal speed and is
+        followed by ``after`` more steps of the same primitive: 1 while the episode leaves room for it and for
+        :attr:`reserve`, else what makes it fit, up to the cap."""
+        left = self.left()
+        if left is None or need <= 0:
+            return 1.0
+        room = left - self.reserve - after
+        if need <= room:
+            return 1.0
+        return float(min(MAX_PACE, need / max(room, 1)))
 
     # ------------------------------------------------------------------ state
     def qpos(self) -> np.ndarray:
@@ -88,14 +123,15 @@ class ArmHandMotion:
         for k in range(1, steps + 1):
             yield self.emit(start + (goal - start) * k / steps, guard)
 
-    def move_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, max_step_rad: float | None = None
-                 ) -> Iterator[np.ndarray]:
+    def move_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, max_step_rad: float | None = None,
+                 after: int = 0) -> Iterator[np.ndarray]:
         """Planned arm motion to ``q_goal``'s arm joints, hand targets held (or ``hand``'s); at most
-        ``max_step_rad`` per joint and step (default :attr:`max_arm_step_rad`)."""
-        yield from self.plan_arm(q_goal, hand, max_step_rad=max_step_rad)
+        ``max_step_rad`` per joint and step (default :attr:`max_arm_step_rad`), times the :meth:`pace` the budget
+        asks for (``after``: steps of the same primitive that follow)."""
+        yield from self.plan_arm(q_goal, hand, max_step_rad=max_step_rad, after=after)
 
     def plan_arm(self, q_goal: np.ndarray, hand: np.ndarray | None = None, start: np.ndarray | None = None,
-                 max_step_rad: float | None = None) -> Iterator[np.ndarray]:
+                 max_step_rad: float | None = None, after: int = 0) -> Iterator[np.ndarray]:
         """:meth:`move_arm`, planned now (against the collision model as it is now; ``ExecutionError`` with cause
         ``no_plan`` if there is no path) and stepped when iterated; from ``start`` (default: the current targets)
         when other motions will have brought the arm there first."""
@@ -108,6 +144,9 @@ class ArmHandMotion:
             path = self.planner.plan(start, goal, max_step_rad)
         except PlanningError as e:
             raise ExecutionError(str(e), cause="no_plan") from e
+        pace = self.pace(len(path), after)
+        if pace > 1.0:
+            path = resample(np.vstack([start[None], path]), pace)
         return self._follow(path, goal)
 
     def _follow(self, path: np.ndarray, goal: np.ndarray) -> Iterator[np.ndarray]:
@@ -116,11 +155,15 @@ class ArmHandMotion:
             q[self.hand] = goal[self.hand]
             yield self.emit(q)
 
-    def cartesian(self, offset: np.ndarray, m_per_step: float, guard: bool = False) -> Iterator[np.ndarray]:
-        """Straight palm translation by ``offset`` (world, m), orientation kept, IK per step."""
+    def cartesian(self, offset: np.ndarray, m_per_step: float, guard: bool = False, paced: bool = False,
+                  after: int = 0) -> Iterator[np.ndarray]:
+        """Straight palm translation by ``offset`` (world, m), orientation kept, IK per step; ``paced``: faster by
+        the :meth:`pace` the budget asks for (``after``: steps of the same primitive that follow)."""
         target = self.target()
         palm = self.ik.fk(target)
         n = max(1, int(np.ceil(np.linalg.norm(offset) / m_per_step)))
+        if paced:
+            n = max(1, int(np.ceil(n / self.pace(n, after))))
         q = target
         for k in range(1, n + 1):
             goal = sapien.Pose(palm.p + offset * k / n, palm.q)
@@ -163,3 +206,20 @@ class ArmHandMotion:
             lo, hi = self.world_aabb(name)
             boxes.append(Box(lo - 0.01, hi + 0.01, name))
         self.collision.set_obstacles(boxes)
+
+
+def resample(path: np.ndarray, pace: float) -> np.ndarray:
+    """The densified joint path ``path`` [T + 1, J] (its start first, straight segments cut into equal steps),
+    stepped ``pace`` times faster: the same segments (every corner kept), cut into steps of at most ``pace`` times
+    its largest joint change per step; the start is left out."""
+    steps = np.diff(path, axis=0)
+    step = pace * float(np.max(np.abs(steps)))
+    if step <= 0.0:
+        return path[1:]
+    corner = [k for k in range(1, len(steps)) if not np.allclose(steps[k], steps[k - 1], atol=1e-9)]
+    ends = path[[0, *corner, len(path) - 1]]
+    out = []
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step - 1e-9)))
+        out.extend(a + (b - a) * k / n for k in range(1, n + 1))
+    return np.asarray(out)

@@ -99,11 +99,14 @@ PUSH_STOP_FRACTION = 0.5
 """Pushing stops once the object's centre is within this fraction of the task's tolerance of the goal."""
 CARRY_YAWS_RAD = (0.0, 0.4, -0.4, 0.8, -0.8)
 CARRY_RAISES_M = (0.0, 0.05, 0.1)
-"""Turns of the hand (and the held object) about the vertical through the carry's goal, and extra heights, tried
-when the grasp's own orientation at the carry height has no collision-free arm pose."""
+"""Turns of the hand (and the held object) about the vertical, tried in turn along a level carry's straight line
+(the hand turning steadily on the way) and, where no straight line works, about the vertical through the carry's
+goal with extra heights, for a collision-free arm pose there."""
 CARRY_M_PER_STEP = 0.012
 CARRY_RAMP_STEPS = 6
 """Palm travel per step of a level (straight, orientation-keeping) carry, reached and left over this many steps."""
+MIN_LIFT_M = 0.08
+"""The least a grasp lifts its object (a slip shows as the object rising less than half of the lift)."""
 SLIP_M = 0.03
 """A held object that drifted more than this from its place in the hand during a carry has slipped."""
 
@@ -259,6 +262,8 @@ class RigidPrimitives:
         away = np.zeros(3)
         away[:2] = plan.pregrasp.p[:2] - self.shape(name).footprint().center
         away /= max(float(np.linalg.norm(away)), 1e-9)
+        step_m = self.config.motion.approach_m_per_step
+        n_in = int(np.ceil(np.linalg.norm(plan.palm.p - plan.pregrasp.p) / step_m)) + self.config.motion.settle_steps
         m.avoid_objects()
         m.collision.cover_hand(cover.centers, cover.radii)
         try:
@@ -273,22 +278,23 @@ class RigidPrimitives:
                 if q_stage is None or not m.collision.is_free(m.with_hand(q_stage, plan.open_hand)):
                     log.debug("staging %s: %s", offset, "no IK" if q_stage is None else "in collision")
                     continue
+                n_stage = int(np.ceil(np.linalg.norm(offset) / step_m))
                 try:
-                    path = m.plan_arm(q_stage, hand=hand_q, start=start)
+                    path = m.plan_arm(q_stage, hand=hand_q, start=start, after=n_stage + n_in)
                 except ExecutionError as exc:
                     log.debug("staging %s: %s", offset, exc)
                     continue
                 m.collision.cover_hand(None)
                 if lift > 0:
-                    yield from m.cartesian(np.array([0.0, 0.0, lift]), self.config.motion.approach_m_per_step)
+                    yield from m.cartesian(np.array([0.0, 0.0, lift]), step_m, paced=True)
                 yield from path
-                yield from m.cartesian(-offset, self.config.motion.approach_m_per_step)
+                yield from m.cartesian(-offset, step_m, paced=True, after=n_in)
                 return
         finally:
             m.collision.cover_hand(None)
             m.avoid_objects(exclude=(name,))
         log.info("no staged approach to the %s: planning the arm alone", plan)
-        yield from m.move_arm(q_pre, hand=hand_q)
+        yield from m.move_arm(q_pre, hand=hand_q, after=n_in)
 
     def _clear_start(self, hand_q: np.ndarray) -> tuple[float, np.ndarray]:
         """How far the palm must rise (0 to :data:`ESCAPE_M`, in 3 cm steps) before the opened hand (targets
@@ -305,24 +311,34 @@ class RigidPrimitives:
                 return float(up), goal
         return 0.0, q
 
-    def grasp(self, name: str) -> Iterator[np.ndarray]:
+    def carry_bottom(self, target: str) -> float:
+        """Height (world z) of a carried object's bottom over ``target`` (its top + ``carry_clearance_m``)."""
+        return float(self.m.world_aabb(target)[1][2]) + self.config.carry_clearance_m
+
+    def grasp(self, name: str, lift_to: float | None = None) -> Iterator[np.ndarray]:
+        """Close the planned grasp on ``name`` and lift it ``lift_m`` (or, ``lift_to``, until its bottom is that
+        high, when that is less: a carry goes on from there; at least :data:`MIN_LIFT_M`); open, back off and grasp
+        again if it did not come up."""
         m, c = self.m, self.config
         if self.plan is None:
             raise ExecutionError(f"grasping {name!r} needs a stage that approached it first", cause="unsupported")
         self.placed_on = None
         for attempt in range(c.regrasps + 1):
             z0 = float(self.env.obj(name).pose.p[0, 2])
+            lift = c.motion.lift_m
+            if lift_to is not None:
+                lift = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, lift))
             yield from close_hand(m, self.plan, c.motion)
             self.held = name
-            yield from m.cartesian(np.array([0.0, 0.0, c.motion.lift_m]), c.motion.lift_m_per_step, guard=True)
+            yield from m.cartesian(np.array([0.0, 0.0, lift]), c.motion.lift_m_per_step, guard=True, paced=True)
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
-            if risen >= 0.5 * c.motion.lift_m:
+            if risen >= 0.5 * lift:
                 yield from self._ease_grip()
                 return
             self.held = None
             if attempt == c.regrasps:
                 raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting (rose {risen:.3f} m of "
-                                     f"{c.motion.lift_m:.3f} m)", cause="slipped")
+                                     f"{lift:.3f} m)", cause="slipped")
             log.info("%r slipped (rose %.3f m): opening and grasping again", name, risen)
             yield from self._let_go()
             yield from self.approach(name, self._require)
@@ -359,7 +375,7 @@ class RigidPrimitives:
         risen = float(self.env.obj_height(name)[0])
         if risen < need_m + 0.02:
             yield from self.m.cartesian(np.array([0.0, 0.0, need_m + 0.03 - risen]),
-                                        self.config.motion.lift_m_per_step, guard=True)
+                                        self.config.motion.lift_m_per_step, guard=True, paced=True)
 
     def carry(self, target: str) -> Iterator[np.ndarray]:
         c, m = self.config, self.m
@@ -390,8 +406,19 @@ class RigidPrimitives:
         m.avoid_objects(exclude=(held,))
         m.collision.attach(*_object_spheres(held_lo, held_hi), q_now)
         try:
-            straight = self._level_path(palm, goal, q_now)
-            if straight is not None:  # the hand keeps its orientation: nothing held is tipped out on the way
+            # a straight line, the hand level; turning about the vertical along the way where it must (an object
+            # carried past the robot's base)
+            straight, turn = None, 0.0
+            for turn in CARRY_YAWS_RAD:
+                straight = self._level_path(palm, goal, q_now, turn=turn, pivot=obj_p)
+                if straight is not None:
+                    break
+            pace = 1.0 if straight is None else m.pace(len(straight))
+            if pace > 1.0:  # a short budget: the same line, faster
+                straight = self._level_path(palm, goal, q_now, pace, turn, obj_p) or straight
+            if straight is not None:  # the hand stays level: nothing held is tipped out on the way
+                log.info("carrying %r to %r on a straight line, turning %+.1f rad: %d steps (pace %.2f)", held,
+                         target, turn, len(straight), pace)
                 for q in straight:
                     t = m.target()
                     t[m.arm] = q[m.arm]
@@ -434,7 +461,8 @@ class RigidPrimitives:
             error = goal_xy - (lo[:2] + hi[:2]) / 2
             if float(np.linalg.norm(error)) < PLACE_TOLERANCE_M:
                 break
-            yield from m.cartesian(np.array([error[0], error[1], 0.0]), c.motion.lift_m_per_step, guard=True)
+            yield from m.cartesian(np.array([error[0], error[1], 0.0]), c.motion.lift_m_per_step, guard=True,
+                                   paced=True)
             yield from m.hold(c.motion.settle_steps)
         lo, hi = m.world_aabb(held)
         xy = (lo[:2] + hi[:2]) / 2
@@ -445,9 +473,11 @@ class RigidPrimitives:
         drop = float(lo[2] - surface + PLACE_PRESS_M)
         if drop <= 0:
             return
-        n = max(1, int(np.ceil(drop / c.motion.lift_m_per_step)))
+        speed = c.motion.lift_m_per_step
+        speed *= m.pace(int(np.ceil(drop / speed)))
+        n = max(1, int(np.ceil(drop / speed)))
         palm0, z0 = m.ik.fk(m.qpos()).p[2], float(self.env.obj(held).pose.p[0, 2])
-        for k, action in enumerate(m.cartesian(np.array([0.0, 0.0, -drop]), c.motion.lift_m_per_step, guard=True)):
+        for k, action in enumerate(m.cartesian(np.array([0.0, 0.0, -drop]), speed, guard=True)):
             yield action
             lag = (palm0 - m.ik.fk(m.qpos()).p[2]) - (z0 - float(self.env.obj(held).pose.p[0, 2]))
             if k < n - 1 and lag > PLACE_RESTING_M:
@@ -548,31 +578,39 @@ class RigidPrimitives:
         raise ExecutionError(f"no flat-hand pose behind {name!r} that clears the table and the objects and that the "
                              "arm reaches", cause="no_ik")
 
-    def _level_path(self, start: sapien.Pose, goal: sapien.Pose, q: np.ndarray) -> list[np.ndarray] | None:
-        """Joint vectors moving the palm straight from ``start`` to ``goal`` at a constant orientation, at most
-        :data:`CARRY_M_PER_STEP` a step and ``carry_step_rad`` per joint; None if a step has no IK, jumps branches or
-        collides (the planner's path is used then)."""
+    def _level_path(self, start: sapien.Pose, goal: sapien.Pose, q: np.ndarray, pace: float = 1.0,
+                    turn: float = 0.0, pivot: np.ndarray | None = None) -> list[np.ndarray] | None:
+        """Joint vectors moving the palm straight from ``start`` to ``goal`` at a constant orientation (or turning
+        steadily by ``turn`` rad about the vertical through ``pivot``, which moves with the palm: the held object's
+        centre), at most :data:`CARRY_M_PER_STEP` a step and ``carry_step_rad`` per joint (both times ``pace``);
+        None if a step has no IK, jumps branches or collides (the planner's path is used then)."""
         m = self.m
+        speed, step_rad = CARRY_M_PER_STEP * pace, self.config.carry_step_rad * pace
         length = float(np.linalg.norm(goal.p - start.p))
         # speed ramps up and down over CARRY_RAMP_STEPS (a held ball flies out of a sudden 0.4 m/s start)
-        ramp = np.minimum(1.0, np.arange(1, 4 * CARRY_RAMP_STEPS + int(length / CARRY_M_PER_STEP) + 2)
-                          / CARRY_RAMP_STEPS) * CARRY_M_PER_STEP
+        ramp = np.minimum(1.0, np.arange(1, 4 * CARRY_RAMP_STEPS + int(length / speed) + 2) / CARRY_RAMP_STEPS) * speed
         travelled, profile = 0.0, []
         for v in ramp:
             if travelled >= length:
                 break
             left = length - travelled
-            slow = min(1.0, left / (CARRY_RAMP_STEPS * CARRY_M_PER_STEP) + 0.2)
+            slow = min(1.0, left / (CARRY_RAMP_STEPS * speed) + 0.2)
             travelled = min(length, travelled + v * slow)
             profile.append(travelled / max(length, 1e-9))
         out = []
         for f in profile:
-            nq = m.ik.solve(sapien.Pose(start.p + (goal.p - start.p) * f, start.q), q, restarts=0)
+            pose = sapien.Pose(start.p + (goal.p - start.p) * f, start.q)
+            if turn:
+                at = sapien.Pose((start.p if pivot is None else pivot) + (goal.p - start.p) * f)
+                yaw = turn * f
+                pose = at * sapien.Pose(q=[np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]) * at.inv() * pose
+            nq = m.ik.solve(pose, q, restarts=0)
             if nq is None or not m.collision.is_free(nq):
                 return None
-            steps = int(np.ceil(np.max(np.abs(nq[m.arm] - q[m.arm])) / self.config.carry_step_rad))
-            if steps > 8:  # an IK branch jump, not a fast stretch of the straight line
+            jump = float(np.max(np.abs(nq[m.arm] - q[m.arm])))
+            if jump > 8 * self.config.carry_step_rad:  # an IK branch jump, not a fast stretch of the straight line
                 return None
+            steps = int(np.ceil(jump / step_rad))
             out += [q + (nq - q) * j / max(steps, 1) for j in range(1, max(steps, 1) + 1)]
             q = nq
         return out
@@ -593,12 +631,19 @@ class RigidPrimitives:
         yield from m.cartesian(0.05 * back / np.linalg.norm(back), 0.01)
 
 
-def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
-    """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii."""
+def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01, cell_m: float = 0.02
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii.
+    Seen from above the box is cut into cells about as wide as it is tall (at least ``cell_m``), each covered by
+    a column of spheres as wide as the cell's diagonal: one column for an object at least as tall as it is wide; a
+    layer of small spheres for a flat one (one ball as wide as a tuna can's diagonal would hang 3 cm below it)."""
     size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
-    r = float(min(size[:2]) / 2)
-    n = max(1, int(np.ceil(size[2] / (2 * r))))
-    z = np.linspace(lo[2] + shrink_m + r, hi[2] - shrink_m - r, n) if n > 1 else np.array([(lo[2] + hi[2]) / 2])
-    centre = (lo + hi) / 2
-    pts = np.stack([np.full(n, centre[0]), np.full(n, centre[1]), z], axis=1)
-    return pts, np.full(n, float(np.linalg.norm(size[:2]) / 2))
+    n = np.maximum(1, np.ceil(size[:2] / max(float(size[2]), cell_m) - 1e-9)).astype(int)
+    cell = size[:2] / n
+    r_in = float(min(cell)) / 2
+    nz = max(1, int(np.ceil(size[2] / (2 * r_in))))
+    z = np.linspace(lo[2] + shrink_m + r_in, hi[2] - shrink_m - r_in, nz) if nz > 1 else \
+        np.array([(lo[2] + hi[2]) / 2])
+    xs, ys = (lo[k] + shrink_m + cell[k] * (np.arange(n[k]) + 0.5) for k in range(2))
+    pts = np.stack(np.meshgrid(xs, ys, z, indexing="ij"), axis=-1).reshape(-1, 3)
+    return pts, np.full(len(pts), float(np.linalg.norm(cell) / 2))

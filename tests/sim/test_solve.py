@@ -183,3 +183,54 @@ def test_stage_executor_requires_absolute_targets():
             StageExecutor().reset(env, obs)
     finally:
         env.close()
+
+
+def test_a_paced_path_keeps_every_corner_and_runs_faster():
+    """Resampling a densified joint path for a short budget keeps its segments (every corner is a target), bounds
+    each step by pace x the path's largest step, and ends where the path ends."""
+    from gendex.solve.motion import resample
+
+    corners = np.array([[0.0, 0.0], [0.3, 0.0], [0.3, 0.24]])
+    dense = [corners[0]]
+    for a, b in zip(corners[:-1], corners[1:], strict=True):
+        n = int(np.ceil(np.max(np.abs(b - a)) / 0.06))
+        dense += [a + (b - a) * k / n for k in range(1, n + 1)]
+    dense = np.asarray(dense)
+    fast = resample(dense, 1.6)
+    assert len(fast) < len(dense) - 1
+    assert np.max(np.abs(np.diff(np.vstack([dense[:1], fast]), axis=0))) <= 1.6 * 0.06 + 1e-9
+    assert any(np.allclose(q, corners[1]) for q in fast)
+    assert np.allclose(fast[-1], corners[-1])
+    assert np.allclose(resample(dense, 1.0), dense[1:])
+
+
+def test_motions_keep_their_speed_with_room_and_hurry_when_the_budget_is_short(apple_env):
+    from gendex.solve.motion import MAX_PACE, ArmHandMotion
+
+    motion = ArmHandMotion(apple_env.unwrapped)
+    assert motion.pace(500) == 1.0  # no limit known
+    motion.set_budget(200, used=50)
+    motion.reserve = 60
+    assert motion.left() == 150
+    assert motion.pace(80) == 1.0
+    assert motion.pace(90, after=20) == pytest.approx(90 / 70)
+    assert motion.pace(400) == MAX_PACE
+
+
+@pytest.mark.parametrize(("task", "seeds"), [("GenDex/SetBottleOnPlate-v0", (3, 4)),
+                                             ("GenDex/PutTunaCanInPot-v0", (14, 15))])
+def test_generated_v0_tasks_are_solved_within_their_200_step_limit(task, seeds):
+    """SetBottleOnPlate-v0 and PutTunaCanInPot-v0 as generated: 200 steps per episode, where the carry and set-down
+    at nominal speeds took 170-250; and a tuna can grasp stage asking for two fingers beside the thumb (a pinch
+    closes one: the middle finger joins the index)."""
+    from gendex.solve.attempt import run_attempt
+
+    env = gym.make(task, control_mode="pd_joint_pos", control_joint="both")
+    try:
+        executor = StageExecutor()
+        for seed in seeds:
+            outcome = run_attempt(env, executor, seed)
+            assert outcome.succeeded, (seed, outcome.failure)
+            assert outcome.steps <= 200
+    finally:
+        env.close()
