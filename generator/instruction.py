@@ -242,7 +242,11 @@ def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
         add(a["id"].replace("_", " "), "id", [a])
         cat, aid = a["category"], a["id"]
         if aid.startswith(cat + "_"):  # block_small -> 'small block', trash_can_tall -> 'tall trash can'
-            add(f"{aid[len(cat) + 1:].replace('_', ' ')} {cat.replace('_', ' ')}", "id", [a])
+            suffix = aid[len(cat) + 1:].replace("_", " ")
+            add(f"{suffix} {cat.replace('_', ' ')}", "id", [a])
+            for phrase, target in SYNONYMS.items():  # ... 'tall bin', 'compact microwave oven'
+                if target == cat:
+                    add(f"{suffix} {phrase}", "id", [a])
     for a in assets:
         cat = a["category"]
         same = [b for b in assets if b["category"] == cat]
@@ -339,7 +343,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
     unknown = []
     for k, w in enumerate(words):
-        if used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or len(w) < 3:
+        if used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or (len(w) < 3 and not w.isdigit()):
             continue
         if w in _VERB_WORDS or w in _FILLER:
             continue
@@ -412,7 +416,7 @@ def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict
     models = [a for a in assets if a["id"] == m.asset or ((m.how != "id" or m.asset == category)
                                                             and a["category"] == category)]
     keys = {QUALIFIER_WORDS.get(w, w) for w in words}
-    chosen = [a for a in models if keys & set(a["id"].split("_"))]
+    chosen = [a for a in models if any(p.startswith(k) for k in keys for p in a["id"].split("_"))]
     if not chosen:
         return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), (
             f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
@@ -422,16 +426,19 @@ def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict
 
 
 def _one_per_object(mentions: list[Mention]) -> list[Mention]:
-    """One mention per object named twice (*the drawer of the dresser*: both words name the drawer chests); the
-    more specific wording is kept (an id before a name before a synonym)."""
+    """One mention per object named twice (*the drawer of the dresser*: both words name the drawer chests; *the
+    two-drawer dresser*: one of them); the narrower reading is kept, then the more specific wording (an id before a
+    name before a synonym)."""
     rank = {"id": 0, "name": 1, "synonym": 2}
     out: list[Mention] = []
     for m in mentions:
-        same = next((k for k, o in enumerate(out) if m.how in rank and o.how in rank and o.options
-                     and set(o.options) == set(m.options)), None)
+        same = next((k for k, o in enumerate(out) if m.how in rank and o.how in rank and o.options and m.options
+                     and (set(o.options) <= set(m.options) or set(m.options) <= set(o.options))), None)
         if same is None:
             out.append(m)
-        elif rank[m.how] < rank[out[same].how]:
+            continue
+        o = out[same]
+        if (len(m.options), rank[m.how]) < (len(o.options), rank[o.how]):
             out[same] = m
     return out
 

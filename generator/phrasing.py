@@ -49,6 +49,17 @@ NAMES: dict[str, tuple[str, ...]] = {
 """Words for a catalog category (default: the category with spaces); every one is read back to that category by
 :mod:`generator.instruction`."""
 
+MODEL_WORDS: dict[str, str] = {
+    "cabinet_left_hinge": "left-hinged", "cabinet_right_hinge": "right-hinged",
+    "refrigerator_left_hinge": "left-hinged", "refrigerator_right_hinge": "right-hinged",
+    "microwave_compact": "compact", "microwave_standard": "standard", "oven_compact": "compact",
+    "oven_standard": "standard", "drawer_chest_1": "single-drawer", "drawer_chest_2": "two-drawer",
+    "drawer_chest_3": "three-drawer", "trash_can_small": "small", "trash_can_tall": "tall",
+    "box_with_lid_small": "small", "box_with_lid_large": "large", "laptop_13in": "13-inch", "laptop_15in": "15-inch",
+}
+"""Words that tell an articulated model from its siblings (read back by :mod:`generator.instruction` as that
+model): two tasks on sibling models must not read alike."""
+
 SURFACES = ("table", "tabletop", "counter", "worktop")
 
 COMMANDS: dict[str, tuple[str, ...]] = {
@@ -233,6 +244,7 @@ def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | No
         raise KeyError(f"no wording for skill {skill!r}; known: {sorted(COMMANDS)}")
     surface = _pick(rng, SURFACES)
     articulated = bool(main.get("joints"))
+    main_qualifier = main_qualifier or MODEL_WORDS.get(main["id"], "")
     o = _pick(rng, names_for(main, main_qualifier))
     d = _pick(rng, names_for(other, other_qualifier)) if other is not None else o
     command = _pick(rng, COMMANDS[skill]).format(o=o, d=d if not articulated else o, s=surface)
@@ -249,4 +261,4 @@ def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | No
     return _sentence(command)
 
 
-__all__ = ["COMMANDS", "NAMES", "PURPOSES", "SITUATIONS", "domain", "names_for", "phrase"]
+__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "SITUATIONS", "domain", "names_for", "phrase"]

@@ -99,11 +99,16 @@ listed variant of the same object as a recorded substitution."""
 LAYOUT_JITTER_M = 0.02
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
-STACK_PAIRS = (("block_medium", "block_large"),)
-"""(top, base) blocks the autonomous grammar stacks: the pair StackBlocks measured (93-100 % on unseen seeds). The
-small block on the large one was 6/10 (it lands more than 3 cm off the base's centre): written only when asked for."""
-PUSHED = ("block_large",)
-"""Blocks the autonomous grammar pushes (PushBlockToGoal: the large one, 50/50; a generated push of it 10/10)."""
+STACK_PAIRS: dict[tuple[str, str], str | None] = {
+    ("block_medium", "block_large"): "StackBlocks 93-100 % on unseen seeds",
+    ("rubiks_cube", "block_large"): None, ("foam_brick", "block_large"): None, ("block_small", "block_medium"): None,
+}
+"""(top, base) pairs the autonomous grammar stacks (the base is a block), with where the pair was measured; None: a
+candidate the solvability gate judges. The small block on the large one was 6/10 (it lands more than 3 cm off the
+base's centre): written only when asked for."""
+PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a generated push 10/10",
+                                 "rubiks_cube": None, "foam_brick": None, "tuna_can": None, "sponge": None}
+"""Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
 DISTRACTOR_P = 0.4
 """Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
 STACK_GAP_M = 0.03
@@ -257,11 +262,10 @@ class OfflineBackend:
         out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
         out += [("place_on", self._plate_task(a, b)) for a in g for b in p]
         out += [("open_" + _part(a), self._open_task(a)) for a in o]
-        blocks = [a for a in g if "block" in a["tags"] and a["category"] == "block"]
-        usable = {a["id"]: a for a in blocks}
+        usable = {a["id"]: a for a in g}
         out += [("stack", self._stack_task(usable[t], usable[b])) for t, b in STACK_PAIRS
-                if t in usable and b in usable]
-        out += [("push", self._push_task(a)) for a in blocks if a["id"] in PUSHED]
+                if t in usable and b in usable and usable[b]["category"] == "block"]
+        out += [("push", self._push_task(a)) for a in g if a["id"] in PUSHED]
         by_id = {a["id"]: a for a in assets}
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:

@@ -168,6 +168,7 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
             if why is not None:
                 log.info("proposal %s rejected as a near-duplicate: %s", proposal.name, why)
                 reasons.append(f"{proposal.name}: {why}")
+                existing = (*existing, proposal.name)  # not again
                 continue
         if reading is not None:
             proposal = with_reading(proposal, reading)

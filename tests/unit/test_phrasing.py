@@ -73,3 +73,17 @@ def test_every_catalog_object_has_situations_and_purposes():
         assert SITUATIONS[d] and PURPOSES[d], a["id"]
     assert domain(ASSETS["lemon"]) == "fruit" and domain(ASSETS["hammer"]) == "tool"
     assert domain(ASSETS["trash_can_small"]) == "waste"
+
+
+def test_sibling_models_are_worded_apart_and_read_back_as_themselves():
+    """Two tasks on sibling models (the two- and the three-drawer chest) must not read alike: the model's words
+    come with every name, and the reader takes them back to that model."""
+    from generator.phrasing import MODEL_WORDS
+
+    for aid, words in MODEL_WORDS.items():
+        for name in names_for(ASSETS[aid], words):
+            r = read_instruction(f"close the {name}", list(ASSETS.values()))
+            assert [m.asset for m in r.objects] == [aid] and not r.substitutions, (name, r.lines())
+    two = phrase("close_drawer", ASSETS["drawer_chest_2"], np.random.default_rng(0))
+    three = phrase("close_drawer", ASSETS["drawer_chest_3"], np.random.default_rng(0))
+    assert "two-drawer" in two and "three-drawer" in three
