@@ -30,15 +30,16 @@ link is at any joint position.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 import sapien
 
-from gendex.solve.collision import Box
+from gendex.solve.collision import Box, rotated_box_cover
 from gendex.solve.grasp import axis_rotation, palm_rotation
+from gendex.solve.shape import ObjectShape, PosedShape
 from gendex_envs.errors import ExecutionError
 from gendex_envs.physx import px_objects
 
@@ -72,6 +73,8 @@ OVERSHOOT = 0.05
 """The closed loop commands at most this far (rad or m) past its goal."""
 ARC_CHECK_RAD = 0.05
 """Door-angle spacing of the reachability check along the arc."""
+ESCAPE_M = 0.15
+"""Highest rise of the palm out of the collision model's margins before the open hand is brought to a handle."""
 MAX_ARC_JUMP_RAD = 0.35
 """Largest arm-joint change between neighbouring arc samples: more means IK jumped to another branch."""
 
@@ -145,6 +148,12 @@ def read_joint(env: TaskEnv, name: str, env_idx: int = 0) -> JointFrame:
     link = _matrix(sapien.Pose(pose.p[env_idx].cpu().numpy(), pose.q[env_idx].cpu().numpy()))
     return JointFrame(point=frame[:3, 3].copy(), axis=frame[:3, 0] / np.linalg.norm(frame[:3, 0]),
                       q=float(env.joint_qpos(name)[env_idx]), link=link, prismatic=px.type == "prismatic")
+
+
+def link_pose(link) -> np.ndarray:
+    """[4, 4] world pose of a ManiSkill link (first sub-scene)."""
+    pose = link.pose
+    return sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
 
 
 def handle_local(env: TaskEnv, name: str) -> np.ndarray:
@@ -269,14 +278,19 @@ class HandleConfig:
 
 
 class HandlePrimitives:
-    """The articulated primitives of one episode, built on the executor's :class:`ArmHandMotion`."""
+    """The articulated primitives of one episode, built on the executor's :class:`ArmHandMotion`; ``hand_cover``
+    gives the open hand's sphere cover (palm frame) that the arm's collision model carries while it brings the hand
+    to the part (None: the arm alone)."""
 
-    def __init__(self, motion: ArmHandMotion, config: HandleConfig | None = None):
+    def __init__(self, motion: ArmHandMotion, config: HandleConfig | None = None,
+                 hand_cover: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None):
         self.motion = motion
         self.config = config or HandleConfig()
+        self.hand_cover = hand_cover
         self.grasp: HookGrasp | None = None
         self.hooked = False
         self.target: str | None = None
+        self._shapes: dict[tuple[str, str], ObjectShape | None] = {}
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
         """The actions of primitive ``prim`` (``approach_handle``, ``hook``, ``pull`` or ``shut``) for ``stage``."""
@@ -307,6 +321,45 @@ class HandlePrimitives:
             aabb = px_objects(link)[0].compute_global_aabb_tight()  # PhysX's tight box
             lo, hi = np.asarray(aabb, dtype=np.float64)
             boxes.append(Box(lo - inflate_m, hi + inflate_m, f"{name}/{link.name}"))
+        return boxes
+
+    def _link_shape(self, name: str, link) -> ObjectShape | None:
+        """Convex parts of ``name``'s link ``link`` in its own frame (cached; None for a link without collision
+        shapes)."""
+        key = (name, link.name)
+        if key not in self._shapes:
+            try:
+                self._shapes[key] = ObjectShape.of_actor(link)
+            except ValueError:
+                self._shapes[key] = None
+        return self._shapes[key]
+
+    def _shape(self, name: str) -> ObjectShape:
+        """The moving link's convex parts, in its own frame."""
+        link = self.motion.env.handle_link(name)
+        shape = self._link_shape(name, link)
+        if shape is None:
+            raise ExecutionError(f"{name!r}: the moving link {link.name!r} has no collision shapes",
+                                 cause="unsupported")
+        return shape
+
+    def _fixed_shapes(self, name: str) -> list[PosedShape]:
+        """World shapes of ``name``'s links that the pressed joint does not move."""
+        moving = self.motion.env.handle_link(name).name
+        links = [k for k in self.motion.env.articulations[name].get_links() if k.name != moving]
+        return [shape.posed(link_pose(link)) for link in links
+                if (shape := self._link_shape(name, link)) is not None]
+
+    def _part_boxes(self, name: str) -> list[Box]:
+        """Obstacles while the open hand comes to the part: the fixed links' boxes and the moving link's convex
+        parts, each covered by small boxes along it (:func:`~gendex.solve.collision.rotated_box_cover`: not one box
+        over the wedge a swung door spans), all inflated 1 cm."""
+        boxes = self._boxes(name, moving=True)
+        link = self.motion.env.handle_link(name)
+        m = link_pose(link)
+        for part in self._shape(name).parts:
+            boxes += rotated_box_cover(part.vertices.min(axis=0), part.vertices.max(axis=0), m, 0.01,
+                                       name=f"{name}/{link.name}")
         return boxes
 
     def _chain(self, poses: list[sapien.Pose], q: np.ndarray, restarts: int = 0) -> np.ndarray | None:
@@ -359,11 +412,36 @@ class HandlePrimitives:
         grasp, q_pre, q0 = chosen
         log.info("%r: %s", name, grasp)
         self.grasp, self.target, self.hooked = grasp, name, False
-        ex.collision.set_obstacles(self._boxes(name, moving=False))
-        yield from ex.move_arm(q_pre, hand=q0)
+        yield from self._bring_open_hand(name, q_pre, q0)
         normal = joint.link[:3, :3] @ grasp.normal_local
         yield from ex.cartesian(-PRE_M * normal, self.config.insert_m_per_step)
         yield from ex.settle()
+
+    def _bring_open_hand(self, name: str, q_pre: np.ndarray, q0: np.ndarray) -> Iterator[np.ndarray]:
+        """Planned arm motion to the pre-pose ``q_pre`` with the open hand (targets ``q0``) in the collision model
+        among the part's boxes (:meth:`_part_boxes`), after the palm rose clear of what the resting hand touches (an
+        oven put beside the rest pose: dragged across it, the fingers caught on the door's bar); the arm alone
+        among the fixed links' boxes when that finds no path."""
+        ex = self.motion
+        path, rise = None, 0.0
+        if self.hand_cover is not None:
+            ex.collision.set_obstacles(self._part_boxes(name))
+            ex.collision.cover_hand(*self.hand_cover())
+            try:
+                rise, start = ex.rise_clear(q0, ESCAPE_M)
+                path = ex.plan_arm(q_pre, hand=q0, start=start)
+            except ExecutionError as exc:
+                log.debug("no path with the open hand covered (%s): planning the arm alone", exc)
+                path, rise = None, 0.0
+            finally:
+                ex.collision.cover_hand(None)
+        ex.collision.set_obstacles(self._boxes(name, moving=False))
+        if path is None:
+            yield from ex.move_arm(q_pre, hand=q0)
+            return
+        if rise > 0:
+            yield from ex.cartesian(np.array([0.0, 0.0, rise]), self.config.insert_m_per_step)
+        yield from path
 
     def hook(self, stage) -> Iterator[np.ndarray]:
         ex, c = self.motion, self.config

@@ -121,7 +121,7 @@ class StageExecutor:
         self.rigid.reset()
         self.carried = False
         self.logs: list[StageLog] = []
-        self._handles = HandlePrimitives(self.motion)
+        self._handles = HandlePrimitives(self.motion, hand_cover=self._hand_cover)
         self._presses = PressPrimitives(self.motion, self._hand_cover)
         limit = [n for n in (time_limit(env), getattr(u, "horizon", None)) if n is not None]
         self.motion.set_budget(min(limit) if limit else None, int(u.elapsed_steps[0]))

@@ -175,6 +175,20 @@ class ArmHandMotion:
             t[self.arm] = q[self.arm]
             yield self.emit(t, guard)
 
+    def rise_clear(self, q: np.ndarray, max_m: float, step_m: float = 0.03) -> tuple[float, np.ndarray]:
+        """How far the palm must rise from joint vector ``q`` (0 to ``max_m``, in ``step_m`` steps) before the arm
+        and whatever the collision model carries (an opened hand) are clear, and the joint vector there (``q``
+        itself when no rise clears it): the planner must start from a free configuration, or it would plan a hand
+        that hovers over an object, or rests against one, straight through it."""
+        palm = self.ik.fk(q)
+        for up in np.arange(0.0, max_m + 1e-9, step_m):
+            goal = q if up == 0 else self.ik.solve(sapien.Pose(palm.p + [0.0, 0.0, up], palm.q), q, restarts=0)
+            if goal is None:
+                break
+            if self.collision.is_free(goal):
+                return float(up), goal
+        return 0.0, q
+
     # ------------------------------------------------------------------ scene geometry
     def world_aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World bounding box (lo, hi) of object ``name``'s catalog box, as it is posed now."""

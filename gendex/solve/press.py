@@ -44,7 +44,6 @@ from gendex.solve.articulated import (
     opening_goal,
     read_joint,
 )
-from gendex.solve.collision import Box, rotated_box_cover
 from gendex.solve.grasp import axis_rotation, palm_rotation
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex_envs.errors import ExecutionError
@@ -202,12 +201,6 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
     return out
 
 
-def _link_pose(link) -> np.ndarray:
-    """[4, 4] world pose of a ManiSkill link (first sub-scene)."""
-    pose = link.pose
-    return sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()).to_transformation_matrix()
-
-
 def _clear(palm: sapien.Pose, centres: np.ndarray, radii: np.ndarray, shapes: list[PosedShape],
            margin_m: float) -> bool:
     """Whether the hand's spheres (palm frame) at ``palm`` stay ``margin_m`` off every shape and the table."""
@@ -223,9 +216,7 @@ class PressPrimitives(HandlePrimitives):
     the arm's collision model carries while it brings the hand to the part."""
 
     def __init__(self, motion, hand_cover: Callable[[], tuple[np.ndarray, np.ndarray]], config=None):
-        super().__init__(motion, config)
-        self.hand_cover = hand_cover
-        self._shapes: dict[tuple[str, str], ObjectShape] = {}
+        super().__init__(motion, config, hand_cover)
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
         if prim not in ("approach_press", "press"):
@@ -255,44 +246,6 @@ class PressPrimitives(HandlePrimitives):
         lo, hi = u.articulations[name].get_qlimits()[0, u.joint_index(name)].tolist()
         return float(np.clip(goal + sign * OVERSHOOT, lo, hi))
 
-    def _link_shape(self, name: str, link) -> ObjectShape | None:
-        """Convex parts of ``name``'s link ``link`` in its own frame (cached; None for a link without collision
-        shapes)."""
-        key = (name, link.name)
-        if key not in self._shapes:
-            try:
-                self._shapes[key] = ObjectShape.of_actor(link)
-            except ValueError:
-                self._shapes[key] = None
-        return self._shapes[key]
-
-    def _shape(self, name: str) -> ObjectShape:
-        """The moving link's convex parts, in its own frame."""
-        link = self.motion.env.handle_link(name)
-        shape = self._link_shape(name, link)
-        if shape is None:
-            raise ExecutionError(f"{name!r}: the moving link {link.name!r} has no collision shapes to press",
-                                 cause="unsupported")
-        return shape
-
-    def _fixed_shapes(self, name: str) -> list[PosedShape]:
-        """World shapes of ``name``'s links that the pressed joint does not move."""
-        moving = self.motion.env.handle_link(name).name
-        links = [k for k in self.motion.env.articulations[name].get_links() if k.name != moving]
-        return [shape.posed(_link_pose(link)) for link in links
-                if (shape := self._link_shape(name, link)) is not None]
-
-    def _press_boxes(self, name: str) -> list[Box]:
-        """Obstacles while the hand comes to the part: the fixed links' boxes and the moving link's convex parts,
-        each covered by small boxes along it (:func:`rotated_box_cover`), all inflated 1 cm."""
-        boxes = self._boxes(name, moving=True)
-        link = self.motion.env.handle_link(name)
-        m = _link_pose(link)
-        for part in self._shape(name).parts:
-            boxes += rotated_box_cover(part.vertices.min(axis=0), part.vertices.max(axis=0), m, 0.01,
-                                       name=f"{name}/{link.name}")
-        return boxes
-
     def approach_press(self, stage) -> Iterator[np.ndarray]:
         ex, name = self.motion, stage.target
         u = ex.env
@@ -303,7 +256,7 @@ class PressPrimitives(HandlePrimitives):
         centres, radii = self.hand_cover()
         fixed = self._fixed_shapes(name)
         moving = self._shape(name).posed(joint.link)
-        around = self._press_boxes(name)
+        around = self._part_boxes(name)
         chosen = None
         for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign):
             touch = pose.palm_at(joint, joint.q)

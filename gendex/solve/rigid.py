@@ -267,7 +267,7 @@ class RigidPrimitives:
         m.avoid_objects()
         m.collision.cover_hand(cover.centers, cover.radii)
         try:
-            lift, start = self._clear_start(hand_q)
+            lift, start = m.rise_clear(hand_q, ESCAPE_M)
             for back, rise, out in STAGING_M:
                 offset = -back * plan.approach + rise * up + out * away
                 stage = sapien.Pose(plan.pregrasp.p + offset, plan.pregrasp.q)
@@ -295,21 +295,6 @@ class RigidPrimitives:
             m.avoid_objects(exclude=(name,))
         log.info("no staged approach to the %s: planning the arm alone", plan)
         yield from m.move_arm(q_pre, hand=hand_q, after=n_in)
-
-    def _clear_start(self, hand_q: np.ndarray) -> tuple[float, np.ndarray]:
-        """How far the palm must rise (0 to :data:`ESCAPE_M`, in 3 cm steps) before the opened hand (targets
-        ``hand_q``) is clear of the collision model, and the joint vector there: the planner must start from a free
-        configuration, or it would plan a hand that hovers over an object in its rest pose straight through it."""
-        m = self.m
-        q = hand_q.copy()
-        palm = m.ik.fk(q)
-        for up in np.arange(0.0, ESCAPE_M + 1e-9, 0.03):
-            goal = q if up == 0 else m.ik.solve(sapien.Pose(palm.p + [0.0, 0.0, up], palm.q), q, restarts=0)
-            if goal is None:
-                break
-            if m.collision.is_free(goal):
-                return float(up), goal
-        return 0.0, q
 
     def carry_bottom(self, target: str) -> float:
         """Height (world z) of a carried object's bottom over ``target`` (its top + ``carry_clearance_m``)."""
