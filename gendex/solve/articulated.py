@@ -73,6 +73,9 @@ OVERSHOOT = 0.05
 """The closed loop commands at most this far (rad or m) past its goal."""
 ARC_CHECK_RAD = 0.05
 """Door-angle spacing of the reachability check along the arc."""
+INFLATES_M = (0.01, 0.0)
+"""How much the object's link boxes are inflated for the arm while a hook grasp is checked: every candidate with
+the first, then with the next."""
 ESCAPE_M = 0.15
 """Highest rise of the palm out of the collision model's margins before the open hand is brought to a handle."""
 MAX_ARC_JUMP_RAD = 0.35
@@ -388,40 +391,48 @@ class HandlePrimitives:
         handle = handle_local(u, name)
         goal = self._goal(name)
         chosen = None
-        for grasp in hook_grasps(joint, handle):
-            q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
-            ex.collision.set_obstacles(self._boxes(name, moving=False))
-            q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20, valid=ex.collision.is_free)
-            if q_pre is None:
-                log.debug("%s: pre-pose unreachable", grasp)
-                continue
-            n = INSERT_CHECKS
-            q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)], q_pre)
-            if q_in is None:
-                log.debug("%s: no straight motion in", grasp)
-                continue
-            ex.collision.set_obstacles(self._boxes(name, moving=True))
-            if self._chain(self._arc(grasp, joint, goal), q_in) is None:
-                log.debug("%s: arm cannot follow the arc", grasp)
-                continue
-            chosen = (grasp, q_pre, q0)
-            break
+        # the links' boxes inflated 1 cm first; where no grasp clears them (a low drawer: the forearm housing
+        # passes 1.5 cm from the chest's front), the links' own boxes (the model's 2 cm margin still applies)
+        for inflate in INFLATES_M:
+            for grasp in hook_grasps(joint, handle):
+                q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
+                ex.collision.set_obstacles(self._boxes(name, moving=False, inflate_m=inflate))
+                q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20,
+                                    valid=ex.collision.is_free)
+                if q_pre is None:
+                    log.debug("%s: pre-pose unreachable", grasp)
+                    continue
+                n = INSERT_CHECKS
+                q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)],
+                                   q_pre)
+                if q_in is None:
+                    log.debug("%s: no straight motion in", grasp)
+                    continue
+                ex.collision.set_obstacles(self._boxes(name, moving=True, inflate_m=inflate))
+                if self._chain(self._arc(grasp, joint, goal), q_in) is None:
+                    log.debug("%s: arm cannot follow the arc", grasp)
+                    continue
+                chosen = (grasp, q_pre, q0, inflate)
+                break
+            if chosen is not None:
+                break
         if chosen is None:
             raise ExecutionError(f"no hook grasp of {name!r}'s handle that the arm can reach and pull along the "
                                  f"door's arc", cause="no_ik")
-        grasp, q_pre, q0 = chosen
+        grasp, q_pre, q0, inflate = chosen
         log.info("%r: %s", name, grasp)
         self.grasp, self.target, self.hooked = grasp, name, False
-        yield from self._bring_open_hand(name, q_pre, q0)
+        yield from self._bring_open_hand(name, q_pre, q0, inflate)
         normal = joint.link[:3, :3] @ grasp.normal_local
         yield from ex.cartesian(-PRE_M * normal, self.config.insert_m_per_step)
         yield from ex.settle()
 
-    def _bring_open_hand(self, name: str, q_pre: np.ndarray, q0: np.ndarray) -> Iterator[np.ndarray]:
+    def _bring_open_hand(self, name: str, q_pre: np.ndarray, q0: np.ndarray, inflate_m: float = 0.01
+                         ) -> Iterator[np.ndarray]:
         """Planned arm motion to the pre-pose ``q_pre`` with the open hand (targets ``q0``) in the collision model
         among the part's boxes (:meth:`_part_boxes`), after the palm rose clear of what the resting hand touches (an
         oven put beside the rest pose: dragged across it, the fingers caught on the door's bar); the arm alone
-        among the fixed links' boxes when that finds no path."""
+        among the links' boxes (inflated ``inflate_m``) when that finds no path."""
         ex = self.motion
         path, rise = None, 0.0
         if self.hand_cover is not None:
@@ -435,7 +446,7 @@ class HandlePrimitives:
                 path, rise = None, 0.0
             finally:
                 ex.collision.cover_hand(None)
-        ex.collision.set_obstacles(self._boxes(name, moving=False))
+        ex.collision.set_obstacles(self._boxes(name, moving=False, inflate_m=inflate_m))
         if path is None:
             yield from ex.move_arm(q_pre, hand=q0)
             return
