@@ -37,6 +37,7 @@ STEEL: RGBA = (0.75, 0.75, 0.78, 1.0)
 DARK: RGBA = (0.12, 0.12, 0.14, 1.0)
 PLASTIC: RGBA = (0.25, 0.45, 0.65, 1.0)
 SILVER: RGBA = (0.68, 0.70, 0.73, 1.0)
+RED: RGBA = (0.80, 0.15, 0.12, 1.0)
 
 BAR_R = 0.011
 """Default handle-bar radius (Ø 2.2 cm)."""
@@ -485,6 +486,20 @@ def faucet(id: str, mode: Literal["swivel", "lift"]) -> Model:
                  params={"mode": mode, "column_height": top})
 
 
+def valve(id: str, top: float = 0.12, lever: float = 0.13) -> Model:
+    """A quarter-turn ball valve on an upright pipe ``top`` m tall, its lever (``lever`` m) pointing -x: the lever
+    turns 90° about the pipe's vertical axis (towards -y)."""
+    body = [cyl((0.0, 0.0, 0.006), 0.04, 0.012, "z", STEEL), cyl((0.0, 0.0, top / 2), 0.018, top, "z", STEEL),
+            cyl((0.0, 0.0, top - 0.045), 0.026, 0.07, "y", SILVER)]  # base flange, riser, valve body across it
+    arm = [cyl((0.0, 0.0, 0.01), 0.015, 0.02, "z", STEEL), box((-lever, -0.012, 0.012), (-0.005, 0.012, 0.027), RED)]
+    grip = (-0.7 * lever, 0.0, 0.0195)
+    joint = Joint("lever_hinge", "revolute", "body", "lever", (0.0, 0.0, top), (0.0, 0.0, 1.0), (0.0, 1.57), 0.0, 1.2,
+                  grip, damping=0.02, friction=0.005, effort=5.0)
+    return Model(id, "valve", ("fixture", "plumbing", "lever"),
+                 (Link("body", 1.2, tuple(body)), Link("lever", 0.12, tuple(arm))), (joint,), friction=0.7,
+                 params={"pipe_height": top, "lever_length": lever})
+
+
 def knob(id: str, style: Literal["stove", "dial"]) -> Model:
     """A control knob on a small upright panel, turning about x (counter-clockwise seen from the front opens)."""
     if style == "stove":
@@ -529,6 +544,8 @@ VARIANTS: dict[str, Callable[[], Model]] = {
     "trash_can_tall": lambda: trash_can("trash_can_tall", 0.26, 0.30, 0.40),
     "faucet_lever_swivel": lambda: faucet("faucet_lever_swivel", "swivel"),
     "faucet_lever_lift": lambda: faucet("faucet_lever_lift", "lift"),
+    "valve_lever": lambda: valve("valve_lever"),
+    "valve_lever_short": lambda: valve("valve_lever_short", 0.09, 0.10),
     "knob_stove": lambda: knob("knob_stove", "stove"),
     "knob_dial": lambda: knob("knob_dial", "dial"),
 }
