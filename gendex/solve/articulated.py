@@ -282,11 +282,11 @@ class HandleConfig:
 
 class HandlePrimitives:
     """The articulated primitives of one episode, built on the executor's :class:`ArmHandMotion`; ``hand_cover``
-    gives the open hand's sphere cover (palm frame) that the arm's collision model carries while it brings the hand
-    to the part (None: the arm alone)."""
+    gives the sphere cover (palm frame) of the open hand, or of the hand at the joint targets it is given, that the
+    arm's collision model carries while it brings the hand to the part (None: the arm alone)."""
 
     def __init__(self, motion: ArmHandMotion, config: HandleConfig | None = None,
-                 hand_cover: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None):
+                 hand_cover: Callable[..., tuple[np.ndarray, np.ndarray]] | None = None):
         self.motion = motion
         self.config = config or HandleConfig()
         self.hand_cover = hand_cover

@@ -144,9 +144,9 @@ class StageExecutor:
             self.logs[-1].steps += self.motion.steps - before
         return action
 
-    def _hand_cover(self) -> tuple[np.ndarray, np.ndarray]:
-        """Sphere cover (palm frame: centres, radii) of the hand opened flat for a press."""
-        cover = self.rigid.hand.spheres(HOOK_OPEN)
+    def _hand_cover(self, hand: dict[str, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Sphere cover (palm frame: centres, radii) of the hand at ``hand`` (default: opened flat for a press)."""
+        cover = self.rigid.hand.spheres(HOOK_OPEN if hand is None else hand)
         return cover.centers, cover.radii
 
     @property

@@ -57,6 +57,16 @@ the open hand: palm skin at y = -13.3 mm, the palm spans z = 0 to 0.09)."""
 FINGER_CONTACT = np.array([0.0, -0.010, 0.18])
 """Palm frame point that touches the surface in a fingertip press: the middle finger's skin at its pad, fingers
 straight (the finger pads lie at z = 0.174 to 0.185; the tips end 2 cm further)."""
+SHELF_HAND = HOOK_OPEN | {"FFJ2": 1.57, "MFJ2": 1.57, "RFJ2": 1.57, "LFJ2": 1.2, "LFJ1": 1.57, "LFJ0": 1.57}
+"""A shelf: the fingers bent square at their knuckles, straight beyond (the little finger curled out of the way),
+the thumb in the palm plane."""
+SHELF_CONTACT = np.array([0.011, -0.085, 0.091])
+"""Palm frame point that touches the surface in a shelf lift: the top of the bent middle finger 1.6 cm from its
+tip (its axis at z = 0.099, radius 7-8 mm; the fingers end at y = -0.101)."""
+SHELF_FOLLOWS = (-0.5, -0.25, 0.0)
+"""How much of the part's turn a shelf's palm takes on: turning against the part (-0.5) tips the fingers into it
+as it rises and keeps the wrist near the robot; a palm kept level (0) left the arm stretched straight before a
+bottom-hinged oven door was shut (no IK below 0.14 rad)."""
 CONTACT_GAP_M = 0.008
 """The press pose stops this short of the surface; the closed loop then pushes."""
 PRESS_LEAD_M = 0.03
@@ -114,6 +124,8 @@ class PressPose(LinkGrip):
     """Joint position at which :attr:`offset` was computed (where the palm faces the surface square on)."""
     contact: np.ndarray = field(default_factory=lambda: PALM_CONTACT.copy())
     """[3] palm frame point that touches the part."""
+    hand: dict[str, float] = field(default_factory=lambda: dict(HOOK_OPEN))
+    """Hand joint targets while the pose is brought in and pushes (the open hand, or a shelf)."""
 
     def palm_at(self, joint: JointFrame, q: float, out_m: float = 0.0) -> sapien.Pose:
         pose = super().palm_at(joint, q, out_m)
@@ -126,6 +138,9 @@ class PressPose(LinkGrip):
         return sapien.Pose(np.asarray(m, dtype=np.float32))
 
     def __str__(self) -> str:
+        if self.site == "shelf":
+            return (f"shelf lift at the grip point {self.shift_m[0]:+.2f} m along the axis and "
+                    f"{self.shift_m[1]:+.2f} m out (following {self.follow:.2f} of the turn)")
         return (f"press with the {self.site} at the grip point {self.shift_m[0]:+.2f} m along the axis and "
                 f"{self.shift_m[1]:+.2f} m out (fingers "
                 f"{self.fingers}, following {self.follow:.1f} of the turn, backing off {self.back})")
@@ -198,6 +213,36 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
                     for follow in FOLLOWS:
                         out.append(PressPose(off, back.copy(), site=site, fingers=words, back=how, shift_m=shift,
                                              follow=follow, q_ref=joint.q, contact=contact.copy()))
+    if not joint.prismatic:
+        out += shelf_poses(joint, contacts)
+    return out
+
+
+def shelf_poses(joint: JointFrame, contacts: list[tuple[np.ndarray, np.ndarray, tuple[float, float]]]
+                ) -> list[PressPose]:
+    """Shelf lifts of a hinged part (after every palm and fingertip press): the fingers bent square under the
+    surface at each contact (the shelf's top facing the push), pointing from the contact towards the hinge axis,
+    the palm on the far side of the contact from the hinge; it slides in along the bent fingers. A door that lies
+    open on its stop with its handle underneath (an oven's) is lifted shut by the edge beyond the handle, where no
+    palm fits under it."""
+    rot_t = joint.link[:3, :3].T
+    axis = rot_t @ joint.axis
+    hinge = rot_t @ (joint.point - joint.link[:3, 3])
+    out = []
+    for surface, m, shift in contacts:
+        inward = hinge - surface
+        inward -= np.dot(inward, axis) * axis + np.dot(inward, m) * m
+        if np.linalg.norm(inward) < 1e-6:
+            continue
+        inward /= np.linalg.norm(inward)
+        rot = palm_rotation(-m, inward)  # the palm's knuckle end against the push, bent fingers towards the hinge
+        off = np.eye(4)
+        off[:3, :3] = rot
+        off[:3, 3] = surface - CONTACT_GAP_M * m - rot @ SHELF_CONTACT
+        for follow in SHELF_FOLLOWS:
+            out.append(PressPose(off, -inward, site="shelf", fingers="bent towards the hinge",
+                                 back="along the bent fingers", shift_m=shift, follow=follow, q_ref=joint.q,
+                                 contact=SHELF_CONTACT.copy(), hand=dict(SHELF_HAND)))
     return out
 
 
@@ -215,7 +260,7 @@ class PressPrimitives(HandlePrimitives):
     """The press primitives of one episode; ``hand_cover`` gives the open hand's sphere cover (palm frame) that
     the arm's collision model carries while it brings the hand to the part."""
 
-    def __init__(self, motion, hand_cover: Callable[[], tuple[np.ndarray, np.ndarray]], config=None):
+    def __init__(self, motion, hand_cover: Callable[..., tuple[np.ndarray, np.ndarray]], config=None):
         super().__init__(motion, config, hand_cover)
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
@@ -253,20 +298,23 @@ class PressPrimitives(HandlePrimitives):
         sign = self._sign(stage)
         goal = self._press_goal(name, sign)
         stop = self._handover(name, joint, sign, goal)
-        centres, radii = self.hand_cover()
+        covers: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         fixed = self._fixed_shapes(name)
         moving = self._shape(name).posed(joint.link)
         around = self._part_boxes(name)
         chosen = None
         for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign):
             touch = pose.palm_at(joint, joint.q)
+            if pose.site not in covers:
+                covers[pose.site] = self.hand_cover(pose.hand)
+            centres, radii = covers[pose.site]
             if not _clear(touch, centres, radii, [moving], -HAND_CLEAR_M):
                 log.debug("%s: the hand would touch the part elsewhere", pose)
                 continue
             if not all(_clear(p, centres, radii, fixed, HAND_CLEAR_M) for p in [touch, *self._arc(pose, joint, stop)]):
                 log.debug("%s: the hand would hit the fixed part or the table", pose)
                 continue
-            q0 = ex.with_hand(ex.target(), HOOK_OPEN)
+            q0 = ex.with_hand(ex.target(), pose.hand)
             ex.collision.set_obstacles(around)  # the pre-pose: the open hand clear of the whole part
             ex.collision.cover_hand(centres, radii)
             try:
@@ -299,7 +347,7 @@ class PressPrimitives(HandlePrimitives):
         log.info("%r: %s", name, pose)
         self.grasp, self.target, self.hooked = pose, name, False
         ex.collision.set_obstacles(around)
-        ex.collision.cover_hand(centres, radii)
+        ex.collision.cover_hand(*covers[pose.site])
         try:
             path = ex.plan_arm(q_pre, hand=q0)
         except ExecutionError as exc:  # the hand starts too close to something: plan the arm alone
@@ -330,7 +378,7 @@ class PressPrimitives(HandlePrimitives):
             lead = max(self.config.lead_rad, PRESS_LEAD_M / max(radius, 1e-3))
         goal = self._press_goal(name, sign)
         stop = self._handover(name, joint, sign, goal)
-        yield from self._move_joint(stage, stop, sign, hand=HOOK_OPEN, lead=lead)
+        yield from self._move_joint(stage, stop, sign, hand=self.grasp.hand, lead=lead)
         if stop == goal:
             return
         ex = self.motion

@@ -58,19 +58,23 @@ def test_press_direction_is_where_the_grip_point_moves_in_the_simulator(make_env
 
 def test_press_poses_touch_the_part_square_on_and_follow_it(make_env):
     """Every press pose puts its palm-frame contact point CONTACT_GAP_M off the door's surface on the side the push
-    comes from, the palm facing the push; along the door's path the contact point stays on the door (a pose that
-    follows half the turn keeps the point, not the orientation)."""
+    comes from, the palm facing the push (a shelf: the top of its bent fingers); along the door's path the contact
+    point stays on the door (a pose that follows half the turn keeps the point, not the orientation)."""
     env = make_env("CloseCabinet")
     u = env.unwrapped
     env.reset(seed=2)
     joint = read_joint(u, "cabinet")
     shape = ObjectShape.of_actor(u.handle_link("cabinet"))
     poses = press.press_poses(joint, shape, handle_local(u, "cabinet"), -1.0)
-    assert {p.site for p in poses} == {"palm", "fingers"} and {p.follow for p in poses} == {1.0, 0.5}
+    assert {p.site for p in poses} == {"palm", "fingers", "shelf"}
+    assert {p.follow for p in poses if p.site != "shelf"} == {1.0, 0.5}
+    assert {p.follow for p in poses if p.site == "shelf"} == set(press.SHELF_FOLLOWS)
+    assert [p.site for p in poses].index("shelf") > max(i for i, p in enumerate(poses) if p.site != "shelf")
     for pose in poses:
         palm = pose.palm_at(joint, joint.q).to_transformation_matrix()
         touch = palm[:3, :3] @ pose.contact + palm[:3, 3]
-        push = palm[:3, :3] @ np.array([0.0, -1.0, 0.0])  # the palm's skin faces -y of the palm frame
+        # the palm's skin faces -y of the palm frame; a shelf's bent fingers face -z (the palm's knuckle end)
+        push = palm[:3, :3] @ (np.array([0.0, 0.0, -1.0]) if pose.site == "shelf" else np.array([0.0, -1.0, 0.0]))
         depth = shape.posed(joint.link).ray_intervals(touch, push)[0][0]
         assert depth == pytest.approx(press.CONTACT_GAP_M, abs=1e-4), pose
         surface = np.linalg.inv(joint.link) @ np.append(touch + depth * push, 1.0)
@@ -81,7 +85,7 @@ def test_press_poses_touch_the_part_square_on_and_follow_it(make_env):
         assert np.allclose(later[:3, :3] @ pose.contact + later[:3, 3], joint.point_at(local[:3], joint.q - 0.3),
                            atol=1e-5)
         turned = np.degrees(np.arccos(np.clip((np.trace(palm[:3, :3].T @ later[:3, :3]) - 1) / 2, -1, 1)))
-        assert turned == pytest.approx(np.degrees(0.3) * pose.follow, abs=0.01)
+        assert turned == pytest.approx(np.degrees(0.3) * abs(pose.follow), abs=0.01)
 
 
 def test_the_press_stops_where_gravity_takes_over_only_for_a_lid(make_env):
@@ -112,6 +116,7 @@ def test_the_press_stops_where_gravity_takes_over_only_for_a_lid(make_env):
     ("OpenTrashCan", "trash_can", lambda f: f >= 0.5),
     ("OpenBoxLid", "box", lambda f: f >= 0.5),
     ("CloseMicrowave", "microwave", lambda f: f < 0.1),
+    ("CloseOvenCompact", "oven", lambda f: f < 0.1),
 ])
 def test_the_executor_presses_parts_no_stage_grasps(make_env, task, name, done):
     env = make_env(task)
@@ -122,3 +127,14 @@ def test_the_executor_presses_parts_no_stage_grasps(make_env, task, name, done):
         fraction = float(u.joint_open_fraction(name)[0])
         assert bool(info["success"]) and done(fraction), (task, seed, fraction)
         assert [log.primitive for log in executor.logs][:2] == ["approach_press", "press"]
+
+
+def test_an_oven_door_lying_open_on_its_stop_is_lifted_shut_by_a_shelf_under_its_edge(make_env):
+    """The open oven door lies level on its stop with its handle underneath, 5 cm over the table: no palm or
+    fingertip press fits under it, and the shelf lift (fingers bent square under the free edge beyond the handle,
+    the palm turning against the door as it rises) is what the executor chooses and what shuts it."""
+    env = make_env("CloseOvenCompact")
+    executor = StageExecutor()
+    info = _run(env, 907, executor)
+    assert executor._presses.grasp.site == "shelf"
+    assert bool(info["success"]) and float(env.unwrapped.joint_open_fraction("oven")[0]) < 0.1
