@@ -368,7 +368,8 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
             typer.secho(line, fg=typer.colors.YELLOW if "SUBSTITUTED" in line or " chose " in line else None,
                         err=True)
     command = _command("generate")
-    rows = []
+    rows: list = []
+    failed: list[str] = []
     try:
         with tqdm(total=n, desc="tasks", unit="task") as bar:
             def progress(summary) -> None:
@@ -376,7 +377,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
             run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
-                         candidates=candidates, gate_attempts=gate_attempts, reading=reading)
+                         candidates=candidates, gate_attempts=gate_attempts, reading=reading, failed=failed)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")
@@ -392,6 +393,13 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         for phrase, asset in s.substitutions.items():
             typer.secho(f"    substituted: {phrase!r} -> {asset} (recorded in the task's proposal record)",
                         fg=typer.colors.YELLOW)
+    for reason in failed:
+        typer.secho(f"  no task: {reason}", fg=typer.colors.RED, err=True)
+    gated = sum(1 for s in rows for r in s.dropped if "solvability gate" in r)
+    typer.echo(f"\n{len(rows)} of {n} task(s) committed; {sum(len(s.dropped) for s in rows)} proposal(s) rejected on "
+               f"the way ({gated} by the solvability gate); {len(failed)} task slot(s) without a task")
+    if failed:
+        raise typer.Exit(1)
 
 
 @app.command()

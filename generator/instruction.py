@@ -50,7 +50,8 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck"),
               "a graspable object and a container (bowl, pot, mug), with 'in' or 'into'", "put the lemon in the bowl"),
     TaskSkill("place_on", ("set", "put", "place", "lay", "move", "rest"),
-              "a graspable object and a plate, with 'on' or 'onto'", "set the bottle on the plate"),
+              "a graspable object and a plate, tray or cutting board, with 'on' or 'onto'",
+              "set the bottle on the plate"),
     TaskSkill("stack", ("stack", "pile", "balance"), "two blocks", "stack the small block on the large block"),
     TaskSkill("push", ("push", "slide", "shove", "nudge"), "an object on the table, pushed to a goal mark",
               "push the block to the goal"),
@@ -59,7 +60,7 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
               "open the top drawer"),
     TaskSkill("close", ("close", "shut", "push shut", "push closed"),
               "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
-    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing"), "a faucet lever",
+    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing"), "a faucet or valve lever",
               "turn on the faucet"),
     TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
@@ -82,6 +83,8 @@ SYNONYMS: dict[str, str] = {
     "tin of tuna": "tuna_can", "serving bowl": "bowl", "mixing bowl": "bowl", "dinner plate": "plate",
     "teacup": "cup", "soft brick": "foam_brick", "puzzle cube": "rubiks_cube", "drawer unit": "drawer_chest",
     "storage box": "box_with_lid", "notebook computer": "laptop", "stove knob": "knob_stove",
+    "chopping board": "cutting_board", "serving tray": "tray", "ball valve": "valve", "shutoff valve": "valve",
+    "stopcock": "valve",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 
@@ -142,7 +145,7 @@ class Reading:
     skill: str
     """A key of :data:`TASK_SKILLS`."""
     objects: tuple[Mention, ...]
-    """In the order of their roles (the thing acted on first, then the container, plate or base)."""
+    """In the order of their roles (the thing acted on first, then the container, surface or base)."""
     notes: tuple[str, ...] = field(default=())
     """Parts of the request that shape nothing (``the top drawer``: the drawer the solver opens is the first)."""
 
@@ -179,8 +182,9 @@ def is_container(a: dict) -> bool:
     return "container" in a["tags"] and not a.get("joints") and a["category"] not in ("cup", "wine_glass", "jar")
 
 
-def is_plate(a: dict) -> bool:
-    return a["category"] == "plate"
+def is_surface(a: dict) -> bool:
+    """Something flat to set an object on: a plate, or an asset tagged ``surface`` (tray, cutting board)."""
+    return a["category"] == "plate" or ("surface" in a["tags"] and not a.get("joints"))
 
 
 def is_block(a: dict) -> bool:
@@ -197,7 +201,7 @@ def part_kinds(a: dict) -> tuple[str, ...]:
 
 
 ROLE_TESTS = {
-    "graspable": is_graspable, "container": is_container, "plate": is_plate, "block": is_block,
+    "graspable": is_graspable, "container": is_container, "surface": is_surface, "block": is_block,
     "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
@@ -206,7 +210,7 @@ ROLE_TESTS = {
 """What an object must be to play each role."""
 
 SKILL_ROLES: dict[str, tuple[str, ...]] = {
-    "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "plate"),
+    "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",),
 }

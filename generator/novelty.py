@@ -55,11 +55,12 @@ def spec_signature(spec: TaskSpec) -> Signature:
 def proposal_signature(proposal: dict) -> Signature:
     """The signature of a proposal as a backend writes it (the JSON object the propose step parses)."""
     objects = {o["name"]: asset_dict(o["asset"]) for o in proposal["objects"]}
-    succ = proposal["success"]
-    obj, target = objects.get(succ.get("object")), objects.get(succ.get("target"))
-    found = {condition_skill(succ["type"], target_category=target["category"] if target else None,
-                             target_is_goal=succ.get("target") == GOAL_TARGET, negate=bool(succ.get("negate")),
-                             part=part_of(obj) if obj and obj.get("joints") else None)}
+    found = set()
+    for succ in (proposal["success"], *(proposal.get("also") or ())):
+        obj, target = objects.get(succ.get("object")), objects.get(succ.get("target"))
+        found.add(condition_skill(succ["type"], target_category=target["category"] if target else None,
+                                  target_is_goal=succ.get("target") == GOAL_TARGET, negate=bool(succ.get("negate")),
+                                  part=part_of(obj) if obj and obj.get("joints") else None))
     found |= {s["skill"] for s in proposal["steps"] if s["skill"] in STAGE_TASK_SKILLS}
     return tuple(k for k in TASK_SKILLS if k in found), tuple(sorted({kind(a) for a in objects.values()}))
 

@@ -19,6 +19,7 @@ The choice is a pure function of the ``rng`` given, so a seeded author words the
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -45,6 +46,9 @@ NAMES: dict[str, tuple[str, ...]] = {
     "refrigerator": ("fridge", "refrigerator"),
     "laptop": ("laptop", "notebook computer"),
     "knob": ("knob", "dial"),
+    "cutting_board": ("cutting board", "chopping board"),
+    "tray": ("tray", "serving tray"),
+    "valve": ("valve", "ball valve", "shutoff valve"),
 }
 """Words for a catalog category (default: the category with spaces); every one is read back to that category by
 :mod:`generator.instruction`."""
@@ -205,8 +209,8 @@ PURPOSES: dict[str, tuple[str, ...]] = {
 SHAPES = (0.4, 0.7, 0.9)
 """Cumulative shares of the sentence shapes: situation + command, command + purpose, all three, the bare command."""
 
-DOMAIN_OF_CATEGORY = {"trash_can": "waste", "box_with_lid": "box", "faucet": "fixture", "laptop": "box",
-                      "knob": "appliance"}
+DOMAIN_OF_CATEGORY = {"trash_can": "waste", "box_with_lid": "box", "faucet": "fixture", "valve": "fixture",
+                      "laptop": "box", "knob": "appliance"}
 DOMAIN_OF_TAG = (("fruit", "fruit"), ("food", "food"), ("ball", "ball"), ("toy", "toy"), ("tool", "tool"),
                  ("utensil", "kitchenware"), ("kitchenware", "kitchenware"), ("tableware", "kitchenware"),
                  ("appliance", "appliance"), ("furniture", "furniture"), ("fixture", "fixture"), ("box", "box"))
@@ -235,30 +239,51 @@ def _sentence(text: str) -> str:
     return text[:1].upper() + text[1:] + ("" if text.endswith((".", "!", "?")) else ".")
 
 
+@dataclass(frozen=True)
+class Part:
+    """One thing a task asks for: a skill (a key of :data:`COMMANDS`) on catalog asset ``main``, with ``other`` the
+    destination (container, plate, base block) where there is one; a qualifier tells two objects of the same
+    category apart (*the small block on the large block*)."""
+
+    skill: str
+    main: dict
+    other: dict | None = None
+    main_qualifier: str = ""
+    other_qualifier: str = ""
+
+
+def command(part: Part, rng: np.random.Generator, surface: str) -> str:
+    """The bare command for ``part`` (no capital, no full stop)."""
+    if part.skill not in COMMANDS:
+        raise KeyError(f"no wording for skill {part.skill!r}; known: {sorted(COMMANDS)}")
+    articulated = bool(part.main.get("joints"))
+    o = _pick(rng, names_for(part.main, part.main_qualifier or MODEL_WORDS.get(part.main["id"], "")))
+    d = _pick(rng, names_for(part.other, part.other_qualifier)) if part.other is not None else o
+    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface)
+
+
 def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | None = None,
            main_qualifier: str = "", other_qualifier: str = "") -> str:
-    """An instruction for a task of ``skill`` (a key of :data:`COMMANDS`) acting on catalog asset ``main``, with
-    ``other`` the destination (container, plate, base block) where there is one; a qualifier tells two objects of
-    the same category apart (*the small block on the large block*)."""
-    if skill not in COMMANDS:
-        raise KeyError(f"no wording for skill {skill!r}; known: {sorted(COMMANDS)}")
+    """An instruction for one :class:`Part` (see there for the arguments)."""
+    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier)], rng)
+
+
+def phrase_parts(parts: list[Part], rng: np.random.Generator) -> str:
+    """An instruction for a task of one or more parts done in turn (*..., then ...*), with a situation from the
+    first part's main object and a purpose from the last one's (or neither, or one of them)."""
     surface = _pick(rng, SURFACES)
-    articulated = bool(main.get("joints"))
-    main_qualifier = main_qualifier or MODEL_WORDS.get(main["id"], "")
-    o = _pick(rng, names_for(main, main_qualifier))
-    d = _pick(rng, names_for(other, other_qualifier)) if other is not None else o
-    command = _pick(rng, COMMANDS[skill]).format(o=o, d=d if not articulated else o, s=surface)
-    dom = domain(main)
+    text = ", then ".join(command(p, rng, surface) for p in parts)
     shape = rng.random()
-    situation = _pick(rng, SITUATIONS[dom]).format(s=surface)
-    purpose = _pick(rng, PURPOSES[dom])
+    situation = _pick(rng, SITUATIONS[domain(parts[0].main)]).format(s=surface)
+    purpose = _pick(rng, PURPOSES[domain(parts[-1].main)])
     if shape < SHAPES[0]:
-        return _sentence(f"{situation}: {command}")
+        return _sentence(f"{situation}: {text}")
     if shape < SHAPES[1]:
-        return _sentence(f"{command}, {purpose}")
+        return _sentence(f"{text}, {purpose}")
     if shape < SHAPES[2]:
-        return _sentence(f"{situation}: {command}, {purpose}")
-    return _sentence(command)
+        return _sentence(f"{situation}: {text}, {purpose}")
+    return _sentence(text)
 
 
-__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "SITUATIONS", "domain", "names_for", "phrase"]
+__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "SITUATIONS", "Part", "command", "domain", "names_for",
+           "phrase", "phrase_parts"]

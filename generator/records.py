@@ -34,8 +34,8 @@ class ProposedStep:
 
 @dataclass(frozen=True)
 class Proposal:
-    """What the task is: objects from the catalog, atomic steps (a skill on a target each), and one checkable
-    success condition."""
+    """What the task is: objects from the catalog, atomic steps (a skill on a target each), and checkable success
+    conditions (one, or one per part of a composed task)."""
 
     name: str
     description: str
@@ -50,6 +50,14 @@ class Proposal:
     named only a kind of object ('a fruit'), or the backend chose another object than the one named."""
     reading: dict[str, Any] | None = None
     """How the instruction was read before any backend was asked (:class:`generator.instruction.Reading`)."""
+    also: tuple[dict[str, Any], ...] = ()
+    """Further success conditions that must hold as well: a composed task (*close the microwave, then put the apple
+    into the bowl*) has one per part."""
+
+    @property
+    def conditions(self) -> tuple[dict[str, Any], ...]:
+        """Every success condition of the task: :attr:`success`, then :attr:`also`."""
+        return (self.success, *self.also)
 
 
 @dataclass(frozen=True)

@@ -52,8 +52,11 @@ def _get_obs_extra(env, info):
 """Reward of a push: the palm to the object, the object to the goal mark (format with ``fail`` and ``obj``)."""
 
 
-def _success_condition(spec: dict) -> dict:
-    return spec["success"]["conditions"][0]
+def _success_condition(spec: dict, obj: str | None = None) -> dict:
+    """The task's success condition on ``obj`` (the object a stage acts on, or carries to), else the first: a
+    composed task has one condition per part."""
+    conds = spec["success"]["conditions"]
+    return next((c for c in conds if obj is not None and obj in (c.get("object"), c.get("target"))), conds[0])
 
 
 def _stage(spec: dict, name: str) -> dict:
@@ -71,7 +74,7 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     """Reward module for one RL stage of ``spec`` (a task dict), by the stage's skill."""
     stage = _stage(spec, stage_name)
     kind, obj = stage["skill"], stage["target"]
-    cond = _success_condition(spec)
+    cond = _success_condition(spec, obj)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
@@ -169,8 +172,54 @@ def _get_obs_extra(env, info):
     return src
 
 
+_COMPOSED = '''REWARD_MAX = 7.0
+LIFT_M = 0.1
+
+
+def evaluate(env):
+{fail}    return {{"fail": fail, "open_fraction": env.joint_open_fraction({art!r}), "height": env.obj_height({obj!r})}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    first = rt.fraction({progress})
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj({obj!r})))
+    lifted = rt.lift(info["height"], LIFT_M)
+{carry}    reward = 2.0 * first + (first > 0.99) * (reach + grasp + lifted + carry)
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p, "open_fraction": info["open_fraction"][:, None]}}
+'''
+"""Reward of a composed task: the articulated part's progress first, then the rigid part's staged terms."""
+
+
+def _progress(cond: dict) -> str:
+    """A joint condition's progress in [0, 1] as code: a shut joint from open (0) to shut past the fraction (1)."""
+    frac = float(cond.get("min_fraction") or 0.8)
+    return (f'(1.0 - info["open_fraction"]) / {1.0 - frac!r}' if cond.get("negate")
+            else f'info["open_fraction"] / {frac!r}')
+
+
+def _carry_term(target: str | None) -> str:
+    return (f'    carry = rt.place(p, env.obj_pose({target!r}).p) * (lifted > 0.5)\n'
+            if target else "    carry = torch.zeros_like(reach)\n")
+
+
 def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
-    """Reward module of the whole task: staged terms towards the task's success condition."""
+    """Reward module of the whole task: staged terms towards the task's success condition (for a composed task,
+    the articulated part's condition first, then the rigid part's)."""
+    conds = spec["success"]["conditions"]
+    if len(conds) > 1:
+        joint = next(c for c in conds if c["type"] == "joint_open")
+        rest = next(c for c in conds if c is not joint)
+        rigid = _rigid(spec, roles)
+        fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
+        return _HEADER.format(title=f"{spec['name']}: {spec['instruction']}") + _COMPOSED.format(
+            fail=fail, art=joint["object"], obj=rest["object"], progress=_progress(joint),
+            carry=_carry_term(rest.get("target")))
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
@@ -201,8 +250,7 @@ def _get_obs_extra(env, info):
     target = cond.get("target")
     if target == "goal":  # a push: the object towards the goal mark, never lifted
         return src + _PUSH.format(fail=fail, obj=obj)
-    carry = (f'    carry = rt.place(p, env.obj_pose({target!r}).p) * (lifted > 0.5)\n'
-             if target else "    carry = torch.zeros_like(reach)\n")
+    carry = _carry_term(target)
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1
 

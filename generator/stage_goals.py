@@ -41,12 +41,15 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
     if skill == "lift":
         h = _task_value(task_conditions, "lifted", target, "min_height_m", LIFT_M)
         return [dict(HELD, object=target), {"type": "lifted", "object": target, "min_height_m": h}]
-    if skill == "release":
-        return [*(dict(c) for c in task_conditions), {"type": "grasped", "object": target, "negate": True}]
+    if skill == "release":  # the task's conditions on the released object (all of them if none names it)
+        mine = [c for c in task_conditions if c.get("object") == target] or task_conditions
+        return [*(dict(c) for c in mine), {"type": "grasped", "object": target, "negate": True}]
     if skill in ("open", "close", "turn"):
         frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
         cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
         return [cond | {"negate": True}] if skill == "close" else [cond]
+    if skill == "place":  # the task's conditions with this target: the held object set on it
+        return [dict(c) for c in task_conditions if c.get("target") == target] or None
     if skill == "push":  # the task's own condition on the pushed object (near the goal mark)
         return [dict(c) for c in task_conditions if c.get("object") == target] or None
     return None

@@ -41,8 +41,8 @@ import yaml
 
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
-from generator.instruction import InstructionError, is_plate
-from generator.phrasing import phrase
+from generator.instruction import InstructionError, is_surface
+from generator.phrasing import Part, phrase, phrase_parts
 
 MODEL_ID = "gendex-offline-1"
 
@@ -85,6 +85,10 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
                                "measured": None},
     ("turn", "faucet_lever_lift"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
                                     "measured": "gate 10/10 (guided generation)"},
+    ("turn", "valve_lever"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                              "measured": None},
+    ("turn", "valve_lever_short"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                                    "measured": None},
     ("close", "refrigerator_left_hinge"): {"pos_m": (0.65, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
                                            "measured": "gate 10/10 (guided generation)"},
 }
@@ -109,6 +113,14 @@ base's centre): written only when asked for."""
 PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a generated push 10/10",
                                  "rubiks_cube": None, "foam_brick": None, "tuna_can": None, "sponge": None}
 """Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
+COMPOSE_STRIDE = 12
+"""A composed task pairs each articulated first part with every COMPOSE_STRIDE-th rigid task (a different slice
+for each first part): a few hundred compositions, not every pair."""
+COMPOSED_SIDE_M = 0.1
+"""An articulated object this far off the middle (|y|) keeps a composed task's movable objects on the other side;
+nearer the middle, they stay at the front (x <= 0.08 m)."""
+COMPOSED_WEIGHT = 2.0
+"""How much likelier a composed task is drawn than the tasks of any one skill."""
 DISTRACTOR_P = 0.4
 """Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
 STACK_GAP_M = 0.03
@@ -135,6 +147,11 @@ def _camel(*words: str) -> str:
 def _part(a: dict) -> str:
     """The kind of part an articulated asset's main joint moves: ``door``, ``drawer``, ``lid`` or ``lever``."""
     return a["joints"][0]["handle_link"].split("_")[0]
+
+
+def _kind(skill: str, a: dict) -> str:
+    """The task skill of ``skill`` (open, close, turn) on articulated ``a``: ``close_door``, ``open_lid``, ``turn``."""
+    return "turn" if skill == "turn" else f"{skill}_{_part(a)}"
 
 
 def _qualifiers(a: dict, b: dict | None) -> dict[str, str]:
@@ -205,6 +222,20 @@ def fits_in(g: dict, c: dict) -> bool:
     return max(g["size_m"][:2]) * hand_fit_scale(g["size_m"][:2]) < 0.7 * _min_xy(c)
 
 
+def _movable_region(proposal: dict, assets: dict[str, dict], acts: dict[str, str]) -> tuple:
+    """Where movable objects go: :data:`MOVABLE_REGION_M`, or in a composed task the half of it away from the
+    articulated object's measured layout (the hand works on that object first, and its door or lid swings there)."""
+    (x0, x1), (y0, y1) = MOVABLE_REGION_M
+    for o in proposal["objects"]:
+        layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
+        if layout is not None and len(proposal["objects"]) > 1:
+            y = layout["pos_m"][1]
+            if abs(y) >= COMPOSED_SIDE_M:
+                return (x0, x1), ((y0, 0.0) if y > 0 else (0.0, y1))
+            return (x0, min(x1, 0.08)), (y0, y1)
+    return MOVABLE_REGION_M
+
+
 class OfflineBackend:
     """Deterministic stand-in for a model; see the module docstring. Same seed and requests, same answers."""
 
@@ -244,7 +275,8 @@ class OfflineBackend:
             raise BackendError(f"the offline task grammar is exhausted: all {len(options)} tasks it can write "
                                "exist, or duplicate an existing task's skills and objects")
         skills = sorted(by_skill)
-        pool = by_skill[skills[int(rng.integers(len(skills)))]]
+        weights = np.array([COMPOSED_WEIGHT if k == "composed" else 1.0 for k in skills])
+        pool = by_skill[skills[int(rng.choice(len(skills), p=weights / weights.sum()))]]
         return _fence("json", json.dumps(pool[int(rng.integers(len(pool)))], indent=2))
 
     def _words(self, name: str) -> np.random.Generator:
@@ -256,7 +288,7 @@ class OfflineBackend:
         """Every task this grammar can write from ``assets``, each with its task skill."""
         g = [a for a in assets if graspable(a)]
         c = [a for a in assets if container(a)]
-        p = [a for a in assets if is_plate(a)]
+        p = [a for a in assets if is_surface(a)]
         o = [a for a in assets if openable(a)]
         out = [("lift", self._lift_task(a)) for a in g]
         out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
@@ -269,10 +301,38 @@ class OfflineBackend:
         by_id = {a["id"]: a for a in assets}
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
-                part = _part(by_id[i])
-                kind = "turn" if skill == "turn" else f"{skill}_{'lid' if part == 'lid' else part}"
-                out.append((kind, self._articulated_task(skill, by_id[i])))
+                out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
+        # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
+        # in the middle of where the rigid part works: measured 0/3), then a rigid task
+        firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
+                  if i in by_id and not lay["grasp"] and lay["measured"] and skill != "turn"]
+        seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in g for b in c if fits_in(a, b)]
+                   + [("place_on", a, b) for a in g for b in p])
+        for k, (skill, art) in enumerate(firsts):
+            for second in seconds[k % COMPOSE_STRIDE::COMPOSE_STRIDE]:
+                composed = self._composed_task(skill, art, *second)
+                if composed is not None:
+                    out.append(("composed", composed))
         return out
+
+    def _composed_task(self, skill: str, art: dict, second: str, a: dict, b: dict | None) -> dict | None:
+        """``skill`` (close, open by pressing, turn) on ``art``, then ``second`` (lift, put_in, place_on) on ``a``
+        (into / onto ``b``): one task, both success conditions (``success`` and ``also``); None when the two parts'
+        object names clash."""
+        first = self._articulated_task(skill, art)
+        rest = {"lift": lambda: self._lift_task(a), "put_in": lambda: self._put_task(a, b),
+                "place_on": lambda: self._plate_task(a, b)}[second]()
+        if {o["name"] for o in first["objects"]} & {o["name"] for o in rest["objects"]}:
+            return None
+        name = f"{first['name']}Then{rest['name']}"
+        parts = [Part(_kind(skill, art), art), Part(second, a, b, **_qualifiers(a, b))]
+        text = rest["success_text"]
+        return {
+            "name": name, "description": phrase_parts(parts, self._words(name)),
+            "objects": first["objects"] + rest["objects"], "steps": first["steps"] + rest["steps"],
+            "success": first["success"], "also": [rest["success"]],
+            "success_text": f"{first['success_text'][:-1]}, and {text[:1].lower()}{text[1:]}",
+        }
 
     def _lift_task(self, a: dict) -> dict:
         n = a["category"]
@@ -391,9 +451,8 @@ class OfflineBackend:
             success = {"type": "joint_open", "object": n, "min_fraction": 0.5}
             text = f"The {part} is open to at least half of its opening."
         name = _camel(skill, a["id"])
-        kind = "turn" if skill == "turn" else f"{skill}_{part}"
         return {
-            "name": name, "description": phrase(kind, a, self._words(name)),
+            "name": name, "description": phrase(_kind(skill, a), a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": steps, "success": success, "success_text": text,
         }
@@ -435,7 +494,8 @@ class OfflineBackend:
             g = pick(0, graspable, "object to put in")
             proposal = self._put_task(g, pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in"))
         elif skill == "place_on":
-            proposal = self._plate_task(pick(0, graspable, "object to set down"), pick(1, is_plate, "plate"))
+            proposal = self._plate_task(pick(0, graspable, "object to set down"),
+                                        pick(1, is_surface, "plate, tray or board"))
         elif skill == "stack":
             a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack")
             proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a),
@@ -487,11 +547,12 @@ class OfflineBackend:
         objects = []
         acts = {s["target"]: s["skill"] for s in proposal["steps"] if s["skill"] in ("open", "close", "turn")}
         goal = None
+        movable = _movable_region(proposal, assets, acts)
         for o in proposal["objects"]:
             a = assets[o["asset"]]
             # articulated objects anywhere at the back, movable ones where the solver measurably works (module
             # constant); overlaps and support are the critic's job
-            (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else MOVABLE_REGION_M
+            (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else movable
             x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
             entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
             layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
@@ -520,16 +581,17 @@ class OfflineBackend:
             objects.append(self._distractor(proposal, assets, rng))
         stages = []
         for i, s in enumerate(proposal["steps"]):
-            method = "motion_planning" if s["skill"] in ("reach", "carry") else "RL"
+            method = "motion_planning" if s["skill"] in ("reach", "carry", "place") else "RL"
             repeated = i > 0 and s["skill"] == proposal["steps"][i - 1]["skill"]
             stages.append({"name": f"{s['skill']}_{s['target']}" + (f"_{i}" if repeated else ""),
                            "instruction": s["instruction"], "skill": s["skill"], "method": method,
                            "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
                            "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})
-        cond = {k: v for k, v in proposal["success"].items() if v is not None}
+        conds = [{k: v for k, v in c.items() if v is not None}
+                 for c in (proposal["success"], *(proposal.get("also") or ()))]
         spec = {"name": proposal["name"], "instruction": proposal["description"], "objects": objects,
                 **({"goal": goal} if goal else {}),
-                "stages": stages, "success": {"description": proposal["success_text"], "conditions": [cond]},
+                "stages": stages, "success": {"description": proposal["success_text"], "conditions": conds},
                 # room for a re-planned approach, a regrasp or a slow door: twice the stages' horizons
                 "max_episode_steps": max(250, 2 * sum(st["horizon"] for st in stages))}
         return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
@@ -552,6 +614,7 @@ class OfflineBackend:
 
     # ------------------------------------------------------------------ plan
     _PLAN = {"reach": ("motion_planning", "arm", 60), "carry": ("motion_planning", "arm", 60),
+             "place": ("motion_planning", "arm", 30),
              "grasp": ("RL", "hand", 40), "lift": ("RL", "lift_inspire", 40), "release": ("RL", "hand", 20),
              "open": ("RL", "both", 80), "close": ("RL", "both", 80), "push": ("RL", "both", 60)}
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from typing import Any
 
 from gendex_envs.errors import suggest
 from gendex_envs.spec import (
@@ -30,6 +31,10 @@ from generator.steps.common import ask, parse_json_block
 log = logging.getLogger(__name__)
 
 MAX_OBJECTS = 3
+MAX_STEPS = 8
+"""Steps of a proposal: up to 4 for one skill (reach, grasp, carry, release), up to 8 for a composed task."""
+MAX_PARTS = 2
+"""Success conditions of a proposal: one, or one per part of a composed task (``success`` and ``also``)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
                 "min_dz_m", "max_dz_m")
 """Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut)."""
@@ -88,25 +93,35 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
                                 f"{list(CONTROL_JOINT_MODES)}")
         steps.append(ProposedStep(s["skill"], s["target"], s["control_joint"],
                                   str(s.get("instruction") or f"{s['skill']} the {s['target']}")))
-    if not 1 <= len(steps) <= 5:
-        raise ProposalError(f"a task has 1 to 5 steps, the proposal has {len(steps)}")
-    succ = raw["success"]
-    if not isinstance(succ, dict) or succ.get("type") not in PROPOSAL_CONDITION_TYPES:
-        raise ProposalError(f"success.type {succ.get('type') if isinstance(succ, dict) else succ!r} is not one of "
-                            f"{list(PROPOSAL_CONDITION_TYPES)}")
-    if succ.get("object") not in names:
-        raise ProposalError(f"success.object {succ.get('object')!r} is not a proposed object; objects: {names}")
-    targets = names + [GOAL_TARGET] if succ["type"] == "near" else names
-    if succ["type"] in ("inside", "near", "over") and succ.get("target") not in targets:
-        raise ProposalError(f"success.target {succ.get('target')!r} must name a proposed object for a "
-                            f"{succ['type']!r} condition; allowed: {targets}")
-    if succ["type"] == "joint_open" and not assets[objects[names.index(succ["object"])].asset]["joints"]:
-        raise ProposalError(f"success: joint_open needs an articulated object, {succ['object']!r} is rigid")
+    if not 1 <= len(steps) <= MAX_STEPS:
+        raise ProposalError(f"a task has 1 to {MAX_STEPS} steps, the proposal has {len(steps)}")
+    succ = _condition(raw["success"], "success", names, objects, assets)
+    also = raw.get("also") or []
+    if not isinstance(also, list) or len(also) > MAX_PARTS - 1:
+        raise ProposalError(f"also must be a list of at most {MAX_PARTS - 1} further success conditions, got "
+                            f"{also!r}")
+    more = tuple(_condition(c, f"also[{i}]", names, objects, assets) for i, c in enumerate(also))
     subs = raw.get("substitutions") or {}
     return Proposal(name=name, description=str(raw["description"]), objects=tuple(objects), steps=tuple(steps),
-                    success={k: v for k, v in succ.items() if k in SUCCESS_KEYS},
+                    success=succ, also=more,
                     success_text=str(raw["success_text"]), instruction=instruction,
                     substitutions={str(k): str(v) for k, v in subs.items()} if isinstance(subs, dict) else {})
+
+
+def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedObject], assets: dict) -> dict:
+    """One success condition of a proposal, checked: a known type naming proposed objects."""
+    if not isinstance(succ, dict) or succ.get("type") not in PROPOSAL_CONDITION_TYPES:
+        raise ProposalError(f"{where}.type {succ.get('type') if isinstance(succ, dict) else succ!r} is not one of "
+                            f"{list(PROPOSAL_CONDITION_TYPES)}")
+    if succ.get("object") not in names:
+        raise ProposalError(f"{where}.object {succ.get('object')!r} is not a proposed object; objects: {names}")
+    targets = names + [GOAL_TARGET] if succ["type"] == "near" else names
+    if succ["type"] in ("inside", "near", "over") and succ.get("target") not in targets:
+        raise ProposalError(f"{where}.target {succ.get('target')!r} must name a proposed object for a "
+                            f"{succ['type']!r} condition; allowed: {targets}")
+    if succ["type"] == "joint_open" and not assets[objects[names.index(succ["object"])].asset]["joints"]:
+        raise ProposalError(f"{where}: joint_open needs an articulated object, {succ['object']!r} is rigid")
+    return {k: v for k, v in succ.items() if k in SUCCESS_KEYS}
 
 
 def with_reading(proposal: Proposal, reading: Reading) -> Proposal:

@@ -71,6 +71,19 @@ def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reaso
     assert [p for p in tmp_path.iterdir() if not p.name.startswith(".")] == []
 
 
+def test_a_batch_goes_on_past_a_task_slot_without_a_task_and_reports_it(tmp_path, monkeypatch):
+    """Three proposals of the first slot fail the gate: with ``failed`` given, the reasons are recorded there and the
+    second slot's task is still committed (a whole batch is not lost to one slot)."""
+    verdicts = iter([GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3})] * 3
+                    + [GateResult(10, 10, 900, list(range(10)), {})])
+    monkeypatch.setattr("generator.pipeline.run_gate", lambda draft, name, attempts: next(verdicts))
+    failed: list[str] = []
+    [s] = generate(lambda: OfflineBackend(seed=11), tmp_path, n=2, seed=0, command="test", failed=failed,
+                   candidates=1)
+    assert len(failed) == 1 and "no proposal passed after 3 attempts" in failed[0] and "a/b/timeout" in failed[0]
+    assert [p.name for p in tmp_path.iterdir() if not p.name.startswith(".")] == [s.committed.name]
+
+
 def test_the_gate_child_reports_a_crash_as_a_named_error(tmp_path):
     with pytest.raises(gate_mod.GateError, match="crashed"):
         gate_mod.run_gate(tmp_path, "Nothing", attempts=1)  # an empty draft: no task spec

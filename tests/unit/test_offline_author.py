@@ -125,7 +125,7 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=3)
-    options = [o for _, o in b._task_options(list(asset_dicts()))]
+    options = [o for skill, o in b._task_options(list(asset_dicts())) if skill != "composed"]
     picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn"))
               or (o["name"].startswith("Open") and o["objects"][0]["asset"] in {i for _, i in ARTICULATED_LAYOUTS})]
     kinds = {o["name"][:4] for o in picked}
@@ -188,3 +188,38 @@ def test_scenes_may_carry_clutter_that_no_stage_or_condition_names():
     raw["objects"] += [dict(clutter, name=f"d{i}") for i in range(MAX_DISTRACTORS + 1)]
     with pytest.raises(SceneError, match="at most 2"):
         parse_scene("```yaml\n" + yaml.safe_dump(raw) + "```\n", p)
+
+
+def test_composed_tasks_do_two_parts_in_turn_and_check_both():
+    """A composed task: a part the open hand does on an articulated object (close a door, open a lid, turn a lever),
+    then a rigid one (lift, put into, set on). Both conditions are the task's success (``success`` and ``also``),
+    the steps are the two parts' in order, the wording says both, and every reward module passes the validator."""
+    from generator.novelty import proposal_signature
+    from generator.steps.propose import parse_proposal
+
+    b = OfflineBackend(seed=2)
+    composed = [o for skill, o in b._task_options(list(asset_dicts())) if skill == "composed"]
+    assert len(composed) >= 50
+    for i, raw in enumerate(composed[::25]):
+        p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+        assert len(p.conditions) == 2 and p.conditions[0]["type"] == "joint_open", p.name
+        assert [s.skill for s in p.steps][0] == "reach" and len(p.steps) >= 4
+        assert ", then " in p.description and "Then" in p.name
+        skills, _ = proposal_signature(dataclasses.asdict(p))
+        assert len(skills) == 2, skills
+        ids = {o.asset for o in p.objects}
+        context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+                   "candidate_index": 0, "index": i, "attempt": 0}
+        spec = spec_to_dict(adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="",
+                                                                              context=context)).text, p), p))
+        assert len(spec["success"]["conditions"]) == 2
+        roles = roles_of(dataclasses.asdict(p))
+        src = compose_task_module(spec, roles)
+        check_reward_source(src)
+        assert "open_fraction" in src and "first > 0.99" in src
+        for st in spec["stages"]:
+            if st["method"] == "RL":
+                check_reward_source(compose_stage_module(spec, st["name"], roles), filename=st["name"])
+    with pytest.raises(Exception, match="also must be a list of at most 1"):
+        raw = dict(composed[0], also=[composed[0]["success"]] * 2)
+        parse_proposal("```json\n" + json.dumps(raw) + "\n```")
