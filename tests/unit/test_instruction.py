@@ -88,9 +88,13 @@ def test_the_proposal_records_the_reading_and_the_offline_author_keeps_to_it():
     # 'tap' means either faucet: one with a measured layout is used, no substitution
     p, _ = propose(OfflineBackend(seed=0), instruction="turn on the tap")
     assert p.objects[0].asset in ("faucet_lever_swivel", "faucet_lever_lift") and p.substitutions == {}
-    # a variant named by its id that has a candidate layout (the gate decides): that one
+    # a variant named by its id that has a layout of its own: that one
+    p, _ = propose(OfflineBackend(seed=0), instruction="close the drawer_chest_3")
+    assert [o.asset for o in p.objects] == ["drawer_chest_3"] and p.substitutions == {}
+    # one the author has no layout for (the lift-lever faucet slips): the laid-out sibling, recorded
     p, _ = propose(OfflineBackend(seed=0), instruction="turn on the faucet_lever_lift")
-    assert [o.asset for o in p.objects] == ["faucet_lever_lift"] and p.substitutions == {}
+    assert [o.asset for o in p.objects] == ["faucet_lever_swivel"]
+    assert p.substitutions == {"faucet lever lift": "faucet_lever_swivel"}
     # a variant with no layout of its own: its laid-out sibling, recorded as a substitution
     p, _ = propose(OfflineBackend(seed=0), instruction="shut the right fridge")
     assert [o.asset for o in p.objects] == ["refrigerator_left_hinge"]
