@@ -83,9 +83,10 @@ MAX_ARC_JUMP_RAD = 0.35
 
 SOLVED_CATEGORIES = ("cabinet", "microwave", "refrigerator", "drawer_chest")
 """Articulated categories whose main joint these primitives open and close by the handle (side-hinged doors,
-drawers; each variant opened on 3-5 seeds). Bottom-hinged doors (oven, dishwasher) find no hook grasp the arm can
-follow down the arc. Lids (a tab, not a bar), a door being shut and a lever are pressed instead
-(:mod:`gendex.solve.press`), when no stage grasps them."""
+drawers; each variant opened on 3-5 seeds). Bottom-hinged doors (oven, dishwasher) are opened by the hook only
+near the robot (OpenOvenCompact-v0, the oven at x 0.35 m); at the cabinet's place no hook grasp follows their arc.
+Lids (a tab, not a bar), a door being shut (an oven's lying open: lifted by a shelf of bent fingers) and a lever
+are pressed instead (:mod:`gendex.solve.press`), when no stage grasps them."""
 
 HOOK_OPEN = {"THJ4": 0.0, "THJ3": 0.0, "THJ2": 0.0, "THJ1": 0.0, "THJ0": 0.0} | {
     f + j: 0.0 for f in ("FF", "MF", "RF", "LF") for j in ("J3", "J2", "J1", "J0")} | {"LFJ4": 0.0}
