@@ -28,6 +28,7 @@ from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
 from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
+from gendex_envs import observation
 from gendex_envs.atomic_io import write_json
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -101,14 +102,14 @@ def _open_exporters(cfg: CollectConfig, env: gym.Env) -> dict[str, object]:
     if unknown:
         raise EpisodeError(f"unknown formats {unknown}; allowed: {list(FORMATS)}")
     u = env.unwrapped
-    names = [j.name for j in u.agent.robot.get_active_joints()]
     writers: dict[str, object] = {}
     if "lerobot" in cfg.formats:
         action_names = list(u.agent.controller.free_joint_names)
         res = u.sensor_resolution
         writers["lerobot"] = LeRobotV3Writer(
             cfg.out / "lerobot", fps=int(u.control_freq), robot_type="ur10e_shadowhand",
-            state_names=[f"{n}.pos" for n in names] + [f"{n}.vel" for n in names], action_names=action_names,
+            state_names=observation.robot_state_names(env), action_names=action_names,
+            environment_state_names=observation.environment_state_names(env),
             cameras={c: (res, res) for c in cfg.cameras} or None)
     if "h5" in cfg.formats:
         writers["h5"] = TrajectoryWriter(cfg.out / "trajectories", **env_info(env))

@@ -47,6 +47,12 @@ class Episode:
     """[T + 1, E] float32 flattened ``env.get_state()`` (for exact replay)."""
     images: dict[str, np.ndarray] = field(default_factory=dict)
     """camera name -> [T + 1, H, W, 3] uint8 RGB (optional)."""
+    environment_state: np.ndarray | None = None
+    """[T + 1, K] float32 the world as a learner observes it (:func:`gendex_envs.observation.environment_state`:
+    object poses, articulation joint positions, the goal mark), after reset and after each action; None when not
+    recorded."""
+    environment_state_names: tuple[str, ...] = ()
+    """The K names of :attr:`environment_state`'s columns."""
     reset_kwargs: dict = field(default_factory=dict)
     """Keyword arguments of the reset that started the episode (``{"seed": seed}`` at least)."""
     info: dict = field(default_factory=dict)
@@ -57,6 +63,12 @@ class Episode:
         checks = {"state": (self.state, t + 1), "reward": (self.reward, t), "success": (self.success, t),
                   "fail": (self.fail, t), "env_states": (self.env_states, t + 1)}
         checks.update({f"images[{k}]": (v, t + 1) for k, v in self.images.items()})
+        if self.environment_state is not None:
+            checks["environment_state"] = (self.environment_state, t + 1)
+            if np.asarray(self.environment_state).shape[1:] != (len(self.environment_state_names),):
+                raise EpisodeError(f"episode of {self.task_id} (seed {self.seed}): environment_state has "
+                                   f"{np.asarray(self.environment_state).shape[1:]} columns and "
+                                   f"{len(self.environment_state_names)} names; they must match")
         bad = {k: len(v) for k, (v, n) in checks.items() if len(v) != n}
         if t == 0 or bad:
             raise EpisodeError(f"episode of {self.task_id} (seed {self.seed}) has {t} actions; rows expected: "

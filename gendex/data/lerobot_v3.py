@@ -197,6 +197,7 @@ class LeRobotV3Writer:
 
     def __init__(self, root: Path | str, *, fps: int, robot_type: str, state_names: list[str],
                  action_names: list[str], cameras: dict[str, tuple[int, int]] | None = None,
+                 environment_state_names: list[str] | None = None,
                  chunks_size: int = 1000, data_files_size_in_mb: float = 100,
                  codebase_version: str = CODEBASE_VERSION):
         if codebase_version != CODEBASE_VERSION:
@@ -208,6 +209,7 @@ class LeRobotV3Writer:
         self.root = Path(root)
         self.fps, self.robot_type = int(fps), robot_type
         self.state_names, self.action_names = list(state_names), list(action_names)
+        self.environment_state_names = list(environment_state_names or [])
         self.cameras = {k: (int(h), int(w)) for k, (h, w) in (cameras or {}).items()}
         self.chunks_size, self.data_files_size_in_mb = int(chunks_size), data_files_size_in_mb
         self.features = self._declared_features()
@@ -247,6 +249,10 @@ class LeRobotV3Writer:
         feats = {"observation.state": {"dtype": "float32", "shape": [len(self.state_names)],
                                        "names": self.state_names},
                  "action": {"dtype": "float32", "shape": [len(self.action_names)], "names": self.action_names}}
+        if self.environment_state_names:
+            feats["observation.environment_state"] = {"dtype": "float32",
+                                                      "shape": [len(self.environment_state_names)],
+                                                      "names": self.environment_state_names}
         for cam, (h, w) in self.cameras.items():
             feats[f"observation.images.{cam}"] = {"dtype": "image", "shape": [h, w, 3],
                                                   "names": ["height", "width", "channels"]}
@@ -305,8 +311,14 @@ class LeRobotV3Writer:
             raise EpisodeError(f"{who} was recorded at {ep.fps} fps; this dataset is {self.fps} fps (only equal "
                                f"fps is allowed)")
         t = ep.length
-        for key, arr, rows, names in (("state", ep.state, t + 1, self.state_names),
-                                      ("action", ep.action, t, self.action_names)):
+        checks = [("state", ep.state, t + 1, self.state_names), ("action", ep.action, t, self.action_names)]
+        if self.environment_state_names:
+            if ep.environment_state is None or list(ep.environment_state_names) != self.environment_state_names:
+                raise EpisodeError(f"{who} has environment state named {list(ep.environment_state_names)[:4]}...; "
+                                   f"this dataset declares {self.environment_state_names[:4]}... (the same task "
+                                   f"and objects are needed)")
+            checks.append(("environment_state", ep.environment_state, t + 1, self.environment_state_names))
+        for key, arr, rows, names in checks:
             arr = np.asarray(arr)
             if arr.shape != (rows, len(names)):
                 raise EpisodeError(f"{who}: {key} has shape {arr.shape}; this dataset declares {len(names)} "
@@ -345,6 +357,8 @@ class LeRobotV3Writer:
                    "frame_index": np.arange(t, dtype=np.int64), "episode_index": np.full(t, e, np.int64),
                    "index": np.arange(start, start + t, dtype=np.int64),
                    "task_index": np.full(t, task_index, np.int64)}
+        if self.environment_state_names:
+            numeric["observation.environment_state"] = np.asarray(ep.environment_state[:t], np.float32)
         columns, ep_stats = {}, {}
         for key, ft in self.features.items():
             if ft["dtype"] == "image":
@@ -447,12 +461,17 @@ v3.0 dataset format.
 ```python
 import gymnasium as gym
 import gendex_envs  # registers the GenDex task ids
+from gendex_envs.observation import LeRobotObservation
 
-env = gym.make({make})
+env = LeRobotObservation(gym.make({make}))
+obs, info = env.reset(seed=0)  # obs: the features below, by the same names, for one frame
 ```
 
-Every `action` row is an action of this env (its `action_space`), and `observation.state` lists the robot's joint
-positions then velocities, named in `meta/info.json`.
+Every `action` row is an action of this env (its `action_space`). `observation.state` lists the robot's joint
+positions then velocities; `observation.environment_state`, where present, every task object's position and
+orientation (wxyz), each articulated object's joint positions and the goal mark's position; both are named column
+by column in `meta/info.json`. `LeRobotObservation` returns exactly these features (and the camera images, with
+`obs_mode="rgb"`), so a policy trained on this data runs in the env as it is.
 
 ## How it was made
 

@@ -20,6 +20,7 @@ import numpy as np
 import torch
 
 from gendex.data.episode import Episode, EpisodeError
+from gendex_envs import observation
 
 
 class ReplayError(EpisodeError):
@@ -125,9 +126,15 @@ def object_positions(env: gym.Env, state: np.ndarray | None = None,
 
 
 def robot_state(env: gym.Env) -> np.ndarray:
-    """[S] float32 robot joint positions then velocities."""
-    robot = _base(env).agent.robot
-    return torch.cat([robot.get_qpos()[0], robot.get_qvel()[0]]).detach().cpu().numpy().astype(np.float32)
+    """[S] float32 robot joint positions then velocities (``observation.state``)."""
+    _base(env)
+    return observation.robot_state(env)[0].detach().cpu().numpy().astype(np.float32)
+
+
+def environment_state(env: gym.Env) -> np.ndarray:
+    """[K] float32 the world as a learner observes it (``observation.environment_state``)."""
+    _base(env)
+    return observation.environment_state(env)[0].detach().cpu().numpy().astype(np.float32)
 
 
 def max_episode_steps(env: gym.Env) -> int:
@@ -162,6 +169,7 @@ class EpisodeRecorder:
         out = self.env.reset(seed=int(seed))
         self.seed = int(seed)
         self._states, self._env_states = [robot_state(self.env)], [flat_env_state(self.env)]
+        self._world = [environment_state(self.env)]
         self._actions, self._rewards, self._success, self._fail = [], [], [], []
         return out
 
@@ -176,6 +184,7 @@ class EpisodeRecorder:
         self._fail.append(bool(_scalar(step_info.get("fail", False))))
         self._states.append(robot_state(self.env))
         self._env_states.append(flat_env_state(self.env))
+        self._world.append(environment_state(self.env))
         return out
 
     @property
@@ -193,6 +202,8 @@ class EpisodeRecorder:
             state=np.stack(self._states), action=np.stack(self._actions),
             reward=np.asarray(self._rewards, dtype=np.float32), success=np.asarray(self._success, dtype=bool),
             fail=np.asarray(self._fail, dtype=bool), env_states=np.stack(self._env_states),
+            environment_state=np.stack(self._world),
+            environment_state_names=tuple(observation.environment_state_names(self.env)),
             reset_kwargs={"seed": self.seed}, info=dict(info or {}))
 
 
