@@ -9,9 +9,10 @@ schema.
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
-_HEADER = '''"""{title}
+_HEADER_TEMPLATE = '''"""{title}
 
 Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
 """
@@ -52,6 +53,11 @@ def _get_obs_extra(env, info):
 """Reward of a push: the palm to the object, the object to the goal mark (format with ``fail`` and ``obj``)."""
 
 
+def _header(title: str) -> str:
+    """The module header, its title wrapped to docstring width (an instruction may be a long sentence)."""
+    return _HEADER_TEMPLATE.format(title=textwrap.fill(title, width=100))
+
+
 def _success_condition(spec: dict, obj: str | None = None) -> dict:
     """The task's success condition on ``obj`` (the object a stage acts on, or carries to), else the first: a
     composed task has one condition per part."""
@@ -78,7 +84,7 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
-    src = _HEADER.format(title=title)
+    src = _header(title)
     if kind == "push" or (cond.get("target") == "goal" and kind not in ("open", "close", "turn")):
         return src + _PUSH.format(fail=fail, obj=obj)
     if kind in ("open", "close", "turn"):
@@ -217,13 +223,13 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
         rest = next(c for c in conds if c is not joint)
         rigid = _rigid(spec, roles)
         fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
-        return _HEADER.format(title=f"{spec['name']}: {spec['instruction']}") + _COMPOSED.format(
+        return _header(f"{spec['name']}: {spec['instruction']}") + _COMPOSED.format(
             fail=fail, art=joint["object"], obj=rest["object"], progress=_progress(joint),
             carry=_carry_term(rest.get("target")))
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
-    src = _HEADER.format(title=f"{spec['name']}: {spec['instruction']}")
+    src = _header(f"{spec['name']}: {spec['instruction']}")
     obj = cond["object"]
     if cond["type"] == "joint_open":
         # a shut joint (negated condition) progresses from open (0) to shut past the fraction (1)
