@@ -216,6 +216,10 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
             out: Path = typer.Option(..., "--out", help="Dataset folder (resumes if it holds a collection)."),
             fmt: str = typer.Option("lerobot", "--format", help="lerobot | h5 | both"),
             cameras: str = typer.Option("", help="Comma-separated camera names to record (e.g. left_overhead)."),
+            resolution: int = typer.Option(128, min=16, help="Camera images are RESOLUTION x RESOLUTION pixels."),
+            video: str = typer.Option("libsvtav1", help="Camera images as MP4 video with this encoder (libsvtav1: "
+                                                        "AV1, lerobot's default; libx264: H.264) or 'png' (PNG "
+                                                        "inside the parquet files)."),
             workers: int = typer.Option(1, min=1, help="Worker processes running attempts (one env each)."),
             seed: int = typer.Option(0, help="Attempt k resets with seed + k."),
             solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
@@ -234,10 +238,15 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
         _die(ValueError(f"--format {fmt!r} is not one of {sorted(formats)}.{suggest(fmt, formats)}"))
     if solver not in SOLVERS:
         _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
+    from gendex.data.video import CODECS
+
+    if video != "png" and video not in CODECS:
+        _die(ValueError(f"--video {video!r} is not one of {[*sorted(CODECS), 'png']}"))
     try:
         version = resolve_task(task_id)
         cfg = CollectConfig(task_id=version.env_id, num_success=num_success, out=out, formats=formats[fmt],
                             cameras=tuple(c for c in cameras.split(",") if c), seed=seed, max_attempts=max_attempts,
+                            resolution=resolution, video_codec=None if video == "png" else video,
                             **SOLVER_ENV_KWARGS[solver])
         spec = version.spec
         with tqdm(total=num_success, desc="successes", unit="ep") as bar:
@@ -413,18 +422,26 @@ def train(task_id: str = typer.Argument(..., help="e.g. GenDex/PickUpBottle-v0, 
           seed: int = typer.Option(0, "--seed"),
           out: Path = typer.Option(None, "--out", help="Run folder (default: out/train/<Name>-v<N>); train more "
                                                        "stages into the same folder to chain them."),
-          eval_episodes: int = typer.Option(20, "--eval-episodes", min=1)) -> None:
+          eval_episodes: int = typer.Option(20, "--eval-episodes", min=1),
+          init_from: str = typer.Option(None, "--init-from", help="Start from the stage's policy in this task "
+                                                                  "version (id or folder) or training run folder."),
+          ppo: list[str] = typer.Option(None, "--ppo", help="Override a preset setting, KEY=VALUE (repeatable), "
+                                                            "e.g. --ppo log_std_init=-1.5 --ppo ent_coef=0.001.")
+          ) -> None:
     """Train PPO on one stage of a task version into a run folder (the version is never changed); publish the
     result as a new version with ``gendex promote``."""
-    from gendex.train.train import default_run_dir, train_stage
+    from gendex.train.presets import get_preset, parse_overrides
+    from gendex.train.train import default_run_dir, policy_to_start_from, train_stage
     from gendex_envs.errors import GenDexError
     from gendex_envs.registry import resolve_task
 
     try:
         version = resolve_task(task_id)
         run = out or default_run_dir(version)
-        r = train_stage(version, stage, steps=steps, run_dir=run, preset=preset, n_envs=envs, seed=seed,
-                        eval_episodes=eval_episodes, command=_command("train"))
+        chosen = get_preset(preset).with_overrides(**parse_overrides(ppo or []))
+        init = policy_to_start_from(version, stage, init_from) if init_from else None
+        r = train_stage(version, stage, steps=steps, run_dir=run, preset=chosen, n_envs=envs, seed=seed,
+                        eval_episodes=eval_episodes, command=_command("train"), init=init)
     except GenDexError as exc:
         _die(exc)
     typer.echo(f"{r.stage}: {r.steps} env steps in {r.wall_s:.0f} s -> {r.policy.model}\n"

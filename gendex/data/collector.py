@@ -26,6 +26,7 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
+from gendex.data.video import DEFAULT_CODEC
 from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
 from gendex_envs import observation
@@ -53,11 +54,18 @@ class CollectConfig:
     control_mode: str = "pd_joint_pos"
     """Action space of the solver's actions (``gendex.solve.SOLVER_ENV_KWARGS``); recorded with the data."""
     control_joint: str = "both"
+    resolution: int = 128
+    """Camera images are ``resolution`` x ``resolution`` (the env's ``sensor_resolution``)."""
+    video_codec: str | None = DEFAULT_CODEC
+    """Camera images as MP4 videos with this encoder (LeRobot v3.0's ``videos/``), or None: PNG in the parquet."""
 
     def env_kwargs(self) -> dict:
         """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""
-        return {"control_mode": self.control_mode, "control_joint": self.control_joint,
-                "obs_mode": "rgb" if self.cameras else "state"}
+        kwargs = {"control_mode": self.control_mode, "control_joint": self.control_joint,
+                  "obs_mode": "rgb" if self.cameras else "state"}
+        if self.cameras:
+            kwargs["sensor_resolution"] = self.resolution
+        return kwargs
 
 
 @dataclass
@@ -110,7 +118,7 @@ def _open_exporters(cfg: CollectConfig, env: gym.Env) -> dict[str, object]:
             cfg.out / "lerobot", fps=int(u.control_freq), robot_type="ur10e_shadowhand",
             state_names=observation.robot_state_names(env), action_names=action_names,
             environment_state_names=observation.environment_state_names(env),
-            cameras={c: (res, res) for c in cfg.cameras} or None)
+            cameras={c: (res, res) for c in cfg.cameras} or None, video_codec=cfg.video_codec)
     if "h5" in cfg.formats:
         writers["h5"] = TrajectoryWriter(cfg.out / "trajectories", **env_info(env))
     return writers

@@ -7,6 +7,9 @@ Layout (as lerobot's ``LeRobotDataset`` reads it)::
     meta/tasks.parquet                           task_index column; the task string is the pandas index
     meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``)
     data/chunk-CCC/file-FFF.parquet              one row per action (frame); images as struct<bytes PNG, path>
+    videos/<key>/chunk-CCC/file-FFF.mp4          with ``video_codec``: a camera's frames instead, one MP4 per
+                                                 episode (frame k at k / fps), located by the episode row's
+                                                 ``videos/<key>/{chunk_index,file_index,from_,to_timestamp}``
 
 Frame ``t`` of an episode holds ``observation.state = state[t]``, ``action = action[t]``, the images of step ``t``,
 ``next.reward/next.success = reward[t]/success[t]`` and ``next.done`` (True on the last frame), as lerobot's
@@ -36,11 +39,13 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from gendex.data.episode import Episode, EpisodeError
+from gendex.data.video import CODECS, PIX_FMT, encode
 
 log = logging.getLogger(__name__)
 
 CODEBASE_VERSION = "v3.0"
 DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 INFO_PATH, STATS_PATH, TASKS_PATH, JOURNAL_PATH = ("meta/info.json", "meta/stats.json", "meta/tasks.parquet",
                                                    "meta/.commit.json")
@@ -197,7 +202,7 @@ class LeRobotV3Writer:
 
     def __init__(self, root: Path | str, *, fps: int, robot_type: str, state_names: list[str],
                  action_names: list[str], cameras: dict[str, tuple[int, int]] | None = None,
-                 environment_state_names: list[str] | None = None,
+                 environment_state_names: list[str] | None = None, video_codec: str | None = None,
                  chunks_size: int = 1000, data_files_size_in_mb: float = 100,
                  codebase_version: str = CODEBASE_VERSION):
         if codebase_version != CODEBASE_VERSION:
@@ -210,6 +215,10 @@ class LeRobotV3Writer:
         self.fps, self.robot_type = int(fps), robot_type
         self.state_names, self.action_names = list(state_names), list(action_names)
         self.environment_state_names = list(environment_state_names or [])
+        if video_codec is not None and video_codec not in CODECS:
+            raise LeRobotDatasetError(f"video_codec {video_codec!r} is not one of {sorted(CODECS)} (or None: images "
+                                      f"as PNG inside the parquet files)")
+        self.video_codec = video_codec
         self.cameras = {k: (int(h), int(w)) for k, (h, w) in (cameras or {}).items()}
         self.chunks_size, self.data_files_size_in_mb = int(chunks_size), data_files_size_in_mb
         self.features = self._declared_features()
@@ -256,6 +265,11 @@ class LeRobotV3Writer:
         for cam, (h, w) in self.cameras.items():
             feats[f"observation.images.{cam}"] = {"dtype": "image", "shape": [h, w, 3],
                                                   "names": ["height", "width", "channels"]}
+            if self.video_codec is not None:
+                feats[f"observation.images.{cam}"] |= {"dtype": "video", "info": {
+                    "video.height": h, "video.width": w, "video.codec": CODECS[self.video_codec][0],
+                    "video.pix_fmt": PIX_FMT, "video.is_depth_map": False, "video.fps": self.fps,
+                    "video.channels": 3, "has_audio": False}}
         feats.update({k: {"dtype": d, "shape": [1], "names": None} for k, d in STEP_FEATURES.items()})
         feats.update({k: dict(v) for k, v in INDEX_FEATURES.items()})
         return feats
@@ -266,7 +280,8 @@ class LeRobotV3Writer:
                 "chunks_size": self.chunks_size, "data_files_size_in_mb": self.data_files_size_in_mb,
                 "video_files_size_in_mb": DEFAULT_VIDEO_FILE_SIZE_IN_MB, "fps": self.fps,
                 "splits": {"train": f"0:{n_episodes}"} if n_episodes else {},
-                "data_path": DATA_PATH, "video_path": None, "features": self.features}
+                "data_path": DATA_PATH, "video_path": VIDEO_PATH if self.video_codec is not None else None,
+                "features": self.features}
 
     def _resume(self) -> None:
         info = json.loads((self.root / INFO_PATH).read_text())
@@ -359,9 +374,13 @@ class LeRobotV3Writer:
                    "task_index": np.full(t, task_index, np.int64)}
         if self.environment_state_names:
             numeric["observation.environment_state"] = np.asarray(ep.environment_state[:t], np.float32)
-        columns, ep_stats = {}, {}
+        columns, ep_stats, videos = {}, {}, []
         for key, ft in self.features.items():
-            if ft["dtype"] == "image":
+            if ft["dtype"] == "video":  # one MP4 per episode; frame k at k / fps
+                images = ep.images[key.removeprefix("observation.images.")][:t]
+                ep_stats[key] = _image_stats(images)
+                videos.append((key, images))
+            elif ft["dtype"] == "image":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
                 columns[key], ep_stats[key] = _png_column(images), _image_stats(images)
             else:
@@ -378,6 +397,10 @@ class LeRobotV3Writer:
         row = {"episode_index": e, "tasks": [ep.instruction], "length": t, "data/chunk_index": chunk,
                "data/file_index": file, "dataset_from_index": start, "dataset_to_index": start + t,
                "meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0}
+        vchunk, vfile = divmod(e, self.chunks_size)
+        for key, _ in videos:
+            row.update({f"videos/{key}/chunk_index": vchunk, f"videos/{key}/file_index": vfile,
+                        f"videos/{key}/from_timestamp": 0.0, f"videos/{key}/to_timestamp": t / self.fps})
         row.update({f"stats/{k}/{s}": (np.asarray(v).astype(np.int64) if s == "count" else v).tolist()
                     for k, d in ep_stats.items() for s, v in d.items()})
         rows = [*self._rows, row]
@@ -385,7 +408,9 @@ class LeRobotV3Writer:
         info = self._info(len(rows), start + t, tasks)
         r = self.root
         try:
-            self._commit_episode(r, chunk, file, current, tasks, rows, stats, info)
+            movies = [(r / VIDEO_PATH.format(video_key=k, chunk_index=vchunk, file_index=vfile), frames)
+                      for k, frames in videos]
+            self._commit_episode(r, chunk, file, current, tasks, rows, stats, info, movies)
         except BaseException:
             if (r / JOURNAL_PATH).exists():  # committed but not fully applied: only a new writer may go on
                 self._closed = True
@@ -396,9 +421,10 @@ class LeRobotV3Writer:
         log.debug("%s: wrote episode %d (%d frames) to data chunk %d file %d", r, e, t, chunk, file)
         return e
 
-    @staticmethod
-    def _commit_episode(r: Path, chunk, file, current, tasks, rows, stats, info) -> None:
-        _commit(r, [(r / DATA_PATH.format(chunk_index=chunk, file_index=file), lambda p: pq.write_table(current, p)),
+    def _commit_episode(self, r: Path, chunk, file, current, tasks, rows, stats, info, movies) -> None:
+        encoded = [(path, lambda p, f=frames: encode(f, p, self.fps, self.video_codec)) for path, frames in movies]
+        _commit(r, [*encoded,
+                    (r / DATA_PATH.format(chunk_index=chunk, file_index=file), lambda p: pq.write_table(current, p)),
                     (r / TASKS_PATH, lambda p: pq.write_table(_tasks_table(tasks), p)),
                     (r / EPISODES_PATH.format(chunk_index=0, file_index=0),
                      lambda p: pq.write_table(pa.Table.from_pylist(rows), p)),

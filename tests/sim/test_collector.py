@@ -1,5 +1,6 @@
 """Collector: keeps successful episodes only, resumes after interruption, formats agree, replay reproduces."""
 
+import dataclasses
 import json
 import shutil
 
@@ -99,3 +100,21 @@ def test_two_workers_give_the_same_dataset(near_task, tmp_path):
     two = collect(_cfg(tmp_path / "w2"), HoldSolver, workers=2)
     assert two.kept_seeds == one.kept_seeds and two.attempts == one.attempts and two.env_steps == one.env_steps
     assert _counts(tmp_path / "w2") == _counts(tmp_path / "w1")
+
+
+def test_cameras_are_recorded_as_video_at_the_asked_resolution(near_task, tmp_path):
+    """--cameras with the default video codec: the dataset's info names a video_path, each kept episode has an MP4
+    per camera holding one frame per action at the asked resolution, and the card's gym.make call says so."""
+    from gendex.data.video import decode
+
+    cfg = _cfg(tmp_path, cameras=("left_overhead",), resolution=64)
+    state = collect(dataclasses.replace(cfg, num_success=1, formats=("lerobot",)), lambda: HoldSolver(steps=4))
+    assert state.successes == 1
+    root = tmp_path / "lerobot"
+    info = json.loads((root / "meta" / "info.json").read_text())
+    key = "observation.images.left_overhead"
+    assert info["video_path"] and info["features"][key]["dtype"] == "video"
+    assert info["features"][key]["shape"] == [64, 64, 3]
+    [video] = (root / "videos" / key).rglob("*.mp4")
+    assert decode(video).shape == (info["total_frames"], 64, 64, 3)
+    assert cfg.env_kwargs()["sensor_resolution"] == 64 and cfg.env_kwargs()["obs_mode"] == "rgb"

@@ -313,3 +313,53 @@ def test_loads_with_lerobot(dataset):
     ds = LeRobotDataset("local/gendex-test", root=dataset)
     assert len(ds) == 16 and ds.num_episodes == 3
     assert ds[8]["task"] == "open the drawer"
+
+
+def _smooth_episode(t: int, seed: int, h: int = 16, w: int = 24) -> Episode:
+    ep = make_episode(t, seed, cams=())
+    yy, xx = np.mgrid[0:h, 0:w]
+    frames = np.stack([np.stack([(xx * 8 + 10 * k) % 256, (yy * 12) % 256, np.full_like(xx, 40 * seed % 256)], -1)
+                       for k in range(t + 1)]).astype(np.uint8)
+    ep.images = {"front": frames}
+    return ep
+
+
+@pytest.mark.parametrize("codec", ["libsvtav1", "libx264"])
+def test_camera_images_as_video_files_in_the_v3_layout(tmp_path, codec):
+    """With a video codec, camera frames go to videos/<key>/chunk-000/file-<episode>.mp4 (one file per episode,
+    frame k at k/fps), the feature is declared as video, the episode rows say where each episode's frames are, and
+    the same episodes give the same bytes."""
+    from gendex.data.video import decode
+
+    eps = [_smooth_episode(6, 1), _smooth_episode(4, 2)]
+    roots = [tmp_path / "a", tmp_path / "b"]
+    for root in roots:
+        with writer(root, cameras={"front": (16, 24)}, video_codec=codec) as w:
+            for e in eps:
+                w.add_episode(e)
+    info, stats, rows = meta(roots[0])
+    key = "observation.images.front"
+    assert info["video_path"] == lv3.VIDEO_PATH and info["features"][key]["dtype"] == "video"
+    assert info["features"][key]["info"]["video.codec"] == {"libsvtav1": "av1", "libx264": "h264"}[codec]
+    assert key not in read_episode_frames(roots[0]).column_names  # not inside the parquet
+    assert np.asarray(stats[key]["mean"]).shape == (3, 1, 1)
+    for k, (e, row) in enumerate(zip(eps, rows.to_pylist(), strict=True)):
+        path = roots[0] / info["video_path"].format(video_key=key, chunk_index=row[f"videos/{key}/chunk_index"],
+                                                    file_index=row[f"videos/{key}/file_index"])
+        assert path.name == f"file-{k:03d}.mp4"
+        assert row[f"videos/{key}/from_timestamp"] == 0.0 and row[f"videos/{key}/to_timestamp"] == e.length / FPS
+        frames = decode(path)
+        assert frames.shape == (e.length, 16, 24, 3)  # T frames: one per action, like the parquet rows
+        assert np.abs(frames.astype(int) - e.images["front"][:e.length]).mean() < 12
+        assert path.read_bytes() == (roots[1] / path.relative_to(roots[0])).read_bytes()
+
+
+def test_video_options_are_checked(tmp_path):
+    from gendex.data.video import VideoError, encode
+
+    with pytest.raises(LeRobotDatasetError, match="video_codec 'mjpeg' is not one of"):
+        writer(tmp_path / "x", video_codec="mjpeg")
+    with pytest.raises(VideoError, match="even height and width"):
+        encode(np.zeros((2, 7, 8, 3), np.uint8), tmp_path / "odd.mp4", 10)
+    with pytest.raises(VideoError, match=r"\[T, H, W, 3\] uint8"):
+        encode(np.zeros((2, 8, 8), np.uint8), tmp_path / "flat.mp4", 10)

@@ -1,0 +1,64 @@
+"""Camera frames as video files, the way LeRobot v3.0 datasets store them (PyAV, FFmpeg's libraries).
+
+:func:`encode` writes ``[T, H, W, 3]`` uint8 RGB frames as an MP4 whose frame ``i`` has presentation time ``i / fps``
+exactly (time base ``1/fps``), so lerobot's decoder finds each frame at its timestamp. The default codec is
+lerobot's own default, AV1 by SVT-AV1 (``libsvtav1``, yuv420p, a key frame every 2 frames, CRF 30); ``libx264``
+(H.264) is the alternative for players without AV1. Encoding is deterministic: the same frames give the same bytes
+(a dataset build can be verified against its manifest's checksums). :func:`decode` reads every frame back.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from gendex.data.episode import EpisodeError
+
+CODECS = {"libsvtav1": ("av1", {"g": "2", "crf": "30"}), "libx264": ("h264", {"g": "2", "crf": "23"})}
+"""Encoder -> (codec name recorded in the dataset's features, encoder options)."""
+DEFAULT_CODEC = "libsvtav1"
+PIX_FMT = "yuv420p"
+
+
+class VideoError(EpisodeError):
+    """Frames cannot be encoded as asked, or a video file cannot be read."""
+
+
+def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_CODEC) -> None:
+    """Write ``frames`` ([T, H, W, 3] uint8 RGB; H and W even) to the MP4 file ``path``."""
+    import av
+
+    if codec not in CODECS:
+        raise VideoError(f"video codec {codec!r} is not one of {sorted(CODECS)}")
+    frames = np.asarray(frames)
+    if frames.ndim != 4 or frames.shape[-1] != 3 or frames.dtype != np.uint8 or len(frames) == 0:
+        raise VideoError(f"frames must be [T, H, W, 3] uint8 with T >= 1, got {frames.dtype} {list(frames.shape)}")
+    h, w = frames.shape[1:3]
+    if h % 2 or w % 2:
+        raise VideoError(f"frames of {h} x {w}: {PIX_FMT} video needs an even height and width")
+    os.environ.setdefault("SVT_LOG", "1")  # SVT-AV1 prints its whole configuration at info level
+    with av.open(str(path), "w", format="mp4") as container:
+        stream = container.add_stream(codec, rate=int(fps))
+        stream.width, stream.height, stream.pix_fmt = w, h, PIX_FMT
+        stream.options = dict(CODECS[codec][1])
+        for frame in frames:
+            for packet in stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(frame), format="rgb24")):
+                container.mux(packet)
+        for packet in stream.encode():
+            container.mux(packet)
+
+
+def decode(path: Path | str) -> np.ndarray:
+    """Every frame of the video at ``path`` as [T, H, W, 3] uint8 RGB."""
+    import av
+
+    try:
+        with av.open(str(path)) as container:
+            return np.stack([f.to_ndarray(format="rgb24") for f in container.decode(video=0)])
+    except (av.error.FFmpegError, ValueError) as exc:
+        raise VideoError(f"{path}: cannot decode the video ({exc})") from exc
+
+
+__all__ = ["CODECS", "DEFAULT_CODEC", "VideoError", "decode", "encode"]
