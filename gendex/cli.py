@@ -12,8 +12,12 @@ from pathlib import Path
 
 import typer
 
+from gendex.cli_common import die as _die
+from gendex.cli_dataset import dataset_app
+
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="GenDex: generative simulation for dexterous hands (ShadowHand on UR10e, SAPIEN/ManiSkill3).")
+app.add_typer(dataset_app, name="dataset")
 log = logging.getLogger("gendex")
 
 
@@ -25,9 +29,6 @@ def _main(verbose: bool = typer.Option(False, "--verbose", "-v", help="Log debug
     logging.getLogger("gymnasium_robotics").setLevel(logging.ERROR)
 
 
-def _die(exc: Exception) -> None:
-    typer.secho(f"error: {exc}", fg=typer.colors.RED, err=True)
-    raise typer.Exit(code=2)
 
 
 @app.command("list")
@@ -227,7 +228,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
     """Collect successful episodes into a LeRobot v3.0 dataset and/or HDF5 trajectories (resumable)."""
     from tqdm import tqdm
 
-    from gendex.data.collector import CollectConfig
+    from gendex.data.collector import CollectConfig, write_card
     from gendex.data.collector import collect as run_collect
     from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
     from gendex_envs.errors import GenDexError, suggest
@@ -256,7 +257,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
                 bar.refresh()
             state = run_collect(cfg, SOLVERS[solver], progress, workers=workers)
         if "lerobot" in cfg.formats and state.successes:
-            _write_card(cfg, spec.instruction, solver, state)
+            write_card(cfg, spec.instruction, solver, state)
     except GenDexError as exc:
         _die(exc)
     typer.echo(f"{state.successes}/{state.attempts} attempts succeeded; {state.env_steps} env steps "
@@ -275,19 +276,6 @@ def _echo_failures(failures: dict[str, int]) -> None:
     for key, n in breakdown(failures):
         stage, skill, cause = key.split("/")
         typer.echo(f"  {n:4d}  {cause:20s} stage {stage} ({skill})")
-
-
-def _write_card(cfg, instruction: str, solver: str, state) -> None:
-    import json
-
-    from gendex.data.lerobot_v3 import write_dataset_card
-
-    root = cfg.out / "lerobot"
-    info = json.loads((root / "meta" / "info.json").read_text())
-    seeds = f"{cfg.seed}..{cfg.seed + state.attempts - 1}"
-    write_dataset_card(root, task_id=cfg.task_id, instruction=instruction, robot="ShadowHand on UR10e (30 joints)",
-                       env_kwargs=cfg.env_kwargs(), n_episodes=info["total_episodes"], n_frames=info["total_frames"],
-                       how_made=f"gendex collect with solver '{solver}', seeds {seeds}")
 
 
 @app.command()
@@ -559,7 +547,7 @@ def _demo_generate(out: Path, n: int, seed: int) -> None:
 
 
 def _demo_collect(out: Path, n: int, seed: int) -> None:
-    from gendex.data.collector import CollectConfig
+    from gendex.data.collector import CollectConfig, write_card
     from gendex.data.collector import collect as run_collect
     from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
     from gendex_envs.registry import resolve_task
@@ -570,7 +558,7 @@ def _demo_collect(out: Path, n: int, seed: int) -> None:
                         max_attempts=5 * n, **SOLVER_ENV_KWARGS["stages"])
     state = run_collect(cfg, SOLVERS["stages"])
     if state.successes:
-        _write_card(cfg, version.spec.instruction, "stages", state)
+        write_card(cfg, version.spec.instruction, "stages", state)
     typer.echo(f"\nCollected {state.successes}/{state.attempts} successful {task_id} episodes "
                f"({state.env_steps_per_success:.0f} env steps per success) into the LeRobot dataset {out / 'lerobot'}")
     if state.successes < n:

@@ -31,6 +31,7 @@ from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
 from gendex_envs import observation
 from gendex_envs.atomic_io import write_json
+from gendex_envs.registry import HISTORY_FREE
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex.solve import Solver
@@ -62,7 +63,7 @@ class CollectConfig:
     def env_kwargs(self) -> dict:
         """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""
         kwargs = {"control_mode": self.control_mode, "control_joint": self.control_joint,
-                  "obs_mode": "rgb" if self.cameras else "state"}
+                  "obs_mode": "rgb" if self.cameras else "state", **HISTORY_FREE}
         if self.cameras:
             kwargs["sensor_resolution"] = self.resolution
         return kwargs
@@ -279,3 +280,17 @@ def _image(obs, camera: str) -> np.ndarray:
     except (KeyError, TypeError) as exc:
         raise EpisodeError(f"camera {camera!r} is not in the observation; cameras: "
                            f"{sorted(obs.get('sensor_data', {})) if isinstance(obs, dict) else []}") from exc
+
+
+def write_card(cfg: CollectConfig, instruction: str, solver: str, state: CollectState) -> Path:
+    """The dataset card of a LeRobot collection (``<out>/lerobot/README.md``): the exact ``gym.make`` call, how
+    observations are read, and how the episodes were made."""
+    from gendex.data.lerobot_v3 import write_dataset_card
+
+    root = cfg.out / "lerobot"
+    info = json.loads((root / "meta" / "info.json").read_text())
+    seeds = f"{cfg.seed}..{cfg.seed + state.attempts - 1}"
+    return write_dataset_card(root, task_id=cfg.task_id, instruction=instruction,
+                              robot="ShadowHand on UR10e (30 joints)", env_kwargs=cfg.env_kwargs(),
+                              n_episodes=info["total_episodes"], n_frames=info["total_frames"],
+                              how_made=f"gendex collect with solver '{solver}', seeds {seeds}")

@@ -119,6 +119,8 @@ class StageExecutor:
             self._policies: dict[str, StagePolicy] = {}
             self.rigid = RigidPrimitives(self.motion, self.config.rigid)
         self.rigid.reset()
+        # the episode's own randomness (env.np_random follows the reset seed): the same seed plans the same paths
+        self.motion.planner.reseed(int(u.np_random.integers(2**31)))
         self.carried = False
         self.logs: list[StageLog] = []
         self._handles = HandlePrimitives(self.motion, hand_cover=self._hand_cover)
@@ -244,20 +246,22 @@ class StageExecutor:
         yield from self.motion.hold(spec.success.hold_steps + 10)
 
     def _run_policy(self, stage, files: PolicyFiles) -> Iterator[np.ndarray]:
-        """Run the stage's trained policy until the stage's success conditions hold or its horizon ends; then keep
-        the bookkeeping its skill implies (what the hand holds, whether a handle is hooked)."""
+        """Run the stage's trained policy until the stage's success conditions hold (for the steps its env counts
+        them, :attr:`~gendex.solve.policy.StagePolicy.hold_steps`) or its horizon ends; then keep the bookkeeping
+        its skill implies (what the hand holds, whether a handle is hooked)."""
         key = str(files.model)
         if key not in self._policies:
             self._policies[key] = StagePolicy.load(self._env.task, files)
         policy = self._policies[key]
         env = self._env
         info = policy.judge.evaluate(env)  # one evaluation per step: it feeds the next observation too
-        done = False
+        done, streak = False, 0
         for _ in range(stage.horizon):
             target = policy.targets(env, policy.act(env, info))[0].cpu().numpy().astype(np.float64)
             yield self.motion.emit(target)
             info = policy.judge.evaluate(env)
-            if bool(info["success"][0]):
+            streak = streak + 1 if bool(info["success"][0]) else 0
+            if streak >= policy.hold_steps:
                 done = True
                 break
         if not done:

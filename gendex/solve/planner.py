@@ -33,7 +33,13 @@ class ArmPlanner:
         self.max_step_rad = max_step_rad
         self.check_step_rad = check_step_rad
         self.time_limit_s = time_limit_s
-        self.seed = seed
+        self.reseed(seed)
+
+    def reseed(self, seed: int) -> None:
+        """Make the searches from now on a function of ``seed`` (the executor reseeds with each episode's seed, so
+        an attempt plans the same paths in any process, whatever ran before it)."""
+        self.seed = int(seed)
+        self._searches = 0
 
     def segment_free(self, a: np.ndarray, b: np.ndarray) -> bool:
         """True when every configuration on the straight joint-space segment a→b (arm entries) is free."""
@@ -78,6 +84,10 @@ class ArmPlanner:
             raise PlanningError("the straight motion is blocked and OMPL is not importable "
                                 "(pip install ompl)") from e
         ou.setLogLevel(ou.LOG_WARN)
+        # OMPL seeds every RNG it creates from one global generator: reset it before each search, from the
+        # planner's seed and the search's rank in the episode, so the search does not depend on earlier ones
+        ou.RNG.setSeed((self.seed * 7919 + self._searches) % (2**31 - 1) + 1)
+        self._searches += 1
         arm = self.ik.arm
         lo, hi = self.ik.limits[arm, 0], self.ik.limits[arm, 1]
         space = ob.RealVectorStateSpace(len(arm))

@@ -106,7 +106,7 @@ def measure(folder: Path, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_
 
     from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
     from gendex.solve.attempt import run_attempt
-    from gendex_envs.registry import make_env
+    from gendex_envs.registry import HISTORY_FREE, make_env
     from gendex_envs.task_version import TaskVersion
 
     torch.set_num_threads(1)
@@ -114,7 +114,7 @@ def measure(folder: Path, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_
     stop_early = seeds is None
     seeds = gate_seeds(version.name, attempts) if seeds is None else list(seeds)
     attempts = len(seeds)
-    env = make_env(version, obs_mode="state", **SOLVER_ENV_KWARGS["stages"])
+    env = make_env(version, obs_mode="state", **SOLVER_ENV_KWARGS["stages"], **HISTORY_FREE)
     solver = SOLVERS["stages"]()
     done, ok, steps, failures = 0, 0, 0, {}
     try:

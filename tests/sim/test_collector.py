@@ -89,7 +89,8 @@ def test_cli_collect_then_replay(near_task, tmp_path):
     assert result.exit_code == 0, result.output
     assert "2/" in result.output and (out / "lerobot" / "README.md").is_file()
     card = (out / "lerobot" / "README.md").read_text()  # the exact env the actions belong to
-    assert f"gym.make('{TASK}', control_mode='pd_joint_pos', control_joint='both', obs_mode='state')" in card
+    assert (f"gym.make('{TASK}', control_mode='pd_joint_pos', control_joint='both', obs_mode='state', "
+            "reconfiguration_freq=1)") in card
     replayed = CliRunner().invoke(app, ["replay", str(out / "trajectories.h5")])
     assert replayed.exit_code == 0, replayed.output
     assert replayed.output.count(": OK") == 2

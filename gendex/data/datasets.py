@@ -1,0 +1,353 @@
+"""Published datasets: a manifest per dataset in ``datasets/``, and building, verifying, pushing and pulling them.
+
+A manifest (``datasets/<name>.yaml``) says what a dataset is: its tasks with episodes and seeds per task, the
+solver, cameras, resolution and video codec, the GenDex version, and the SHA-256 of every file of the built
+dataset. From it,
+
+- :func:`build` collects each task with ``gendex.data.collector`` into ``<out>/<task>/`` (a LeRobot v3.0 dataset
+  in ``lerobot/`` with its card; resumable: a killed build goes on where it stopped; ``workers`` processes per task)
+  and writes ``<out>/gendex_dataset.json`` (the manifest as built, what each collection took);
+- :func:`verify` checks a built or downloaded copy against the manifest, file by file: a missing, extra or
+  different file is named. Collection is deterministic (an episode depends only on task version, seed and actions,
+  and the planner is seeded per episode), so a build reproduces the manifest's checksums byte for byte;
+- :func:`push` and :func:`pull` move a built dataset to and from a remote: the Hugging Face Hub
+  (:class:`HubRemote`, ``huggingface_hub``) or a folder (:class:`FolderRemote`, a file-backed stand-in with the
+  same interface, which the tests use: this machine has no network). A one-task dataset is pushed with its LeRobot
+  dataset at the repo's root (``LeRobotDataset(repo_id)`` loads it; its card carries the ``LeRobot`` tag) and the
+  repo gets the ``v3.0`` git tag lerobot looks for; several tasks go in ``<task>/`` folders. A pull restores the
+  build's layout, so the copy verifies against the manifest.
+
+Checksums cover every file of each task's ``lerobot/`` folder (data, meta, videos, card) and ``gendex_dataset.json``;
+the collector's bookkeeping (``collect_state.json``, which holds wall-clock time) is left out.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import shutil
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Protocol
+
+import dacite
+import yaml
+
+from gendex.data.episode import EpisodeError
+
+log = logging.getLogger(__name__)
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+DATASETS_DIR = REPO_ROOT / "datasets"
+BUILD_RECORD = "gendex_dataset.json"
+SKIPPED = ("collect_state.json",)
+"""Files a build writes that are not part of the dataset (bookkeeping with wall-clock times)."""
+
+
+class DatasetError(EpisodeError):
+    """A manifest is malformed or unknown, or a dataset does not match its manifest."""
+
+
+@dataclass(frozen=True)
+class DatasetTask:
+    task: str
+    """A versioned Gymnasium id, e.g. ``GenDex/PutAppleBowl-v1``."""
+    episodes: int
+    """Successful episodes to keep."""
+    seed: int = 0
+    """Attempt k resets with ``seed + k``."""
+    max_attempts: int | None = None
+    """Give up after this many attempts (default: the collector's, 20 x episodes)."""
+
+
+@dataclass(frozen=True)
+class DatasetManifest:
+    name: str
+    description: str
+    tasks: tuple[DatasetTask, ...]
+    gendex_version: str
+    solver: str = "stages"
+    cameras: tuple[str, ...] = ()
+    resolution: int = 128
+    video_codec: str | None = "libsvtav1"
+    checksums: dict[str, str] = field(default_factory=dict)
+    """Path in the built dataset -> SHA-256 (hex) of its bytes; empty until a build was recorded."""
+
+    def folder(self, task: DatasetTask) -> str:
+        """The sub-folder of a built dataset holding ``task`` (``PutAppleBowl-v1``)."""
+        return task.task.split("/", 1)[-1]
+
+
+def _check(m: DatasetManifest) -> DatasetManifest:
+    from gendex.data.video import CODECS
+    from gendex.solve import SOLVERS
+
+    problems = []
+    if not m.tasks:
+        problems.append("tasks is empty")
+    names = [m.folder(t) for t in m.tasks]
+    if len(set(names)) != len(names):
+        problems.append(f"a task is listed twice: {names}")
+    for t in m.tasks:
+        if not t.task.startswith("GenDex/") or "-v" not in t.task:
+            problems.append(f"task {t.task!r} is not a versioned GenDex id (GenDex/<Name>-v<N>)")
+        if t.episodes < 1 or (t.max_attempts is not None and t.max_attempts < t.episodes):
+            problems.append(f"{t.task}: episodes ({t.episodes}) must be >= 1 and <= max_attempts ({t.max_attempts})")
+    if m.solver not in SOLVERS:
+        problems.append(f"solver {m.solver!r} is not one of {sorted(SOLVERS)}")
+    if m.video_codec is not None and m.video_codec not in CODECS:
+        problems.append(f"video_codec {m.video_codec!r} is not one of {sorted(CODECS)} or null")
+    if problems:
+        raise DatasetError(f"dataset manifest {m.name!r}: " + "; ".join(problems))
+    return m
+
+
+def manifest_path(name: str) -> Path:
+    """``datasets/<name>.yaml``; a path to a manifest file is taken as it is."""
+    p = Path(name)
+    return p if p.suffix in (".yaml", ".yml") and p.is_file() else DATASETS_DIR / f"{name}.yaml"
+
+
+def load_manifest(name: str | Path) -> DatasetManifest:
+    """The manifest ``datasets/<name>.yaml`` (or a manifest file), checked."""
+    path = manifest_path(str(name))
+    if not path.is_file():
+        known = sorted(p.stem for p in DATASETS_DIR.glob("*.yaml"))
+        raise DatasetError(f"no dataset manifest {name!r}; known: {', '.join(known) or 'none'} (in {DATASETS_DIR})")
+    raw = yaml.safe_load(path.read_text())
+    try:
+        m = dacite.from_dict(DatasetManifest, raw, config=dacite.Config(strict=True, cast=[tuple]))
+    except (dacite.DaciteError, TypeError) as exc:
+        raise DatasetError(f"{path}: {exc}") from exc
+    if m.name != path.stem:
+        raise DatasetError(f"{path}: name {m.name!r} must equal the file's name {path.stem!r}")
+    return _check(m)
+
+
+def save_manifest(m: DatasetManifest, path: Path) -> None:
+    """Write ``m`` as YAML (checksums sorted by path)."""
+    raw = asdict(m)
+    raw["tasks"] = [{k: v for k, v in t.items() if v is not None} for t in raw["tasks"]]
+    raw["cameras"] = list(m.cameras)
+    raw["checksums"] = dict(sorted(m.checksums.items()))
+    header = (f"# GenDex dataset manifest: `gendex dataset build {m.name}` collects it, `gendex dataset verify`\n"
+              "# checks a copy against the checksums (written by `gendex dataset build --record`). See\n"
+              "# docs/datasets.md.\n")
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(header + yaml.safe_dump(raw, sort_keys=False, width=110))
+    tmp.replace(path)
+
+
+# --------------------------------------------------------------------------------------------- checksums
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with path.open("rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def checksums(root: Path) -> dict[str, str]:
+    """Relative path -> SHA-256 of every file of the built dataset at ``root`` (bookkeeping and temp files left
+    out)."""
+    root = Path(root)
+    return {str(p.relative_to(root)): _sha256(p) for p in sorted(root.rglob("*"))
+            if p.is_file() and p.name not in SKIPPED and not p.name.startswith(".")}
+
+
+@dataclass(frozen=True)
+class Verification:
+    missing: tuple[str, ...]
+    extra: tuple[str, ...]
+    different: tuple[str, ...]
+    checked: int
+
+    @property
+    def ok(self) -> bool:
+        return not (self.missing or self.extra or self.different)
+
+    def summary(self) -> str:
+        if self.ok:
+            return f"{self.checked} files match the manifest"
+        parts = [f"{len(v)} {k} ({', '.join(v[:3])}{', ...' if len(v) > 3 else ''})"
+                 for k, v in (("missing", self.missing), ("extra", self.extra), ("different", self.different)) if v]
+        return "; ".join(parts)
+
+
+def verify(root: Path, manifest: DatasetManifest) -> Verification:
+    """Compare the dataset at ``root`` with ``manifest``'s checksums; :class:`DatasetError` when the manifest has
+    none yet (build it with ``--record`` first)."""
+    if not manifest.checksums:
+        raise DatasetError(f"manifest {manifest.name!r} holds no checksums yet: record them with "
+                           f"`gendex dataset build {manifest.name} --record`")
+    if not Path(root).is_dir():
+        raise DatasetError(f"{root} is not a folder holding a built dataset")
+    have, want = checksums(root), manifest.checksums
+    return Verification(missing=tuple(sorted(set(want) - set(have))), extra=tuple(sorted(set(have) - set(want))),
+                        different=tuple(sorted(k for k in set(want) & set(have) if want[k] != have[k])),
+                        checked=len(want))
+
+
+# --------------------------------------------------------------------------------------------- build
+def build(manifest: DatasetManifest, out: Path, *, workers: int = 1,
+          progress: Callable[[str, int, int], None] | None = None) -> dict[str, str]:
+    """Collect every task of ``manifest`` into ``out`` (resumable), write its card and the build record; returns
+    the built dataset's checksums. ``progress(task, successes, attempts)`` after each attempt."""
+    from gendex.data.collector import CollectConfig, collect, write_card
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+    from gendex_envs.registry import resolve_task
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    record = {"manifest": manifest.name, "description": manifest.description, "gendex_version":
+              manifest.gendex_version, "solver": manifest.solver, "tasks": []}
+    for t in manifest.tasks:
+        version = resolve_task(t.task)
+        cfg = CollectConfig(task_id=version.env_id, num_success=t.episodes, out=out / manifest.folder(t),
+                            formats=("lerobot",), cameras=manifest.cameras, seed=t.seed, max_attempts=t.max_attempts,
+                            resolution=manifest.resolution, video_codec=manifest.video_codec,
+                            **SOLVER_ENV_KWARGS[manifest.solver])
+        state = collect(cfg, SOLVERS[manifest.solver],
+                        None if progress is None else lambda s, name=t.task: progress(name, s.successes, s.attempts),
+                        workers=workers)
+        if state.successes < t.episodes:
+            raise DatasetError(f"{t.task}: {state.successes} of {t.episodes} episodes after {state.attempts} "
+                               f"attempts; raise max_attempts or fix the task (failures: {state.failures})")
+        write_card(cfg, version.spec.instruction, manifest.solver, state)
+        record["tasks"].append({"task": t.task, "episodes": t.episodes, "seed": t.seed, "attempts": state.attempts,
+                                "env_steps": state.env_steps, "kept_seeds": state.kept_seeds,
+                                "failures": dict(sorted(state.failures.items()))})
+    (out / BUILD_RECORD).write_text(json.dumps(record, indent=1) + "\n")
+    return checksums(out)
+
+
+def record_checksums(manifest: DatasetManifest, sums: dict[str, str]) -> DatasetManifest:
+    """``manifest`` with its expected checksums replaced by ``sums`` (``gendex dataset build --record``)."""
+    return replace(manifest, checksums=dict(sums))
+
+
+# --------------------------------------------------------------------------------------------- remotes
+class Remote(Protocol):
+    """Where built datasets are published: ``push`` a folder as ``repo_id``, ``pull`` it back into a folder."""
+
+    def push(self, root: Path, repo_id: str, tags: tuple[str, ...]) -> str: ...
+
+    def pull(self, repo_id: str, out: Path) -> Path: ...
+
+
+class HubRemote:
+    """The Hugging Face Hub through ``huggingface_hub``: a dataset repo (created if needed), the whole folder in one
+    commit, the repo tagged. ``endpoint``/``token`` as ``HfApi`` takes them (default: the environment's)."""
+
+    def __init__(self, endpoint: str | None = None, token: str | None = None, api=None):
+        from huggingface_hub import HfApi
+
+        self.api = api if api is not None else HfApi(endpoint=endpoint, token=token)
+
+    def push(self, root: Path, repo_id: str, tags: tuple[str, ...]) -> str:
+        self.api.create_repo(repo_id, repo_type="dataset", exist_ok=True)
+        info = self.api.upload_folder(repo_id=repo_id, repo_type="dataset", folder_path=str(root),
+                                      commit_message=f"GenDex dataset {repo_id}")
+        for tag in tags:
+            self.api.create_tag(repo_id, tag=tag, repo_type="dataset", exist_ok=True)
+        return str(getattr(info, "commit_url", repo_id))
+
+    def pull(self, repo_id: str, out: Path) -> Path:
+        return Path(self.api.snapshot_download(repo_id=repo_id, repo_type="dataset", local_dir=str(out)))
+
+
+class FolderRemote:
+    """A folder standing in for the Hub: ``<folder>/<org>/<name>/`` holds the pushed files and a ``.tags`` file."""
+
+    def __init__(self, folder: Path):
+        self.folder = Path(folder)
+
+    def _repo(self, repo_id: str) -> Path:
+        if repo_id.count("/") != 1 or not all(repo_id.split("/")):
+            raise DatasetError(f"repo id {repo_id!r} must be ORG/NAME")
+        return self.folder / repo_id
+
+    def push(self, root: Path, repo_id: str, tags: tuple[str, ...]) -> str:
+        dest = self._repo(repo_id)
+        tmp = dest.with_name(f".{dest.name}.tmp")
+        shutil.rmtree(tmp, ignore_errors=True)
+        shutil.copytree(root, tmp)
+        (tmp / ".tags").write_text("\n".join(tags) + "\n")
+        shutil.rmtree(dest, ignore_errors=True)
+        tmp.replace(dest)
+        return str(dest)
+
+    def pull(self, repo_id: str, out: Path) -> Path:
+        src = self._repo(repo_id)
+        if not src.is_dir():
+            raise DatasetError(f"{repo_id} is not on the remote {self.folder}")
+        shutil.copytree(src, out, ignore=shutil.ignore_patterns(".tags"), dirs_exist_ok=True)
+        return Path(out)
+
+
+REPO_TAGS = ("v3.0",)
+"""Git tags of a pushed repo: lerobot finds a dataset's format version by its tag (the v3.0 codebase version)."""
+
+
+def _tasks_of(root: Path) -> list[str]:
+    rec = Path(root) / BUILD_RECORD
+    if not rec.is_file():
+        raise DatasetError(f"{root} holds no {BUILD_RECORD}: build it with `gendex dataset build` first")
+    return [t["task"].split("/", 1)[-1] for t in json.loads(rec.read_text())["tasks"]]
+
+
+def _to_repo(root: Path, staging: Path) -> None:
+    """The repo's layout of a build: one task's LeRobot dataset at the repo root (so ``LeRobotDataset(repo_id)``
+    loads it), several tasks in ``<task>/`` folders; the build record at the root; no bookkeeping."""
+    tasks = _tasks_of(root)
+    ignore = shutil.ignore_patterns(*SKIPPED, ".*")
+    if len(tasks) == 1:
+        shutil.copytree(Path(root) / tasks[0] / "lerobot", staging, ignore=ignore)
+    else:
+        for t in tasks:
+            shutil.copytree(Path(root) / t / "lerobot", staging / t / "lerobot", ignore=ignore)
+    shutil.copy2(Path(root) / BUILD_RECORD, staging / BUILD_RECORD)
+
+
+def _from_repo(staging: Path, out: Path) -> None:
+    """Back from the repo's layout (:func:`_to_repo`) to a build's, so the copy verifies against the manifest."""
+    tasks = _tasks_of(staging)
+    out.mkdir(parents=True, exist_ok=True)
+    if len(tasks) == 1:
+        dest = out / tasks[0] / "lerobot"
+        shutil.copytree(staging, dest, ignore=shutil.ignore_patterns(BUILD_RECORD, ".*"), dirs_exist_ok=True)
+    else:
+        for t in tasks:
+            shutil.copytree(staging / t, out / t, dirs_exist_ok=True)
+    shutil.copy2(staging / BUILD_RECORD, out / BUILD_RECORD)
+
+
+def push(root: Path, repo_id: str, remote: Remote, manifest: DatasetManifest | None = None) -> str:
+    """Publish the built dataset at ``root`` as ``repo_id`` (verified against ``manifest`` first, when given)."""
+    import tempfile
+
+    if manifest is not None and manifest.checksums:
+        v = verify(root, manifest)
+        if not v.ok:
+            raise DatasetError(f"{root} does not match manifest {manifest.name!r}: {v.summary()}; not pushed")
+    with tempfile.TemporaryDirectory(prefix="gendex-push-") as tmp:
+        staging = Path(tmp) / "repo"
+        _to_repo(Path(root), staging)
+        return remote.push(staging, repo_id, REPO_TAGS)
+
+
+def pull(repo_id: str, out: Path, remote: Remote, manifest: DatasetManifest | None = None) -> Verification | None:
+    """Download ``repo_id`` into ``out`` (a build's layout) and verify it against ``manifest`` (when given)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="gendex-pull-") as tmp:
+        staging = remote.pull(repo_id, Path(tmp) / "repo")
+        _from_repo(staging, Path(out))
+    return verify(out, manifest) if manifest is not None else None
+
+
+__all__ = ["BUILD_RECORD", "DATASETS_DIR", "DatasetError", "DatasetManifest", "DatasetTask", "FolderRemote",
+           "HubRemote", "Remote", "Verification", "build", "checksums", "load_manifest", "pull", "push",
+           "record_checksums", "save_manifest", "verify"]
