@@ -165,6 +165,14 @@ def _png_column(images: np.ndarray) -> pa.Array:
                                       names=["bytes", "path"])
 
 
+def _canonical(table: pa.Table) -> pa.Table:
+    """``table`` with every fixed-size list typed as :func:`_vectors` makes it (item field ``item``, not parquet's
+    ``element``), so that a table read back and one built in memory are written as the same bytes."""
+    fields = [pa.field(f.name, pa.list_(f.type.value_type, f.type.list_size), f.nullable)
+              if pa.types.is_fixed_size_list(f.type) else f for f in table.schema]
+    return table.cast(pa.schema(fields))
+
+
 def _tasks_table(tasks: dict[str, int]) -> pa.Table:
     """``tasks.parquet`` as pandas writes ``DataFrame({"task_index": ...}, index=Index(tasks, name="task"))``."""
     names = list(tasks)
@@ -311,8 +319,10 @@ class LeRobotV3Writer:
         if self._rows:
             last = self._rows[-1]
             self._chunk, self._file = last["data/chunk_index"], last["data/file_index"]
-            self._current = pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
-                                                                       file_index=self._file))
+            # read back as this writer builds tables (parquet names a list's item "element", the in-memory one
+            # "item"): the file rewritten after a resume is then the same bytes as one written without a break
+            self._current = _canonical(pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
+                                                                                  file_index=self._file)))
             self._stats = _aggregate([self._row_stats(r) for r in self._rows])
         log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
                  len(self._tasks))

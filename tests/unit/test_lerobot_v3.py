@@ -363,3 +363,21 @@ def test_video_options_are_checked(tmp_path):
         encode(np.zeros((2, 7, 8, 3), np.uint8), tmp_path / "odd.mp4", 10)
     with pytest.raises(VideoError, match=r"\[T, H, W, 3\] uint8"):
         encode(np.zeros((2, 8, 8), np.uint8), tmp_path / "flat.mp4", 10)
+
+
+def test_a_resumed_writer_writes_the_same_bytes_as_an_uninterrupted_one(tmp_path, episodes):
+    """Reading a data file back gives parquet's list naming; the writer normalizes it, so a collection stopped after
+    its first episode and resumed ends with the same files as one that never stopped."""
+    with writer(tmp_path / "once") as w:
+        for e in episodes:
+            w.add_episode(e)
+    with writer(tmp_path / "resumed") as w:
+        w.add_episode(episodes[0])
+    with writer(tmp_path / "resumed") as w:
+        for e in episodes[1:]:
+            w.add_episode(e)
+    files = sorted(p.relative_to(tmp_path / "once") for p in (tmp_path / "once").rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(tmp_path / "resumed") for p in (tmp_path / "resumed").rglob("*")
+                           if p.is_file())
+    for f in files:
+        assert (tmp_path / "once" / f).read_bytes() == (tmp_path / "resumed" / f).read_bytes(), f
