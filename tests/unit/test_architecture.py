@@ -13,7 +13,8 @@ from gendex_envs.task_version import RECORDS, TaskLayout
 
 PACKAGES = ("gendex_envs", "gendex", "generator")
 UNITS = {"gendex_envs": "runtime", "gendex.solve": "solve", "gendex.data": "data", "gendex.train": "train",
-         "gendex.cli": "cli", "gendex.gallery": "gallery", "generator": "generator"}
+         "gendex.cli": "cli", "gendex.cli_common": "cli", "gendex.cli_dataset": "cli", "gendex.gallery": "gallery",
+         "generator": "generator"}
 """Import prefix -> the unit the architecture diagram draws (the longest matching prefix wins)."""
 ALLOWED = {
     "runtime": set(),
