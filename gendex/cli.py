@@ -12,12 +12,14 @@ from pathlib import Path
 
 import typer
 
+from gendex.cli_bc import bc_app
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="GenDex: generative simulation for dexterous hands (ShadowHand on UR10e, SAPIEN/ManiSkill3).")
 app.add_typer(dataset_app, name="dataset")
+app.add_typer(bc_app, name="bc")
 log = logging.getLogger("gendex")
 
 

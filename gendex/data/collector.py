@@ -282,14 +282,22 @@ def _image(obs, camera: str) -> np.ndarray:
                            f"{sorted(obs.get('sensor_data', {})) if isinstance(obs, dict) else []}") from exc
 
 
+GENDEX_META = "gendex.json"
+"""``meta/gendex.json`` of a LeRobot collection: the task id, the exact ``gym.make`` keyword arguments, the solver
+and each episode's reset seed (what a learner needs to act in the same env and an evaluation to check that its
+seeds are unseen); lerobot ignores it."""
+
+
 def write_card(cfg: CollectConfig, instruction: str, solver: str, state: CollectState) -> Path:
-    """The dataset card of a LeRobot collection (``<out>/lerobot/README.md``): the exact ``gym.make`` call, how
-    observations are read, and how the episodes were made."""
+    """The dataset card of a LeRobot collection (``<out>/lerobot/README.md``: the exact ``gym.make`` call, how
+    observations are read, how the episodes were made) and its ``meta/gendex.json``."""
     from gendex.data.lerobot_v3 import write_dataset_card
 
     root = cfg.out / "lerobot"
     info = json.loads((root / "meta" / "info.json").read_text())
     seeds = f"{cfg.seed}..{cfg.seed + state.attempts - 1}"
+    write_json(root / "meta" / GENDEX_META, {"task_id": cfg.task_id, "env_kwargs": cfg.env_kwargs(),
+                                             "solver": solver, "episode_seeds": state.kept_seeds}, indent=1)
     return write_dataset_card(root, task_id=cfg.task_id, instruction=instruction,
                               robot="ShadowHand on UR10e (30 joints)", env_kwargs=cfg.env_kwargs(),
                               n_episodes=info["total_episodes"], n_frames=info["total_frames"],

@@ -1,0 +1,1 @@
+"""Evaluating policies on GenDex tasks: the episode runner (:mod:`gendex.eval.runner`)."""

@@ -1,0 +1,139 @@
+"""Run a policy on a task for a list of seeds and record what happened in each episode.
+
+A policy is any object with ``reset()`` and ``act(obs) -> action``: ``obs`` is what
+:class:`~gendex_envs.observation.LeRobotObservation` gives (the features of GenDex datasets, by the same names), the
+action one of the env's default action space (absolute joint targets, ``pd_joint_pos``). A policy that needs the
+simulator itself (the planner oracle) may also have ``bind(env)``, called once with the env.
+
+Conventions (ManiSkill's, LeRobot's): every episode is reset with its own seed and runs until the task's time limit
+or termination (no early stop at success, no partial resets); ``success_once`` (success at any step) and
+``success_at_end`` (at the last step) are both recorded, with the summed and the largest reward. An episode whose
+policy raises, returns a non-finite action or one outside the action space fails with the reason recorded, and the
+evaluation goes on. Envs are made with :data:`~gendex_envs.registry.HISTORY_FREE`, so an episode depends only on the
+task, the seed and the policy.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass
+from typing import Any, Protocol
+
+import gymnasium as gym
+import numpy as np
+
+from gendex_envs.observation import LeRobotObservation
+from gendex_envs.registry import HISTORY_FREE
+
+log = logging.getLogger(__name__)
+
+ACTION_TOL = 1e-4
+"""How far (in the action's units) an action may stray outside the action space before the episode fails."""
+
+
+class Policy(Protocol):
+    def reset(self) -> None: ...
+
+    def act(self, obs: dict[str, np.ndarray]) -> np.ndarray: ...
+
+
+@dataclass(frozen=True)
+class EpisodeResult:
+    task: str
+    seed: int
+    success_once: bool
+    success_at_end: bool
+    sum_reward: float
+    max_reward: float
+    length: int
+    """Env steps taken."""
+    seconds: float
+    failure: str | None = None
+    """Why the policy made the episode fail (it raised, or gave a NaN or out-of-range action); None otherwise."""
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def make_eval_env(task: str, env_kwargs: dict | None = None, max_episode_steps: int | None = None) -> gym.Env:
+    """The env an evaluation runs in: ``gym.make(task, **env_kwargs, **HISTORY_FREE)`` under LeRobotObservation."""
+    kwargs = {**(env_kwargs or {}), **HISTORY_FREE}
+    if max_episode_steps is not None:
+        kwargs["max_episode_steps"] = max_episode_steps
+    return LeRobotObservation(gym.make(task, **kwargs))
+
+
+def _check_action(action: Any, space: gym.spaces.Box) -> tuple[np.ndarray | None, str | None]:
+    try:
+        a = np.asarray(action, dtype=np.float32).reshape(space.shape)
+    except (TypeError, ValueError) as exc:
+        return None, f"the action {np.shape(action)} is not of the action space's shape {space.shape} ({exc})"
+    if not np.all(np.isfinite(a)):
+        return None, "the action holds NaN or inf"
+    low, high = space.low, space.high
+    worst = float(np.max(np.maximum(low - a, a - high)))
+    if worst > ACTION_TOL:
+        i = int(np.argmax(np.maximum(low - a, a - high)))
+        return None, (f"action[{i}] = {a[i]:.4g} is outside the action space [{low[i]:.4g}, {high[i]:.4g}] "
+                      f"by {worst:.3g}")
+    return np.clip(a, low, high), None
+
+
+def run_episode(env: gym.Env, policy: Policy, task: str, seed: int) -> EpisodeResult:
+    """One episode of ``policy`` from ``env.reset(seed=seed)`` until the time limit or termination."""
+    t0 = time.perf_counter()
+    obs, _ = env.reset(seed=int(seed))
+    failure = None
+    once = end = False
+    total, best, steps = 0.0, -np.inf, 0
+    try:
+        policy.reset()
+    except Exception as exc:  # the policy is the user's code: any error fails this episode only
+        failure = f"the policy's reset() raised {type(exc).__name__}: {exc}"
+    while failure is None:
+        try:
+            raw = policy.act(obs)
+        except Exception as exc:  # as above
+            failure = f"the policy's act() raised {type(exc).__name__}: {exc}"
+            break
+        action, failure = _check_action(raw, env.action_space)
+        if failure is not None:
+            break
+        obs, reward, terminated, truncated, info = env.step(action)
+        steps += 1
+        total += float(reward)
+        best = max(best, float(reward))
+        end = bool(np.asarray(info.get("success", False)).reshape(-1)[0])
+        once = once or end
+        if terminated or truncated:
+            break
+    if failure is not None:
+        log.info("%s seed %d: %s", task, seed, failure)
+        end = False
+    return EpisodeResult(task, int(seed), once, end, total, best if steps else 0.0, steps,
+                         round(time.perf_counter() - t0, 3), failure)
+
+
+def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[int], *,
+                  env_kwargs: dict | None = None, max_episode_steps: int | None = None,
+                  progress: Callable[[EpisodeResult], None] | None = None) -> list[EpisodeResult]:
+    """Run a fresh ``make_policy()`` on ``task`` for every seed (one env, reused: it is rebuilt at each reset)."""
+    env = make_eval_env(task, env_kwargs, max_episode_steps)
+    try:
+        policy = make_policy()
+        if hasattr(policy, "bind"):
+            policy.bind(env)
+        out = []
+        for seed in seeds:
+            r = run_episode(env, policy, task, seed)
+            out.append(r)
+            if progress is not None:
+                progress(r)
+        return out
+    finally:
+        env.close()
+
+
+__all__ = ["ACTION_TOL", "EpisodeResult", "Policy", "evaluate_task", "make_eval_env", "run_episode"]

@@ -1,0 +1,1 @@
+"""Learning from GenDex datasets: behaviour cloning with action chunks (:mod:`gendex.imitation.bc`)."""

@@ -1,0 +1,45 @@
+"""The evaluation runner: a policy's bad action fails its episode with the reason and the evaluation goes on;
+every episode is reset with its own seed and judged at its end and at any step."""
+
+import numpy as np
+
+from gendex.eval.runner import evaluate_task
+
+TASK = "GenDex/PutAppleBowl-v1"
+
+
+class Scripted:
+    """Acts by episode: hold the current targets, then NaN, then raise, then a joint far beyond its limit."""
+
+    def __init__(self):
+        self.episode = -1
+
+    def bind(self, env):
+        self.env = env
+
+    def reset(self):
+        self.episode += 1
+
+    def act(self, obs):
+        assert set(obs) == {"observation.state", "observation.environment_state"}
+        hold = self.env.unwrapped.agent.controller.free_targets()[0].cpu().numpy()
+        if self.episode == 1:
+            return hold * np.nan
+        if self.episode == 2:
+            raise RuntimeError("policy crashed")
+        if self.episode == 3:
+            hold = hold.copy()
+            hold[0] += 100.0
+        return hold
+
+
+def test_bad_actions_fail_their_episode_with_a_reason_and_the_run_goes_on():
+    results = evaluate_task(TASK, Scripted, [11, 12, 13, 14], max_episode_steps=3)
+    assert [r.seed for r in results] == [11, 12, 13, 14]
+    hold, nan, crash, far = results
+    assert hold.failure is None and hold.length == 3 and np.isfinite(hold.sum_reward)
+    assert not hold.success_at_end  # holding still does not put the apple in the bowl
+    assert nan.failure == "the action holds NaN or inf" and nan.length == 0
+    assert crash.failure == "the policy's act() raised RuntimeError: policy crashed"
+    assert far.failure.startswith("action[0] = ") and "outside the action space" in far.failure
+    assert not any(r.success_at_end or r.success_once for r in (nan, crash, far))
