@@ -38,6 +38,12 @@ def stage_observation(env, judge: Judge, info: dict | None = None) -> torch.Tens
     return env.unwrapped.state_observation(judge, info)
 
 
+def success_hold_steps(version: TaskVersion, stage: str) -> int:
+    """Consecutive steps ``stage``'s success must hold in its env (:attr:`StagePolicy.hold_steps`)."""
+    own = stage != WHOLE_TASK and version.stage(stage)[1].success is not None
+    return 1 if own else max(1, version.spec.success.hold_steps)
+
+
 @dataclass
 class StagePolicy:
     """A trained PPO policy of one stage, with what it needs to run on another env of the task."""
@@ -52,6 +58,10 @@ class StagePolicy:
     obs_var: np.ndarray
     clip_obs: float
     meta: dict
+    hold_steps: int = 1
+    """Consecutive steps the stage's success must hold before its env counts it (the task's ``hold_steps`` when the
+    stage is judged by the task's conditions, as :meth:`~gendex_envs.task_env.TaskEnv.evaluate` counts it; else 1):
+    the policy was trained and evaluated acting through them, so it runs through them."""
     _joints: tuple | None = field(default=None, init=False, repr=False)
     """(controller, joint indices, per-joint delta bounds), computed once per controller."""
 
@@ -73,7 +83,8 @@ class StagePolicy:
         judge = version.judge(None if files.stage == WHOLE_TASK else files.stage)
         return cls(stage=files.stage, control_joint=meta["control_joint"], judge=judge,
                    model=model, obs_mean=np.asarray(norm["mean"], dtype=np.float32),
-                   obs_var=np.asarray(norm["var"], dtype=np.float32), clip_obs=float(norm["clip"]), meta=meta)
+                   obs_var=np.asarray(norm["var"], dtype=np.float32), clip_obs=float(norm["clip"]), meta=meta,
+                   hold_steps=success_hold_steps(version, files.stage))
 
     def normalize(self, obs: np.ndarray) -> np.ndarray:
         """Raw flat observation(s) -> what the network takes (the training run's running mean and variance)."""

@@ -73,6 +73,34 @@ PRESETS: dict[str, PPOPreset] = {
 table; they follow ManiSkill's PPO baseline."""
 
 
+def parse_overrides(items: list[str]) -> dict:
+    """``["log_std_init=-1.5", "net_arch=256,256"]`` -> preset settings typed like :class:`PPOPreset`'s fields
+    (:class:`TrainingError` for a malformed item or an unknown setting)."""
+    fields = {f.name: getattr(PRESETS["cpu"], f.name) for f in dataclasses.fields(PPOPreset)}
+    out: dict = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        key, raw = key.strip(), raw.strip()
+        if not sep or not raw:
+            raise TrainingError(f"PPO setting {item!r}: write KEY=VALUE")
+        if key not in fields or key == "name":
+            raise TrainingError(f"unknown PPO setting {key!r}; settings: {sorted(set(fields) - {'name'})}."
+                                f"{suggest(key, fields)}")
+        kind = type(fields[key])
+        try:
+            if kind is bool:
+                if raw.lower() not in ("true", "false", "1", "0"):
+                    raise ValueError(raw)
+                out[key] = raw.lower() in ("true", "1")
+            elif kind is tuple:
+                out[key] = tuple(int(x) for x in raw.split(","))
+            else:
+                out[key] = kind(raw)
+        except ValueError:
+            raise TrainingError(f"PPO setting {key}: {raw!r} is not a {kind.__name__}") from None
+    return out
+
+
 def get_preset(name: str) -> PPOPreset:
     try:
         return PRESETS[name]

@@ -10,6 +10,11 @@ version (:func:`promote`).
 Stage K > 0 starts from the version's start states of that stage when it has them, else the run's, else they are
 collected with the stage executor (earlier stages by motion planning, scripted primitives, or the run's and the
 version's trained policies) and saved in the run folder.
+
+Training can start from an earlier policy of the same stage (``init``, :func:`warm_start`): its weights and its
+observation normalization are loaded, and its exploration noise is reset to the preset's ``log_std_init``, so a
+policy trained under much noise can be refined under less (what its deterministic actions, the ones the executor
+runs, need). Its evaluation before training is then the "untrained" one in the record.
 """
 
 from __future__ import annotations
@@ -87,14 +92,65 @@ def stage_start_states(version: TaskVersion, stage: str, index: int, run: TaskLa
     return got.states, got.env_steps
 
 
+def policy_to_start_from(version: TaskVersion, stage: str | int, source: str | Path) -> PolicyFiles:
+    """The policy of ``version``'s ``stage`` in ``source``: a training run folder, or a task version (id or folder)
+    of the same task; :class:`TrainingError` when it has none."""
+    from gendex_envs.registry import resolve_task
+
+    name = TASK_STAGE if stage == TASK_STAGE else version.stage(stage)[1].name
+    run = TaskLayout(source)
+    if run.record("run").is_file():
+        found = Artifacts(run.root).policy(name)
+    else:
+        other = resolve_task(str(source))
+        if other.name != version.name:
+            raise TrainingError(f"{other.env_id} is another task than {version.env_id}: no policy to start from")
+        found = other.policy(name)
+    if found is None:
+        raise TrainingError(f"{source} has no trained policy of stage {name!r} to start from")
+    return found
+
+
+def warm_start(model, venv, init: PolicyFiles, control_joint: str, log_std_init: float) -> dict:
+    """Load the policy ``init`` (model weights, observation normalization) into a fresh PPO ``model`` and its
+    ``VecNormalize`` ``venv``, then set the policy's log standard deviation to ``log_std_init``; returns what the
+    record says about it. :class:`TrainingError` when ``init`` does not fit (other joints, observation or network)."""
+    import json
+
+    import torch
+    from stable_baselines3 import PPO
+
+    meta = json.loads(init.record.read_text())
+    norm = meta["obs_norm"]
+    if meta.get("control_joint") != control_joint or len(norm["mean"]) != venv.observation_space.shape[0]:
+        raise TrainingError(f"{init.model} drives {meta.get('control_joint')!r} from {len(norm['mean'])} "
+                            f"observations; this stage drives {control_joint!r} from "
+                            f"{venv.observation_space.shape[0]}: it cannot start from it")
+    source = PPO.load(str(init.model), device="cpu")
+    try:
+        model.policy.load_state_dict(source.policy.state_dict())
+    except RuntimeError as exc:
+        raise TrainingError(f"{init.model}: its network does not match the preset's ({exc})") from None
+    with torch.no_grad():
+        model.policy.log_std.fill_(log_std_init)
+    venv.obs_rms.mean = np.asarray(norm["mean"], dtype=np.float64)
+    venv.obs_rms.var = np.asarray(norm["var"], dtype=np.float64)
+    venv.obs_rms.count = float(meta.get("steps", 1))
+    log.info("warm start from %s (%s steps), log std reset to %.2f", init.model, meta.get("steps"), log_std_init)
+    model_path = init.model.resolve()
+    shown = model_path.relative_to(Path.cwd()) if model_path.is_relative_to(Path.cwd()) else model_path
+    return dict(model=str(shown), steps=meta.get("steps"), source=meta.get("source"),
+                command=meta.get("command"))
+
+
 def train_stage(version: TaskVersion, stage: str | int | None, *, steps: int, run_dir: str | Path,
                 preset: str | PPOPreset = "cpu", n_envs: int | None = None, seed: int = 0,
                 control_joint: str | None = None, start_states: StartStates | None = None,
                 eval_episodes: int = 20, checkpoint_every: int = 50_000, command: str = "",
-                progress: bool = True) -> TrainResult:
+                progress: bool = True, init: PolicyFiles | None = None) -> TrainResult:
     """Train PPO on ``stage`` (name or index; None: the whole task with every joint) of ``version`` and save it
     into the run folder ``run_dir`` (module doc). ``control_joint`` overrides the stage's joint group (the
-    ablation's "no frozen DoFs" variants)."""
+    ablation's "no frozen DoFs" variants); ``init``: start from this policy of the stage (:func:`warm_start`)."""
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CheckpointCallback
@@ -136,6 +192,7 @@ def train_stage(version: TaskVersion, stage: str | int | None, *, steps: int, ru
     judge = version.judge(None if name == TASK_STAGE else name)
     try:
         model = PPO("MlpPolicy", venv, seed=seed, device="cpu", verbose=0, **p.ppo_kwargs())
+        started = warm_start(model, venv, init, cj, p.log_std_init) if init is not None else None
         fresh = StagePolicy(stage=name, control_joint=cj, judge=judge, model=model,
                             obs_mean=venv.obs_rms.mean.astype(np.float32).copy(),
                             obs_var=venv.obs_rms.var.astype(np.float32).copy(), clip_obs=venv.clip_obs, meta={})
@@ -154,7 +211,7 @@ def train_stage(version: TaskVersion, stage: str | int | None, *, steps: int, ru
                 control_joint=cj, control_mode="pd_joint_delta_pos", preset=dataclasses.asdict(p),
                 steps=trained_steps, seed=seed, obs_norm=norm, obs_dim=len(norm["mean"]),
                 start_states=len(start_states) if start_states else 0, start_state_steps=state_steps,
-                command=command)
+                command=command, init=started)
     with atomic_path(files.model) as tmp:
         model.save(str(tmp))
     write_json(files.record, meta, indent=2, sort_keys=True)
