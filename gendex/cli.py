@@ -15,11 +15,14 @@ import typer
 from gendex.cli_bc import bc_app
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
+from gendex.cli_eval import eval_command, leaderboard_app
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="GenDex: generative simulation for dexterous hands (ShadowHand on UR10e, SAPIEN/ManiSkill3).")
 app.add_typer(dataset_app, name="dataset")
 app.add_typer(bc_app, name="bc")
+app.command("eval")(eval_command)
+app.add_typer(leaderboard_app, name="leaderboard")
 log = logging.getLogger("gendex")
 
 
@@ -241,7 +244,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
         _die(ValueError(f"--format {fmt!r} is not one of {sorted(formats)}.{suggest(fmt, formats)}"))
     if solver not in SOLVERS:
         _die(ValueError(f"--solver {solver!r} is not one of {sorted(SOLVERS)}.{suggest(solver, SOLVERS)}"))
-    from gendex.data.video import CODECS
+    from gendex_envs.video import CODECS
 
     if video != "png" and video not in CODECS:
         _die(ValueError(f"--video {video!r} is not one of {[*sorted(CODECS), 'png']}"))

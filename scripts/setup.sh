@@ -3,7 +3,8 @@
 #   1. a virtual environment in .venv (Python 3.11) with torch==2.13.0 installed first (CPU build),
 #      then the project and its pinned dependencies (constraints.txt);
 #   2. a working Vulkan device for SAPIEN: when none is found and this is Debian 12, Mesa >= 23 lavapipe
-#      from bookworm-backports is installed. The apt source is derived from the machine's own apt config.
+#      from bookworm-backports is installed. The apt source is derived from the machine's own apt config;
+#   3. Debian's chromium and chromium-driver, for the leaderboard's browser test (as root, when missing).
 # Re-runs are fast: a stamp records the hash of the files that define the environment.
 set -euo pipefail
 
@@ -72,7 +73,22 @@ install_lavapipe() {
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq -t bookworm-backports mesa-vulkan-drivers >/dev/null
 }
 
+install_browser() {
+  # Debian's Chromium and its driver, for the leaderboard's browser test (tests/web/); nothing is downloaded by the
+  # test itself. Only as root on Debian; elsewhere the test skips and says why.
+  command -v chromium >/dev/null 2>&1 && command -v chromedriver >/dev/null 2>&1 && return 0
+  if [ "$(id -u)" != "0" ] || ! command -v apt-get >/dev/null 2>&1; then
+    log "chromium + chromium-driver missing and not installable here (not root or no apt): the browser test skips"
+    return 0
+  fi
+  log "installing chromium and chromium-driver (Debian) for the leaderboard's browser test"
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver >/dev/null \
+    || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver \
+         >/dev/null; } || log "could not install chromium: the browser test skips"
+}
+
 install_python_env
+install_browser
 if ! vulkan_ok; then
   install_lavapipe
   vulkan_ok || { log "Vulkan still unusable after installing lavapipe"; exit 3; }

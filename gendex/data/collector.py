@@ -26,12 +26,12 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
-from gendex.data.video import DEFAULT_CODEC
 from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
 from gendex_envs import observation
 from gendex_envs.atomic_io import write_json
 from gendex_envs.registry import HISTORY_FREE
+from gendex_envs.video import DEFAULT_CODEC
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex.solve import Solver

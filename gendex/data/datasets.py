@@ -81,8 +81,8 @@ class DatasetManifest:
 
 
 def _check(m: DatasetManifest) -> DatasetManifest:
-    from gendex.data.video import CODECS
     from gendex.solve import SOLVERS
+    from gendex_envs.video import CODECS
 
     problems = []
     if not m.tasks:

@@ -39,7 +39,7 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from gendex.data.episode import Episode, EpisodeError
-from gendex.data.video import CODECS, PIX_FMT, encode
+from gendex_envs.video import CODECS, PIX_FMT, encode
 
 log = logging.getLogger(__name__)
 

@@ -18,7 +18,8 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 from typing import Any, Protocol
 
 import gymnasium as gym
@@ -52,14 +53,20 @@ class EpisodeResult:
     seconds: float
     failure: str | None = None
     """Why the policy made the episode fail (it raised, or gave a NaN or out-of-range action); None otherwise."""
+    video: str | None = None
+    """The episode's video file, when it was recorded."""
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
-def make_eval_env(task: str, env_kwargs: dict | None = None, max_episode_steps: int | None = None) -> gym.Env:
-    """The env an evaluation runs in: ``gym.make(task, **env_kwargs, **HISTORY_FREE)`` under LeRobotObservation."""
+def make_eval_env(task: str, env_kwargs: dict | None = None, max_episode_steps: int | None = None,
+                  render: bool = False) -> gym.Env:
+    """The env an evaluation runs in: ``gym.make(task, **env_kwargs, **HISTORY_FREE)`` under LeRobotObservation
+    (``render``: with ``render_mode="rgb_array"``, for episode videos)."""
     kwargs = {**(env_kwargs or {}), **HISTORY_FREE}
+    if render:
+        kwargs["render_mode"] = "rgb_array"
     if max_episode_steps is not None:
         kwargs["max_episode_steps"] = max_episode_steps
     return LeRobotObservation(gym.make(task, **kwargs))
@@ -81,10 +88,14 @@ def _check_action(action: Any, space: gym.spaces.Box) -> tuple[np.ndarray | None
     return np.clip(a, low, high), None
 
 
-def run_episode(env: gym.Env, policy: Policy, task: str, seed: int) -> EpisodeResult:
-    """One episode of ``policy`` from ``env.reset(seed=seed)`` until the time limit or termination."""
+def run_episode(env: gym.Env, policy: Policy, task: str, seed: int,
+                frames: list[np.ndarray] | None = None) -> EpisodeResult:
+    """One episode of ``policy`` from ``env.reset(seed=seed)`` until the time limit or termination (``frames``: a
+    list the rendered frame of every step is appended to)."""
     t0 = time.perf_counter()
     obs, _ = env.reset(seed=int(seed))
+    if frames is not None:
+        frames.append(np.asarray(env.render()))
     failure = None
     once = end = False
     total, best, steps = 0.0, -np.inf, 0
@@ -102,6 +113,8 @@ def run_episode(env: gym.Env, policy: Policy, task: str, seed: int) -> EpisodeRe
         if failure is not None:
             break
         obs, reward, terminated, truncated, info = env.step(action)
+        if frames is not None:
+            frames.append(np.asarray(env.render()))
         steps += 1
         total += float(reward)
         best = max(best, float(reward))
@@ -118,16 +131,27 @@ def run_episode(env: gym.Env, policy: Policy, task: str, seed: int) -> EpisodeRe
 
 def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[int], *,
                   env_kwargs: dict | None = None, max_episode_steps: int | None = None,
-                  progress: Callable[[EpisodeResult], None] | None = None) -> list[EpisodeResult]:
-    """Run a fresh ``make_policy()`` on ``task`` for every seed (one env, reused: it is rebuilt at each reset)."""
-    env = make_eval_env(task, env_kwargs, max_episode_steps)
+                  progress: Callable[[EpisodeResult], None] | None = None, videos: int = 0,
+                  video_dir: Path | None = None) -> list[EpisodeResult]:
+    """Run a fresh ``make_policy()`` on ``task`` for every seed (one env, reused: it is rebuilt at each reset);
+    the first ``videos`` episodes are also written as ``<video_dir>/<task name>_<seed>.mp4``."""
+    from gendex_envs.video import encode
+
+    env = make_eval_env(task, env_kwargs, max_episode_steps, render=videos > 0)
     try:
         policy = make_policy()
         if hasattr(policy, "bind"):
             policy.bind(env)
         out = []
-        for seed in seeds:
-            r = run_episode(env, policy, task, seed)
+        for k, seed in enumerate(seeds):
+            frames = [] if k < videos and video_dir is not None else None
+            r = run_episode(env, policy, task, seed, frames)
+            if frames:
+                video_dir.mkdir(parents=True, exist_ok=True)
+                path = video_dir / f"{task.split('/')[-1]}_{seed}.mp4"
+                encode(np.stack([f.reshape(f.shape[-3:]) for f in frames]).astype(np.uint8), path,
+                       int(env.unwrapped.control_freq))
+                r = replace(r, video=str(path))
             out.append(r)
             if progress is not None:
                 progress(r)

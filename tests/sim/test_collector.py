@@ -106,7 +106,7 @@ def test_two_workers_give_the_same_dataset(near_task, tmp_path):
 def test_cameras_are_recorded_as_video_at_the_asked_resolution(near_task, tmp_path):
     """--cameras with the default video codec: the dataset's info names a video_path, each kept episode has an MP4
     per camera holding one frame per action at the asked resolution, and the card's gym.make call says so."""
-    from gendex.data.video import decode
+    from gendex_envs.video import decode
 
     cfg = _cfg(tmp_path, cameras=("left_overhead",), resolution=64)
     state = collect(dataclasses.replace(cfg, num_success=1, formats=("lerobot",)), lambda: HoldSolver(steps=4))

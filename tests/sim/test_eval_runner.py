@@ -43,3 +43,38 @@ def test_bad_actions_fail_their_episode_with_a_reason_and_the_run_goes_on():
     assert crash.failure == "the policy's act() raised RuntimeError: policy crashed"
     assert far.failure.startswith("action[0] = ") and "outside the action space" in far.failure
     assert not any(r.success_at_end or r.success_once for r in (nan, crash, far))
+
+
+def _tiny_suite(tmp_path):
+    from gendex.eval.suite import load_suite
+
+    path = tmp_path / "tiny.yaml"
+    path.write_text("name: tiny\ndescription: two short episodes of PutAppleBowl\ntasks: [GenDex/PutAppleBowl-v1]\n"
+                    "seed: 3000000\nepisodes: 2\nmax_episode_steps: 4\n")
+    return load_suite(path)
+
+
+def test_a_suite_run_resumes_where_it_stopped_and_refuses_seeds_a_policy_learned_from(tmp_path):
+    import json
+
+    import pytest
+
+    from gendex.eval.policies import resolve_policy
+    from gendex.eval.suite_run import EPISODES_FILE, EvalError, run_suite
+
+    suite = _tiny_suite(tmp_path)
+    out = tmp_path / "run"
+    first = run_suite(suite, "hold", resolve_policy, out)
+    assert [e["seed"] for e in first["per_episode"]] == [3_000_000, 3_000_001]
+    assert first["suite"]["complete"] and first["per_task"]["GenDex/PutAppleBowl-v1"]["episodes"] == 2
+    lines = (out / EPISODES_FILE).read_text().splitlines()
+    (out / EPISODES_FILE).write_text(lines[0] + "\n")  # as if stopped after the first episode
+    seen = []
+    again = run_suite(suite, "hold", resolve_policy, out, progress=seen.append)
+    assert [r["seed"] for r in seen] == [3_000_001]  # only the missing episode ran
+    assert again["per_episode"] == first["per_episode"]  # and it came out the same
+    with pytest.raises(EvalError, match="holds an evaluation of hold"):
+        run_suite(suite, "random", resolve_policy, out)
+    with pytest.raises(EvalError, match="trained on seeds \\[3000001\\]"):
+        run_suite(suite, "hold", resolve_policy, tmp_path / "other", training_seeds=[3_000_001, 7])
+    assert json.loads((out / "eval_info.json").read_text())["policy"] == "hold"

@@ -13,8 +13,8 @@ from gendex_envs.task_version import RECORDS, TaskLayout
 
 PACKAGES = ("gendex_envs", "gendex", "generator")
 UNITS = {"gendex_envs": "runtime", "gendex.solve": "solve", "gendex.data": "data", "gendex.train": "train",
-         "gendex.eval": "eval", "gendex.imitation": "imitation", "gendex.cli": "cli", "gendex.cli_common": "cli",
-         "gendex.cli_dataset": "cli", "gendex.cli_bc": "cli", "gendex.gallery": "gallery", "generator": "generator"}
+         "gendex.eval": "eval", "gendex.imitation": "imitation", "gendex.gallery": "gallery", "generator": "generator",
+         **{f"gendex.{m}": "cli" for m in ("cli", "cli_common", "cli_dataset", "cli_bc", "cli_eval")}}
 """Import prefix -> the unit the architecture diagram draws (the longest matching prefix wins)."""
 ALLOWED = {
     "runtime": set(),

@@ -306,15 +306,6 @@ def test_dataset_card(dataset):
             "obs_mode='state')") in text  # the exact env the actions belong to
 
 
-def test_loads_with_lerobot(dataset):
-    pytest.importorskip("lerobot", reason="lerobot is not installable on this Python (see NOTES-platform.md)")
-    from lerobot.datasets.lerobot_dataset import LeRobotDataset
-
-    ds = LeRobotDataset("local/gendex-test", root=dataset)
-    assert len(ds) == 16 and ds.num_episodes == 3
-    assert ds[8]["task"] == "open the drawer"
-
-
 def _smooth_episode(t: int, seed: int, h: int = 16, w: int = 24) -> Episode:
     ep = make_episode(t, seed, cams=())
     yy, xx = np.mgrid[0:h, 0:w]
@@ -329,7 +320,7 @@ def test_camera_images_as_video_files_in_the_v3_layout(tmp_path, codec):
     """With a video codec, camera frames go to videos/<key>/chunk-000/file-<episode>.mp4 (one file per episode,
     frame k at k/fps), the feature is declared as video, the episode rows say where each episode's frames are, and
     the same episodes give the same bytes."""
-    from gendex.data.video import decode
+    from gendex_envs.video import decode
 
     eps = [_smooth_episode(6, 1), _smooth_episode(4, 2)]
     roots = [tmp_path / "a", tmp_path / "b"]
@@ -355,7 +346,7 @@ def test_camera_images_as_video_files_in_the_v3_layout(tmp_path, codec):
 
 
 def test_video_options_are_checked(tmp_path):
-    from gendex.data.video import VideoError, encode
+    from gendex_envs.video import VideoError, encode
 
     with pytest.raises(LeRobotDatasetError, match="video_codec 'mjpeg' is not one of"):
         writer(tmp_path / "x", video_codec="mjpeg")

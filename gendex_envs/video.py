@@ -1,4 +1,5 @@
-"""Camera frames as video files, the way LeRobot v3.0 datasets store them (PyAV, FFmpeg's libraries).
+"""Frames as video files (PyAV, FFmpeg's libraries): the camera streams of LeRobot v3.0 datasets, the episode
+videos of evaluations.
 
 :func:`encode` writes ``[T, H, W, 3]`` uint8 RGB frames as an MP4 whose frame ``i`` has presentation time ``i / fps``
 exactly (time base ``1/fps``), so lerobot's decoder finds each frame at its timestamp. The default codec is
@@ -14,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gendex.data.episode import EpisodeError
+from gendex_envs.errors import GenDexError
 
 CODECS = {"libsvtav1": ("av1", {"g": "2", "crf": "30"}), "libx264": ("h264", {"g": "2", "crf": "23"})}
 """Encoder -> (codec name recorded in the dataset's features, encoder options)."""
@@ -22,7 +23,7 @@ DEFAULT_CODEC = "libsvtav1"
 PIX_FMT = "yuv420p"
 
 
-class VideoError(EpisodeError):
+class VideoError(GenDexError, ValueError):
     """Frames cannot be encoded as asked, or a video file cannot be read."""
 
 

@@ -1,0 +1,86 @@
+"""Benchmark suites as data: ``suites/<name>.yaml``.
+
+A suite fixes what a result on it means: versioned task ids, the evaluation seeds (the same for every task,
+``seed .. seed + episodes - 1``, disjoint from every dataset's and from the solvability gate's), episodes per task
+(default 50, as LIBERO and RoboCasa), the metric that ranks (``success_at_end``, ManiSkill's default;
+``success_once`` is reported too), ``gym.make`` keyword arguments and an optional step limit. A result carries the
+suite file's SHA-256, so two results are comparable exactly when their hashes agree.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import dacite
+import yaml
+
+from gendex_envs.errors import GenDexError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+SUITES_DIR = REPO_ROOT / "suites"
+METRICS = ("success_at_end", "success_once")
+SEED_FLOOR = 1_000_000
+"""Suite seeds start at or above this: datasets use 0 .. their manifests' max attempts, benchmarks 1 000-97 000."""
+
+
+class SuiteError(GenDexError, ValueError):
+    """A suite file is malformed or unknown."""
+
+
+@dataclass(frozen=True)
+class Suite:
+    name: str
+    description: str
+    tasks: tuple[str, ...]
+    seed: int
+    """First evaluation seed; every task is evaluated on ``seed .. seed + episodes - 1``."""
+    episodes: int = 50
+    metric: str = "success_at_end"
+    env_kwargs: dict = field(default_factory=dict)
+    max_episode_steps: int | None = None
+    """Step limit of every episode (None: each task's own)."""
+    hash: str = ""
+    """SHA-256 of the suite file (set when loaded)."""
+
+    def seeds(self, episodes: int | None = None) -> list[int]:
+        return list(range(self.seed, self.seed + (episodes or self.episodes)))
+
+
+def suite_path(name: str | Path) -> Path:
+    p = Path(name)
+    return p if p.suffix in (".yaml", ".yml") and p.is_file() else SUITES_DIR / f"{name}.yaml"
+
+
+def load_suite(name: str | Path) -> Suite:
+    """The suite ``suites/<name>.yaml`` (or a suite file), checked, with its hash."""
+    path = suite_path(name)
+    if not path.is_file():
+        known = sorted(p.stem for p in SUITES_DIR.glob("*.yaml"))
+        raise SuiteError(f"no suite {str(name)!r}; known: {', '.join(known) or 'none'} (in {SUITES_DIR})")
+    data = path.read_bytes()
+    raw = yaml.safe_load(data)
+    try:
+        suite = dacite.from_dict(Suite, {**raw, "hash": hashlib.sha256(data).hexdigest()},
+                                 config=dacite.Config(strict=True, cast=[tuple]))
+    except (dacite.DaciteError, TypeError) as exc:
+        raise SuiteError(f"{path}: {exc}") from exc
+    problems = []
+    if suite.name != path.stem:
+        problems.append(f"name {suite.name!r} must equal the file's name {path.stem!r}")
+    if suite.metric not in METRICS:
+        problems.append(f"metric {suite.metric!r} is not one of {list(METRICS)}")
+    if suite.seed < SEED_FLOOR:
+        problems.append(f"seed {suite.seed} is below {SEED_FLOOR}, where dataset seeds live")
+    if suite.episodes < 1 or not suite.tasks or len(set(suite.tasks)) != len(suite.tasks):
+        problems.append("episodes must be >= 1 and tasks a non-empty list without repeats")
+    bad = [t for t in suite.tasks if not t.startswith("GenDex/") or "-v" not in t]
+    if bad:
+        problems.append(f"tasks must be versioned GenDex ids (GenDex/<Name>-v<N>): {bad}")
+    if problems:
+        raise SuiteError(f"{path}: " + "; ".join(problems))
+    return suite
+
+
+__all__ = ["METRICS", "SEED_FLOOR", "SUITES_DIR", "Suite", "SuiteError", "load_suite", "suite_path"]

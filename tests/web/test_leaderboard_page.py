@@ -1,0 +1,66 @@
+"""The leaderboard site in a real browser: Debian's Chromium, headless, driven by selenium through the system
+chromedriver (nothing is downloaded). scripts/setup.sh installs both; where they are missing this test skips and
+says so."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from board_data import SUITE, entry, synthetic_info, write
+
+from gendex.eval.leaderboard import build_site
+from gendex.eval.suite import load_suite
+
+CHROMIUM, DRIVER = shutil.which("chromium"), shutil.which("chromedriver")
+
+
+@pytest.fixture
+def browser():
+    if not (CHROMIUM and DRIVER):
+        pytest.skip("Debian's chromium and chromium-driver are not installed (scripts/setup.sh installs them as root)")
+    webdriver = pytest.importorskip("selenium.webdriver", reason="selenium is not installed (the dev extra has it)")
+    from selenium.webdriver.chrome.service import Service
+
+    opts = webdriver.ChromeOptions()
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--no-first-run",
+                "--disable-background-networking", "--disable-component-update", "--disable-sync"):
+        opts.add_argument(arg)
+    opts.binary_location = CHROMIUM
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(DRIVER), options=opts)
+    yield driver
+    driver.quit()
+
+
+def test_the_board_loads_sorts_and_opens_a_per_task_breakdown(tmp_path, browser):
+    from selenium.webdriver.common.by import By
+
+    root = tmp_path / "board"
+    tasks = load_suite(SUITE).tasks
+    for name, k in (("weak", 2), ("strong", 9), ("middle", 5)):
+        write(root, name, entry(name.title(), synthetic_info({t: k for t in tasks})))
+    build_site(tmp_path / "site", root)
+    browser.get((tmp_path / "site" / "index.html").as_uri())
+    browser.find_element(By.LINK_TEXT, SUITE).click()
+    assert browser.title == f"GenDex leaderboard: {SUITE}"
+    errors = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    assert errors == [], errors
+
+    def methods():
+        return [r.find_element(By.TAG_NAME, "a").text for r in browser.find_elements(By.CSS_SELECTOR, "tr.entry")]
+
+    assert methods() == ["Strong", "Middle", "Weak"]  # best first as built
+    success = browser.find_element(By.CSS_SELECTOR, 'th[data-key="success"]')
+    success.click()
+    assert methods() == ["Weak", "Middle", "Strong"] and "sorted-asc" in success.get_attribute("class")
+    success.click()
+    assert methods() == ["Strong", "Middle", "Weak"]
+    browser.find_element(By.CSS_SELECTOR, 'th[data-key="method"]').click()
+    assert methods() == ["Middle", "Strong", "Weak"]
+    row = browser.find_elements(By.CSS_SELECTOR, "tr.entry")[1]  # Strong
+    detail = browser.find_element(By.ID, row.get_attribute("data-detail"))
+    assert not detail.is_displayed()
+    row.find_element(By.CSS_SELECTOR, "button.toggle").click()
+    assert detail.is_displayed() and "GenDex/OpenCabinet-v1" in detail.text and "9/10" in detail.text
+    assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
