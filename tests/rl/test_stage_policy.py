@@ -127,3 +127,36 @@ def test_a_whole_task_policy_is_judged_by_the_tasks_success(bottle, tmp_path):
     assert r.stage == WHOLE_TASK and r.policy.meta()["stage"] == WHOLE_TASK
     policy = StagePolicy.load(bottle, r.policy)
     assert policy.judge.stage is None and policy.judge.conditions == bottle.spec.success.conditions
+
+
+def test_warm_start_loads_a_policy_and_resets_its_noise(task_version):
+    """``gendex train --init-from``: the fresh PPO acts as the policy it starts from, with the preset's noise."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    from gendex.train.presets import PRESETS, TrainingError
+    from gendex.train.train import policy_to_start_from, warm_start
+
+    v0 = task_version("RotateTennisBall", 0)
+    files = policy_to_start_from(v0, "rotate_ball", "GenDex/RotateTennisBall-v0")
+    assert files.model == v0.policy("rotate_ball").model
+    with pytest.raises(TrainingError, match="another task"):
+        policy_to_start_from(v0, "rotate_ball", "GenDex/PickUpBottle-v0")
+    venv = VecNormalize(DummyVecEnv([lambda: make_stage_env(v0, "rotate_ball")]), clip_obs=10.0)
+    try:
+        model = PPO("MlpPolicy", venv, device="cpu", **PRESETS["cpu"].ppo_kwargs())
+        record = warm_start(model, venv, files, "hand", -1.2)
+        assert record["steps"] == files.meta()["steps"] and record["model"].endswith("v0/policies/rotate_ball.zip")
+        assert torch.allclose(model.policy.log_std, torch.full_like(model.policy.log_std, -1.2))
+        source = StagePolicy.load(v0, files)
+        obs = venv.reset()
+        raw = venv.get_original_obs()
+        for _ in range(3):  # same actions as the source policy on the states the stage env visits
+            action, _ = model.predict(obs, deterministic=True)
+            np.testing.assert_allclose(np.clip(action, -1, 1), source.predict(raw), atol=1e-4)
+            obs, *_ = venv.step(action)
+            raw = venv.get_original_obs()
+        with pytest.raises(TrainingError, match="cannot start from it"):
+            warm_start(model, venv, files, "arm", -1.2)
+    finally:
+        venv.close()

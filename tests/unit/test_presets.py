@@ -2,7 +2,7 @@
 
 import pytest
 
-from gendex.train.presets import PRESETS, TrainingError, get_preset
+from gendex.train.presets import PRESETS, TrainingError, get_preset, parse_overrides
 
 
 def test_paper_preset_matches_the_seed_table():
@@ -25,3 +25,16 @@ def test_errors_name_the_options():
         get_preset("gpu")
     with pytest.raises(TrainingError, match="unknown PPO settings \\['lr'\\]"):
         get_preset("cpu").with_overrides(lr=1e-3)
+
+
+def test_overrides_from_the_command_line_are_typed_like_the_preset():
+    got = parse_overrides(["log_std_init=-1.2", "n_steps=256", "net_arch=128,64", "gpu_backend=false"])
+    assert got == {"log_std_init": -1.2, "n_steps": 256, "net_arch": (128, 64), "gpu_backend": False}
+    p = get_preset("cpu").with_overrides(**got)
+    assert p.log_std_init == -1.2 and p.ppo_kwargs()["policy_kwargs"]["net_arch"] == [128, 64]
+    with pytest.raises(TrainingError, match="KEY=VALUE"):
+        parse_overrides(["log_std_init"])
+    with pytest.raises(TrainingError, match="unknown PPO setting 'lr'"):
+        parse_overrides(["lr=1e-3"])
+    with pytest.raises(TrainingError, match="n_steps: '2.5' is not a int"):
+        parse_overrides(["n_steps=2.5"])
