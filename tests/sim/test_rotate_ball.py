@@ -94,3 +94,40 @@ def test_random_policy_rarely_succeeds(make_env):
                 break
         successes += bool(info["success"])
     assert successes <= 2
+
+
+def test_trained_policy_turns_the_ball_under_the_executor(make_env):
+    """v1's policy (v0's refined under less exploration noise) as ``gendex collect`` runs it: it acts until the quarter
+    turn has held the task's 5 steps, as in the stage env it was trained in, so the task succeeds on its last step."""
+    from gendex.solve.attempt import run_attempt
+    from gendex.solve.executor import StageExecutor
+
+    env = make_env("GenDex/RotateTennisBall-v1", control_mode="pd_joint_pos", control_joint="both")
+    executor = StageExecutor()
+    successes = 0
+    for seed in range(5):
+        outcome = run_attempt(env, executor, seed)
+        successes += outcome.succeeded
+        if outcome.succeeded:
+            assert [(log.stage, log.primitive) for log in executor.logs] == [("rotate_ball", "policy")]
+            assert executor.logs[0].steps == outcome.steps
+    assert successes >= 4
+
+
+def test_benchmark_reports_the_failure_kinds(repo_root):
+    import re
+    import subprocess
+    import sys
+
+    script = repo_root / "benchmarks" / "rotate_ball.py"
+    out = subprocess.run([sys.executable, str(script), "--task", "GenDex/RotateTennisBall-v0", "--episodes", "2",
+                          "--seed", "5", "--policies", "ppo", "executor"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    rows = re.findall(r"^(ppo|executor)\s+success\s+(\d+)/2\s+drop\s+(\d+)\s+short\s+(\d+)\s+lost\s+(\d+)", out.stdout,
+                      re.MULTILINE)
+    assert [r[0] for r in rows] == ["ppo", "executor"], out.stdout
+    for _, *counts in rows:
+        assert sum(map(int, counts)) == 2
+    assert rows[0][1:] == rows[1][1:]  # the executor runs the policy as its stage env does
+    failed = sum(int(n) for n in rows[0][2:])
+    assert len(re.findall(r"^    seed \d+: (?:drop|short|lost) ", out.stdout, re.MULTILINE)) == 2 * failed
