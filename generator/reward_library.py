@@ -58,10 +58,16 @@ def _header(title: str) -> str:
     return _HEADER_TEMPLATE.format(title=textwrap.fill(title, width=100))
 
 
+def _parts(spec: dict) -> list[dict]:
+    """The task's success conditions, one per part, without the ``grasped`` that the scene step adds beside a
+    ``lifted`` (:func:`generator.steps.scene.hold_lifted`): the lift's reward terms already reward the contact."""
+    return [c for c in spec["success"]["conditions"] if c["type"] != "grasped"]
+
+
 def _success_condition(spec: dict, obj: str | None = None) -> dict:
     """The task's success condition on ``obj`` (the object a stage acts on, or carries to), else the first: a
     composed task has one condition per part."""
-    conds = spec["success"]["conditions"]
+    conds = _parts(spec)
     return next((c for c in conds if obj is not None and obj in (c.get("object"), c.get("target"))), conds[0])
 
 
@@ -217,7 +223,7 @@ def _carry_term(target: str | None) -> str:
 def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
     """Reward module of the whole task: staged terms towards the task's success condition (for a composed task,
     the articulated part's condition first, then the rigid part's)."""
-    conds = spec["success"]["conditions"]
+    conds = _parts(spec)
     if len(conds) > 1:
         joint = next(c for c in conds if c["type"] == "joint_open")
         rest = next(c for c in conds if c is not joint)

@@ -14,7 +14,15 @@ import logging
 
 from gendex.solve.grasp import HAND_SPAN_M, hand_fit_scale
 from gendex_envs.errors import TaskSpecError
-from gendex_envs.spec import SCALE_RANGE, RobotSpec, TableSpec, TaskSpec, dump_task_spec, parse_task_spec
+from gendex_envs.spec import (
+    SCALE_RANGE,
+    ConditionSpec,
+    RobotSpec,
+    TableSpec,
+    TaskSpec,
+    dump_task_spec,
+    parse_task_spec,
+)
 from generator.backends.base import Backend
 from generator.catalog_view import asset_dict, asset_dicts, guidance
 from generator.critic.physical import REACH_MAX_M
@@ -32,6 +40,8 @@ MAX_ARTICULATED_HEIGHT_M = 0.6
 """Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach."""
 CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
+LIFT_HOLD_FINGERS = 1
+"""Fingers besides the thumb that must touch an object a task's success needs lifted (:func:`hold_lifted`)."""
 
 
 def _clamp_scale(s: float) -> float:
@@ -61,6 +71,20 @@ def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
     return dataclasses.replace(spec, objects=objects)
 
 
+def hold_lifted(spec: TaskSpec) -> TaskSpec:
+    """Give every object the task's success needs ``lifted`` a ``grasped`` condition too (thumb and
+    :data:`LIFT_HOLD_FINGERS` finger), unless the success already has one: height alone is met by an object knocked
+    into the air, and random actions did that on 19 of 50 PickUpBottle-v1 episodes."""
+    conds = spec.success.conditions
+    held = {c.object for c in conds if c.type == "grasped" and not c.negate}
+    add = [c.object for c in conds if c.type == "lifted" and not c.negate and c.object not in held]
+    if not add:
+        return spec
+    log.info("success of %s: %s must also be held (a grasped condition added)", spec.name, ", ".join(add))
+    extra = tuple(ConditionSpec(type="grasped", object=o, min_fingers=LIFT_HOLD_FINGERS) for o in dict.fromkeys(add))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=extra + conds))
+
+
 def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     """Parse a scene answer into a TaskSpec using exactly the proposal's objects; :class:`SceneError` otherwise."""
     raw = parse_yaml_block(text, "scene file", SceneError)
@@ -80,7 +104,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
     if spec.name != proposal.name:
         spec = dataclasses.replace(spec, name=proposal.name)
-    return spec
+    return hold_lifted(spec)
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

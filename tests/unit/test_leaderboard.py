@@ -34,7 +34,7 @@ def test_a_bad_suite_is_refused(tmp_path):
 
 
 def test_eval_info_has_lerobots_fields_and_wilson_intervals_per_task():
-    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v1": 10, "GenDex/OpenCabinet-v1": 0})
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v2": 10, "GenDex/OpenCabinet-v1": 0})
     ep = info["per_episode"][0]
     assert {"episode_ix", "sum_reward", "max_reward", "success", "seed"} <= set(ep)
     assert {"avg_sum_reward", "avg_max_reward", "pc_success", "eval_s", "eval_ep_s"} <= set(info["aggregated"])
@@ -47,7 +47,7 @@ def test_eval_info_has_lerobots_fields_and_wilson_intervals_per_task():
 
 
 def test_result_files_are_validated(tmp_path):
-    info = synthetic_info({"GenDex/PutAppleBowl-v1": 3, "GenDex/PickUpBottle-v1": 5, "GenDex/OpenCabinet-v1": 1})
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 3, "GenDex/PickUpBottle-v2": 5, "GenDex/OpenCabinet-v1": 1})
     write(tmp_path, "ok", entry("Random", info))
     assert [e.method for e in load_entries(SUITE, tmp_path)] == ["Random"]
     write(tmp_path, "bad", entry("X", info, policy_kind="magic"))
@@ -68,7 +68,7 @@ def test_result_files_are_validated(tmp_path):
 
 
 def test_a_result_on_another_version_of_the_suite_is_marked_stale(tmp_path):
-    info = synthetic_info({"GenDex/PutAppleBowl-v1": 3, "GenDex/PickUpBottle-v1": 5, "GenDex/OpenCabinet-v1": 1})
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 3, "GenDex/PickUpBottle-v2": 5, "GenDex/OpenCabinet-v1": 1})
     info["suite"]["hash"] = "0" * 64
     write(tmp_path, "old", entry("Old", info))
     [e] = load_entries(SUITE, tmp_path)
