@@ -14,18 +14,18 @@ def policy_factory(spec: str):
     """What ``--policy SPEC`` builds: ``bc:PATH`` (a behaviour-cloning checkpoint) or a built-in / module policy
     (:func:`gendex.eval.policies.resolve_policy`). Top-level, so worker processes can resolve the spec themselves."""
     if spec.startswith("bc:"):
-        from gendex.imitation.bc import BCPolicy
+        from gendex.imitation.bc import load_policy
 
-        path = spec.removeprefix("bc:")
-        return lambda: BCPolicy(path)
+        paths = spec.removeprefix("bc:")
+        return lambda: load_policy(paths)
     from gendex.eval.policies import resolve_policy
 
     return resolve_policy(spec)
 
 
 def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suites/ (e.g. gendex-ref-v1)."),
-                 policy: str = typer.Option(..., "--policy", help="random | hold | oracle | bc:PATH | "
-                                                                  "module:factory"),
+                 policy: str = typer.Option(..., "--policy", help="random | hold | oracle | bc:PATH[,PATH...] "
+                                                                  "(one per task) | module:factory"),
                  out: Path = typer.Option(..., "--out", help="Result folder (resumes a stopped run)."),
                  episodes: int = typer.Option(None, "--episodes", min=1, help="Episodes per task (default: the "
                                                                                "suite's; fewer marks it incomplete)."),

@@ -141,7 +141,16 @@ def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[
     try:
         policy = make_policy()
         if hasattr(policy, "bind"):
-            policy.bind(env)
+            try:
+                policy.bind(env)
+            except Exception as exc:  # the policy cannot act here: each episode fails with the reason
+                why = f"policy bind raised {type(exc).__name__}: {exc}"
+                log.info("%s: %s", task, why)
+                out = [EpisodeResult(task, int(seed), False, False, 0.0, 0.0, 0, 0.0, why) for seed in seeds]
+                for r in out:
+                    if progress is not None:
+                        progress(r)
+                return out
         out = []
         for k, seed in enumerate(seeds):
             frames = [] if k < videos and video_dir is not None else None

@@ -27,9 +27,14 @@ import torch
 from torch import nn
 
 from gendex.imitation.frames import DatasetReadError, Frames, lerobot_root, load_frames
+from gendex_envs.errors import GenDexError
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 
 log = logging.getLogger(__name__)
+
+
+class PolicyTaskError(GenDexError, ValueError):
+    """A BC checkpoint asked to act in a task it did not learn."""
 
 CHECKPOINT = "bc.pt"
 STEP_SCALE = 200.0
@@ -186,7 +191,12 @@ class BCPolicy:
         return list(self.ckpt["training_seeds"])
 
     def bind(self, env) -> None:
-        """Keep the env's action bounds: an action is clipped to them (joint limits of absolute targets)."""
+        """Check that ``env`` is the task the checkpoint learned, and keep its action bounds: an action is clipped to
+        them (joint limits of absolute targets)."""
+        env_id = getattr(getattr(env, "spec", None), "id", None)
+        if env_id is not None and env_id != self.task_id:
+            raise PolicyTaskError(f"BC checkpoint {self.path} learned {self.task_id}, not {env_id}: give one "
+                                  f"checkpoint per task (bc:PATH,PATH,...)")
         self.low, self.high = env.action_space.low, env.action_space.high
 
     def reset(self) -> None:
@@ -206,4 +216,44 @@ class BCPolicy:
         return np.clip(action, self.low, self.high) if hasattr(self, "low") else action
 
 
-__all__ = ["BCConfig", "BCPolicy", "CHECKPOINT", "train"]
+class BCPolicies:
+    """Several checkpoints, one per task, as one evaluation policy (``--policy bc:PATH,PATH,...``): :meth:`bind`
+    picks the checkpoint of the env's task, or fails naming the tasks it has."""
+
+    def __init__(self, paths: list[Path | str]):
+        self.by_task: dict[str, BCPolicy] = {}
+        for path in paths:
+            policy = BCPolicy(path)
+            if policy.task_id in self.by_task:
+                raise PolicyTaskError(f"two BC checkpoints for {policy.task_id}: {self.by_task[policy.task_id].path} "
+                                      f"and {path}")
+            self.by_task[policy.task_id] = policy
+        self.active: BCPolicy | None = None
+
+    @property
+    def training_seeds(self) -> list[int]:
+        return sorted({s for p in self.by_task.values() for s in p.training_seeds})
+
+    def bind(self, env) -> None:
+        env_id = getattr(getattr(env, "spec", None), "id", None)
+        if env_id not in self.by_task:
+            raise PolicyTaskError(f"no BC checkpoint for {env_id}; checkpoints: {sorted(self.by_task)}")
+        self.active = self.by_task[env_id]
+        self.active.bind(env)
+
+    def reset(self) -> None:
+        self.active.reset()
+
+    def act(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        return self.active.act(obs)
+
+
+def load_policy(spec: str) -> BCPolicy | BCPolicies:
+    """``PATH`` (one checkpoint) or ``PATH,PATH,...`` (one per task), as ``--policy bc:...`` gives them."""
+    paths = [s for s in spec.split(",") if s]
+    if not paths:
+        raise PolicyTaskError("bc: needs a checkpoint path (bc:PATH or bc:PATH,PATH,...)")
+    return BCPolicy(paths[0]) if len(paths) == 1 else BCPolicies(paths)
+
+
+__all__ = ["BCConfig", "BCPolicies", "BCPolicy", "CHECKPOINT", "PolicyTaskError", "load_policy", "train"]

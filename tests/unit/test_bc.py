@@ -1,5 +1,6 @@
 """The behaviour-cloning baseline on a synthetic LeRobot dataset (no simulator): it reads the dataset's features,
-learns a mapping from them, and runs as a policy with temporal ensembling."""
+learns a mapping from them, and runs as a policy with temporal ensembling (one check makes a real env: a policy
+bound to the wrong task)."""
 
 from __future__ import annotations
 
@@ -79,3 +80,41 @@ def test_a_dataset_without_environment_state_is_refused(tmp_path):
                                  "environment_state": None, "environment_state_names": ()}))
     with pytest.raises(DatasetReadError, match="no 'observation.environment_state' feature"):
         load_frames(root)
+
+
+def test_a_checkpoint_acts_only_in_the_task_it_learned_and_several_cover_a_suite(toy_dataset, tmp_path):
+    """``bc:PATH`` in another task's env fails naming both tasks; ``bc:A,B`` binds each env to its own task's
+    checkpoint and refuses a task it has none for (the evaluation then fails that task's episodes with the reason)."""
+    import shutil
+    from types import SimpleNamespace
+
+    from gendex.eval.runner import evaluate_task
+    from gendex.imitation.bc import BCPolicies, PolicyTaskError, load_policy
+
+    cfg = BCConfig(chunk=4, steps=20, hidden=16, layers=1)
+    toy = train(toy_dataset, tmp_path / "toy", config=cfg)
+    other_root = tmp_path / "other" / "lerobot"
+    shutil.copytree(toy_dataset, other_root)
+    meta = json.loads((other_root / "meta" / "gendex.json").read_text())
+    (other_root / "meta" / "gendex.json").write_text(json.dumps({**meta, "task_id": "GenDex/Other-v0"}))
+    other = train(other_root, tmp_path / "other_bc", config=cfg)
+
+    def env(task):
+        return SimpleNamespace(spec=SimpleNamespace(id=task),
+                               action_space=SimpleNamespace(low=-np.ones(A), high=np.ones(A)))
+
+    with pytest.raises(PolicyTaskError, match="learned GenDex/Toy-v0, not GenDex/Other-v0"):
+        BCPolicy(toy).bind(env("GenDex/Other-v0"))
+    both = load_policy(f"{toy},{other}")
+    assert isinstance(both, BCPolicies) and sorted(both.by_task) == ["GenDex/Other-v0", "GenDex/Toy-v0"]
+    both.bind(env("GenDex/Other-v0"))
+    assert both.active.task_id == "GenDex/Other-v0"
+    both.reset()
+    assert both.act({STATE: np.zeros(S, np.float32), ENVIRONMENT_STATE: np.zeros(K, np.float32)}).shape == (A,)
+    with pytest.raises(PolicyTaskError, match=r"no BC checkpoint for GenDex/Third-v0; checkpoints: \['GenDex/Other"):
+        both.bind(env("GenDex/Third-v0"))
+    with pytest.raises(PolicyTaskError, match="two BC checkpoints for GenDex/Toy-v0"):
+        load_policy(f"{toy},{toy}")
+    rows = evaluate_task("GenDex/PutAppleBowl-v1", lambda: load_policy(str(toy)), [7, 8])
+    assert [(r.seed, r.success_at_end, r.length) for r in rows] == [(7, False, 0), (8, False, 0)]
+    assert all("learned GenDex/Toy-v0, not GenDex/PutAppleBowl-v1" in r.failure for r in rows)
