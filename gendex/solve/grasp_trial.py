@@ -8,6 +8,12 @@ ramps, the squeeze, the executor's lift (``GraspMotion.lift_m``) and a hold of :
 steps (1 s). The candidate holds when the object rose at least :data:`HELD_FRACTION` of the lift, ends the hold
 still touched by the thumb and a finger, and is not moving. The solved env is never touched, so trials leave its
 history — and the episode being recorded — exactly as they were.
+
+The trial env's own history matters too: a PhysX scene keeps contact caches and solver warm starts across
+``set_state``, so a trial's outcome depended on every trial run in that scene before it, in earlier episodes as well
+(a collection of 204 PutAppleBowl-v1 attempts in one process failed seed 71, which succeeds in a fresh process).
+:meth:`GraspTrials.renew` rebuilds the trial scene; the executor calls it at every episode's start, so an episode's
+trials depend only on that episode.
 """
 
 from __future__ import annotations
@@ -111,6 +117,19 @@ class GraspTrials:
         self.speed = speed or GraspMotion()
         self.steps = 0
         """Simulated control steps of every trial so far (none of them are the episode's)."""
+        self._stale = False
+        self._steps_at_build = 0
+
+    def renew(self) -> None:
+        """Have the next trial run in a rebuilt scene (fresh PhysX caches), so that it does not depend on the trials
+        before. The rebuild (about 0.7 s) waits for that trial: an episode that tries no grasp pays nothing."""
+        self._stale = self.steps > self._steps_at_build  # stepped since it was built
+
+    def _fresh_scene(self) -> None:
+        if self._stale:
+            self.sim.reset(seed=0, options={"reconfigure": True})
+            self._stale = False
+            self._steps_at_build = self.steps
 
     def close(self) -> None:
         self.sim.close()
@@ -119,6 +138,7 @@ class GraspTrials:
               ) -> TrialResult:
         """Try ``plan`` on object ``name`` from the pre-grasp joint vector ``q_pre`` [J] (arm and opened hand);
         ``require``: conditions (the task's own ``grasped`` ones) that must hold at the end as well."""
+        self._fresh_scene()
         sim, m, speed = self.sim, self.motion, self.speed
         sim.set_state(self.main.get_state())
         q = torch.as_tensor(q_pre[None], dtype=torch.float32)

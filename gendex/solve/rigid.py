@@ -151,10 +151,13 @@ class RigidPrimitives:
         self._require: tuple[ConditionSpec, ...] = ()
 
     def reset(self) -> None:
+        """Start an episode: nothing held, and grasp trials in a rebuilt scene (:meth:`GraspTrials.renew`)."""
         self.held = None
         self.plan = None
         self.placed_on = None
         self.trial_log = []
+        if self._trials is not None:
+            self._trials.renew()
 
     def close(self) -> None:
         if self._trials is not None:

@@ -81,3 +81,31 @@ def test_the_stage_solver_collects_the_same_bytes_with_two_workers_and_after_a_k
     resumed = collect(cfg("killed"), SOLVERS["stages"])
     assert one.kept_seeds == two.kept_seeds == resumed.kept_seeds and one.env_steps == two.env_steps
     assert _data_digest(tmp_path / "one") == _data_digest(tmp_path / "two") == _data_digest(tmp_path / "killed")
+
+
+def test_a_grasp_trial_does_not_depend_on_the_trials_before_it():
+    """The same grasp trial from the same state twice in the trial scene gives different numbers (PhysX keeps
+    contact caches across set_state); after :meth:`GraspTrials.renew`, which the executor calls at each episode's
+    start, it gives the first trial's numbers bit for bit. Without it, a 204-attempt collection failed a seed that
+    succeeds in a fresh process."""
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+
+    env = gym.make(TASK, **SOLVER_ENV_KWARGS["stages"])
+    try:
+        obs, _ = env.reset(seed=3)
+        executor = SOLVERS["stages"]()
+        executor.reset(env, obs)
+        plan, q_pre = executor.rigid.choose_grasp("apple")
+        trials = executor.rigid.trials
+
+        def numbers():
+            r = trials.trial(plan, q_pre, "apple")
+            return r.rise_m, r.speed_m_s, r.steps, r.held
+
+        trials.renew()
+        first = numbers()
+        assert numbers() != first  # the scene remembers the trial before
+        executor.reset(env, obs)  # a new episode renews the trial scene
+        assert numbers() == first
+    finally:
+        env.close()
