@@ -145,6 +145,16 @@ def _aggregate(stats_list: list[dict[str, dict[str, np.ndarray]]]) -> dict[str, 
     return out
 
 
+def _fold(stats_list: list[dict[str, dict[str, np.ndarray]]]) -> dict[str, dict[str, np.ndarray]]:
+    """The dataset's stats as a writer accumulates them, one episode at a time (``_aggregate([so_far, episode])``):
+    a resumed writer rebuilds them this way, because one flat :func:`_aggregate` over every episode rounds
+    differently in the last bits."""
+    out = stats_list[0]
+    for s in stats_list[1:]:
+        out = _aggregate([out, s])
+    return out
+
+
 def _jsonable(stats: dict[str, dict[str, np.ndarray]]) -> dict:
     return {k: {s: np.asarray(v).tolist() for s, v in d.items()} for k, d in stats.items()}
 
@@ -320,10 +330,15 @@ class LeRobotV3Writer:
             last = self._rows[-1]
             self._chunk, self._file = last["data/chunk_index"], last["data/file_index"]
             # read back as this writer builds tables (parquet names a list's item "element", the in-memory one
-            # "item"): the file rewritten after a resume is then the same bytes as one written without a break
-            self._current = _canonical(pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
-                                                                                  file_index=self._file)))
-            self._stats = _aggregate([self._row_stats(r) for r in self._rows])
+            # "item"; one chunk per episode, since the parquet encoder's dictionary and page choices follow the
+            # chunks): the file rewritten after a resume is then the same bytes as one written without a break
+            table = _canonical(pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
+                                                                          file_index=self._file)))
+            here = [r for r in self._rows if (r["data/chunk_index"], r["data/file_index"]) == (self._chunk, self._file)]
+            first = here[0]["dataset_from_index"]
+            self._current = pa.concat_tables([table.slice(r["dataset_from_index"] - first, r["length"])
+                                              for r in here])
+            self._stats = _fold([self._row_stats(r) for r in self._rows])
         log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
                  len(self._tasks))
 

@@ -372,3 +372,30 @@ def test_a_resumed_writer_writes_the_same_bytes_as_an_uninterrupted_one(tmp_path
                            if p.is_file())
     for f in files:
         assert (tmp_path / "once" / f).read_bytes() == (tmp_path / "resumed" / f).read_bytes(), f
+
+
+def test_a_long_collection_resumed_midway_writes_the_same_bytes_as_an_uninterrupted_one(tmp_path):
+    """At the size of a real dataset two more things showed (a 200-episode PutAppleBowl build killed after 70
+    episodes and resumed): the stats rounded differently (one flat merge against one episode at a time), and the data
+    parquet's state column compressed differently (the encoder's dictionary falls back to plain when it outgrows its
+    page, and where it does followed how the table was chunked). 30 episodes of 800 frames with 60 state values pass
+    that size."""
+    names = [f"q{i}" for i in range(60)]
+    eps = [make_episode(800, seed, cams=(), s=60) for seed in range(30)]
+
+    def open_writer(root):
+        return writer(root, state_names=names, cameras={})
+
+    with open_writer(tmp_path / "once") as w:
+        for e in eps:
+            w.add_episode(e)
+    w = open_writer(tmp_path / "resumed")
+    for e in eps[:11]:
+        w.add_episode(e)
+    del w  # killed: never closed
+    with open_writer(tmp_path / "resumed") as w:
+        for e in eps[11:]:
+            w.add_episode(e)
+    files = sorted(p.relative_to(tmp_path / "once") for p in (tmp_path / "once").rglob("*") if p.is_file())
+    for f in files:
+        assert (tmp_path / "once" / f).read_bytes() == (tmp_path / "resumed" / f).read_bytes(), f
