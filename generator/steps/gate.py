@@ -6,6 +6,11 @@ task's name), in a **fresh child process**: the outcome does not depend on what 
 process, and the model-written task is exercised away from it. The task is committed only when at least
 :data:`GATE_MIN_RATE` of the attempts succeed. It stops early once that can no longer happen.
 
+A task that solves itself is no task: after the solver, the gate also runs the do-nothing policy (every joint
+target held, :class:`gendex.solve.baselines.HoldSolver`) for the whole episode on :data:`NULL_ATTEMPTS` of the seeds,
+and a draft it solves even once fails the gate (a laptop lid started at 1.2 rad falls shut by itself: 5 of 5
+evaluation episodes of CloseLaptop13in-v0 were won by holding still).
+
 The measurement is stored with the task (its ``solvability`` record): attempts, successes, env steps per success,
 the failures by cause, the seeds and the solver's version. ``gendex list`` shows it. A task that fails the gate is
 not committed; the pipeline records why and proposes again, telling the backend what failed (see
@@ -41,6 +46,8 @@ GATE_SEED_BASE = 50_000_000
 """Gate seeds start here: far above the seeds datasets (0..), benchmarks (1000-90000) and suites use."""
 GATE_TIMEOUT_S = 900
 """The child process is killed after this long (the task counts as failed)."""
+NULL_ATTEMPTS = 3
+"""Gate seeds on which the do-nothing policy must fail."""
 
 
 class GateError(GeneratorError):
@@ -62,6 +69,11 @@ class GateResult:
     min_rate: float = GATE_MIN_RATE
     planned_attempts: int = GATE_ATTEMPTS
     """Attempts the gate would have run; fewer ran when the rate could no longer reach ``min_rate``."""
+    null_attempts: int = 0
+    """Seeds the do-nothing policy was run on (0: not run: records from before this check, or a draft the solver
+    had already failed)."""
+    null_successes: int = 0
+    """Of those, how many it solved (any makes the task fail the gate)."""
 
     @property
     def rate(self) -> float:
@@ -69,7 +81,7 @@ class GateResult:
 
     @property
     def passed(self) -> bool:
-        return self.successes >= self.min_rate * self.planned_attempts - 1e-9
+        return self.successes >= self.min_rate * self.planned_attempts - 1e-9 and self.null_successes == 0
 
     @property
     def env_steps_per_success(self) -> float | None:
@@ -82,8 +94,10 @@ class GateResult:
     def summary(self) -> str:
         """One line: the rate, and the commonest failures."""
         fails = ", ".join(f"{k} x{v}" for k, v in sorted(self.failures.items(), key=lambda kv: -kv[1])[:3])
+        null = (f"; solved by doing nothing on {self.null_successes} of {self.null_attempts} seeds"
+                if self.null_successes else "")
         return (f"{self.successes}/{self.attempts} solved (needs {self.min_rate:.0%} of {self.planned_attempts})"
-                + (f"; failures: {fails}" if fails else ""))
+                + (f"; failures: {fails}" if fails else "") + null)
 
 
 def gate_seeds(name: str, k: int = GATE_ATTEMPTS) -> list[int]:
@@ -128,9 +142,21 @@ def measure(folder: Path, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_
                 failures[r.failure.key] = failures.get(r.failure.key, 0) + 1
             if stop_early and done - ok > (1 - min_rate) * attempts + 1e-9:
                 break  # the rate can no longer reach min_rate
+        null_seeds = seeds[:NULL_ATTEMPTS] if ok >= min_rate * attempts - 1e-9 else []
+        null_ok = sum(null_solves(env, seed, version.spec.max_episode_steps) for seed in null_seeds)
     finally:
         env.close()
-    return GateResult(done, ok, steps, seeds[:done], failures, "stages", solver_version(), min_rate, attempts)
+    return GateResult(done, ok, steps, seeds[:done], failures, "stages", solver_version(), min_rate, attempts,
+                      len(null_seeds), null_ok)
+
+
+def null_solves(env, seed: int, steps: int) -> bool:
+    """Whether holding every joint target for ``steps`` steps (the whole episode) solves ``env``'s task from
+    ``seed``."""
+    from gendex.solve.attempt import run_attempt
+    from gendex.solve.baselines import HoldSolver
+
+    return run_attempt(env, HoldSolver(steps=steps), seed).succeeded
 
 
 def run_gate(draft: Path, name: str, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_MIN_RATE,

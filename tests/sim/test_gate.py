@@ -22,14 +22,15 @@ def test_gate_seeds_are_stable_per_task_and_far_from_every_other_seed():
 
 
 def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path, repo_root):
-    """LiftApple asking for a 60 cm lift, which its lift stage never makes. The gate stops as soon as 80 % can no
+    """LiftApple asking for a 1.5 m lift, beyond the arm's reach (the executor now lifts as high as the task asks:
+    60 cm, the height this test used first, it reaches). The gate stops as soon as 80 % can no
     longer be reached (3 failures of 10) and names the cause."""
     folder = tmp_path / "FarApple" / "v0"
     shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
     spec_path = TaskLayout(folder).spec
     spec = yaml.safe_load(spec_path.read_text())
     spec["name"] = "FarApple"
-    spec["success"]["conditions"][0]["min_height_m"] = 0.6
+    spec["success"]["conditions"][0]["min_height_m"] = 1.5
     spec["max_episode_steps"] = 150
     spec_path.write_text(yaml.safe_dump(spec, sort_keys=False))
     r = measure(folder, attempts=10, min_rate=0.8)
@@ -106,3 +107,13 @@ def test_gate_command_measures_a_committed_version_and_stores_the_record_without
     record = json.loads(version.files.record("solvability").read_text())
     assert record["successes"] == 2 and record["seeds"] == gate_seeds("LiftApple", 2)
     assert version.file_digest() == digest  # a measurement of the version, not part of it
+
+
+def test_a_task_that_solves_itself_fails_the_gate(repo_root):
+    """CloseLaptop13in-v0 starts its lid at 1.2 rad, where it falls shut by itself: holding still solves it, so the
+    gate fails it whatever the solver does. LiftApple-v1 is not solved by holding still and passes."""
+    laptop = measure(repo_root / "generated_tasks" / "CloseLaptop13in" / "v0", attempts=1, min_rate=0.8)
+    assert laptop.successes == 1 and (laptop.null_attempts, laptop.null_successes) == (1, 1)
+    assert not laptop.passed and "solved by doing nothing on 1 of 1 seeds" in laptop.summary()
+    apple = measure(repo_root / "generated_tasks" / "LiftApple" / "v1", attempts=1, min_rate=0.8)
+    assert apple.passed and (apple.null_attempts, apple.null_successes) == (1, 0)
