@@ -36,6 +36,13 @@ log = logging.getLogger(__name__)
 class PolicyTaskError(GenDexError, ValueError):
     """A BC checkpoint asked to act in a task it did not learn."""
 
+
+def _task_name(env_id: str) -> str:
+    """``GenDex/PickUpBottle-v2`` -> ``GenDex/PickUpBottle``: a checkpoint may act in another version of its task
+    (the same objects and spaces; a version changes randomization or success)."""
+    head, _, tail = env_id.rpartition("-v")
+    return head if head and tail.isdigit() else env_id
+
 CHECKPOINT = "bc.pt"
 STEP_SCALE = 200.0
 """The step-count input is ``step / STEP_SCALE``."""
@@ -194,9 +201,12 @@ class BCPolicy:
         """Check that ``env`` is the task the checkpoint learned, and keep its action bounds: an action is clipped to
         them (joint limits of absolute targets)."""
         env_id = getattr(getattr(env, "spec", None), "id", None)
-        if env_id is not None and env_id != self.task_id:
+        if env_id is not None and _task_name(env_id) != _task_name(self.task_id):
             raise PolicyTaskError(f"BC checkpoint {self.path} learned {self.task_id}, not {env_id}: give one "
                                   f"checkpoint per task (bc:PATH,PATH,...)")
+        if env_id is not None and env_id != self.task_id:
+            log.info("BC checkpoint %s learned %s; acting in %s, another version of the task", self.path,
+                     self.task_id, env_id)
         self.low, self.high = env.action_space.low, env.action_space.high
 
     def reset(self) -> None:
@@ -236,9 +246,10 @@ class BCPolicies:
 
     def bind(self, env) -> None:
         env_id = getattr(getattr(env, "spec", None), "id", None)
-        if env_id not in self.by_task:
+        same = [k for k in self.by_task if _task_name(k) == _task_name(str(env_id))]
+        if env_id not in self.by_task and len(same) != 1:
             raise PolicyTaskError(f"no BC checkpoint for {env_id}; checkpoints: {sorted(self.by_task)}")
-        self.active = self.by_task[env_id]
+        self.active = self.by_task[env_id if env_id in self.by_task else same[0]]
         self.active.bind(env)
 
     def reset(self) -> None:

@@ -83,8 +83,9 @@ def test_a_dataset_without_environment_state_is_refused(tmp_path):
 
 
 def test_a_checkpoint_acts_only_in_the_task_it_learned_and_several_cover_a_suite(toy_dataset, tmp_path):
-    """``bc:PATH`` in another task's env fails naming both tasks; ``bc:A,B`` binds each env to its own task's
-    checkpoint and refuses a task it has none for (the evaluation then fails that task's episodes with the reason)."""
+    """``bc:PATH`` in another task's env fails naming both tasks (another version of its own task is allowed);
+    ``bc:A,B`` binds each env to its own task's checkpoint and refuses a task it has none for (the evaluation then
+    fails that task's episodes with the reason)."""
     import shutil
     from types import SimpleNamespace
 
@@ -105,10 +106,14 @@ def test_a_checkpoint_acts_only_in_the_task_it_learned_and_several_cover_a_suite
 
     with pytest.raises(PolicyTaskError, match="learned GenDex/Toy-v0, not GenDex/Other-v0"):
         BCPolicy(toy).bind(env("GenDex/Other-v0"))
+    BCPolicy(toy).bind(env("GenDex/Toy-v3"))  # another version of its task: allowed
     both = load_policy(f"{toy},{other}")
     assert isinstance(both, BCPolicies) and sorted(both.by_task) == ["GenDex/Other-v0", "GenDex/Toy-v0"]
     both.bind(env("GenDex/Other-v0"))
     assert both.active.task_id == "GenDex/Other-v0"
+    both.bind(env("GenDex/Toy-v1"))
+    assert both.active.task_id == "GenDex/Toy-v0"
+    both.bind(env("GenDex/Other-v0"))
     both.reset()
     assert both.act({STATE: np.zeros(S, np.float32), ENVIRONMENT_STATE: np.zeros(K, np.float32)}).shape == (A,)
     with pytest.raises(PolicyTaskError, match=r"no BC checkpoint for GenDex/Third-v0; checkpoints: \['GenDex/Other"):
