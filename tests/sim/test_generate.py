@@ -129,6 +129,11 @@ _LEMON = ('```json\n{"name": "LiftTheLemon", "description": "Lift the lemon.", '
           '"success_text": "The lemon is lifted."}\n```')
 
 
+UNLIFTED = "peach"
+"""An object no library task lifts: a lemon is now a near-duplicate of LiftLemon, and the proposal would be refused
+before the step a test aims at."""
+
+
 def _assert_nothing_committed(root: Path) -> None:
     assert _task_folders(root) == []
     assert not (root / DRAFTS).exists() or not list((root / DRAFTS).iterdir())
@@ -143,7 +148,7 @@ def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(t
 
 
 def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
-    b = Scripted(propose=_LEMON % "lemon", scene="```yaml\nname: LiftTheLemon\nobjects: [\n  - {name: lemon\n```")
+    b = Scripted(propose=_LEMON % UNLIFTED, scene="```yaml\nname: LiftTheLemon\nobjects: [\n  - {name: lemon\n```")
     with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
@@ -152,7 +157,7 @@ def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
 def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path):
     bad = ("```python\nimport os\n\ndef evaluate(env):\n    os.remove('x')\n\n"
            "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
-    b = Scripted(propose=_LEMON % "lemon", reward=bad)
+    b = Scripted(propose=_LEMON % UNLIFTED, reward=bad)
     with pytest.raises(RetriesExhaustedError, match="os"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
@@ -172,7 +177,7 @@ def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path
             return nan
         return offline.complete(request).text
 
-    b = Scripted(propose=_LEMON % "lemon", reward=reward)
+    b = Scripted(propose=_LEMON % UNLIFTED, reward=reward)
     [s] = generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     attempts = s.committed.provenance()["reward_attempts"]["attempts"]
     assert not attempts[0]["ok"] and "nan" in attempts[0]["feedback"].lower()
@@ -290,7 +295,7 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
         bodies.append(body)
         prompt = body["messages"][0]["content"][-1]["text"]
         if "Propose ONE" in prompt:
-            text = _LEMON % "lemon"
+            text = _LEMON % UNLIFTED
         elif "Write the scene file" in prompt:
             text = _SCENE
         elif "renders of a robot task scene" in prompt:
