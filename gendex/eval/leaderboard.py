@@ -218,6 +218,16 @@ def build_site(out: Path, root: Path = LEADERBOARD_DIR) -> list[Path]:
     return [index, *written]
 
 
+def _episodes(e: Entry, suite: Suite) -> str:
+    """Episodes of a result; with the count per task when it ran fewer than the suite's or only some tasks."""
+    n = e.aggregated["episodes"]
+    per = sorted({t["episodes"] for t in e.per_task.values()})
+    if per == [suite.episodes] and len(e.per_task) == len(suite.tasks):
+        return str(n)
+    each = f"{per[0]}" if len(per) == 1 else f"{per[0]}-{per[-1]}"
+    return f"{n} ({each} per task, {len(e.per_task)} of {len(suite.tasks)} tasks)"
+
+
 def markdown(root: Path = LEADERBOARD_DIR) -> str:
     """``docs/leaderboard.md``: a table per suite, best first, with intervals and a per-task table."""
     lines = ["# Leaderboard", "",
@@ -236,8 +246,11 @@ def markdown(root: Path = LEADERBOARD_DIR) -> str:
             a = e.aggregated
             once = sum(t["pc_success_once"] * t["episodes"] for t in e.per_task.values()) / max(1, a["episodes"])
             lines.append(f"| {e.method}{' (stale)' if e.stale else ''} | {e.policy_kind} | {a['pc_success']:.1f} "
-                         f"[{a['wilson95'][0]:.1f}, {a['wilson95'][1]:.1f}] | {once:.1f} | {a['episodes']} | "
+                         f"[{a['wilson95'][0]:.1f}, {a['wilson95'][1]:.1f}] | {once:.1f} | {_episodes(e, suite)} | "
                          f"{e.training_data} | `{e.policy}` |")
+        notes = [f"- **{e.method}**: {e.notes}" for e in entries if e.notes]
+        if notes:
+            lines += ["", *notes]
         tasks = list(suite.tasks)
         lines += ["", "Per task (success %, 95 % CI):", "", "| task | " + " | ".join(e.method for e in entries) + " |",
                   "|---|" + "---|" * len(entries)]

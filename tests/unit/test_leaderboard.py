@@ -86,3 +86,22 @@ def test_site_and_markdown_hold_every_result_best_first(tmp_path):
     assert (tmp_path / "site" / "results" / SUITE / "strong.json").is_file()
     md = markdown(root)
     assert "| Strong | baseline | 90.0 [" in md and "`GenDex/OpenCabinet-v1`" in md
+
+
+def test_the_committed_board_is_valid_current_and_written_into_the_docs():
+    """Every result under leaderboard/ validates against its suite's current file (none stale), carries a per-episode
+    seed for each of the suite's seeds it ran, and docs/leaderboard.md is what ``gendex leaderboard build`` writes."""
+    from gendex.eval.leaderboard import LEADERBOARD_DIR, REPO_ROOT, suites_with_results
+
+    suites = suites_with_results()
+    assert "gendex-ref-v1" in suites
+    for name in suites:
+        suite = load_suite(name)
+        entries = load_entries(name)
+        assert entries and not [e.file for e in entries if e.stale]
+        for e in entries:
+            rows = e.eval_info["per_episode"]
+            for task in e.per_task:
+                seeds = [r["seed"] for r in rows if r["task"] == task]
+                assert seeds == list(range(suite.seed, suite.seed + len(seeds))), (e.file, task)
+    assert (REPO_ROOT / "docs" / "leaderboard.md").read_text() == markdown(LEADERBOARD_DIR)
