@@ -245,7 +245,7 @@ _SCENE = """```yaml
 name: LiftTheLemon
 instruction: Lift the lemon.
 objects:
-  - {name: lemon, asset: lemon, pos_m: [0.1, 0.0, 0.0]}
+  - {name: lemon, asset: peach, pos_m: [0.1, 0.0, 0.0]}
 stages:
   - {name: approach_lemon, instruction: Reach., skill: reach, method: motion_planning, control_joint: arm,
      target: lemon}
