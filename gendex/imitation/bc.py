@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from gymnasium.envs.registration import parse_env_id
 from torch import nn
 
 from gendex.imitation.frames import DatasetReadError, Frames, lerobot_root, load_frames
@@ -40,8 +41,8 @@ class PolicyTaskError(GenDexError, ValueError):
 def _task_name(env_id: str) -> str:
     """``GenDex/PickUpBottle-v2`` -> ``GenDex/PickUpBottle``: a checkpoint may act in another version of its task
     (the same objects and spaces; a version changes randomization or success)."""
-    head, _, tail = env_id.rpartition("-v")
-    return head if head and tail.isdigit() else env_id
+    ns, name, _ = parse_env_id(env_id)
+    return f"{ns}/{name}" if ns else name
 
 CHECKPOINT = "bc.pt"
 STEP_SCALE = 200.0

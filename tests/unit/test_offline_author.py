@@ -230,7 +230,8 @@ def test_a_lift_success_is_written_with_a_grasp_so_a_knocked_object_does_not_cou
     the scene step adds a ``grasped`` condition for each lifted object, once, and leaves other successes alone."""
     from generator.steps.scene import LIFT_HOLD_FINGERS, hold_lifted
 
-    p = next(p for p in _proposals(3, 40) if p.success.get("type") == "lifted")
+    proposals = _proposals(3, 40)
+    p = next(p for p in proposals if p.success.get("type") == "lifted")
     b = OfflineBackend(seed=3)
     ids = {o.asset for o in p.objects}
     context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
@@ -240,7 +241,7 @@ def test_a_lift_success_is_written_with_a_grasp_so_a_knocked_object_does_not_cou
     lifted = p.success["object"]
     assert ("grasped", lifted, LIFT_HOLD_FINGERS) in conds and ("lifted", lifted, None) in conds
     assert hold_lifted(spec) == spec  # already held: nothing added twice
-    put = next(p for p in _proposals(3, 40) if p.success.get("type") == "inside")
+    put = next(p for p in proposals if p.success.get("type") == "inside")
     context["proposal"] = dataclasses.asdict(put)
     context["assets"] = [a for a in asset_dicts() if a["id"] in {o.asset for o in put.objects}]
     other = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, put)
