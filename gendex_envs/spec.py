@@ -25,7 +25,21 @@ import numpy as np
 import yaml
 
 from gendex_envs.errors import StageError, TaskSpecError, suggest
-from gendex_envs.typed_yaml import UniqueKeyLoader, build, join_path, spec_error, suggest_value
+from gendex_envs.typed_yaml import (
+    MAX_CONDITIONS,
+    MAX_INPUT_BYTES,
+    MAX_JOINT_STATES,
+    MAX_OBJECTS,
+    MAX_STAGES,
+    MAX_STEPS,
+    MAX_STRING_CHARS,
+    build,
+    join_path,
+    load_yaml_bounded,
+    quote,
+    spec_error,
+    suggest_value,
+)
 
 log = logging.getLogger(__name__)
 
@@ -67,6 +81,12 @@ GOAL_TARGET = "goal"
 """Reserved name: a ``near`` condition with ``target: goal`` refers to the task's goal site."""
 TASK_NAME_RE = re.compile(r"^[A-Z][A-Za-z0-9]*$")
 SNAKE_NAME_RE = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+def _bounded(limit: int, items: str, why: str, **kwargs: Any) -> Any:
+    """A dataclass field whose list or mapping may hold at most ``limit`` entries, checked (by
+    :func:`~gendex_envs.typed_yaml.build`) before any entry is built."""
+    return field(metadata={"max_items": limit, "items": items, "why": why}, **kwargs)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -121,7 +141,8 @@ class ObjectSpec:
     """Orientation quaternion (w, x, y, z); its norm must be within QUAT_NORM_TOL of 1 (not normalised)."""
     fixed: bool = False
     """True for objects that never move (e.g. a cabinet body)."""
-    joint_state: dict[str, float] = field(default_factory=dict)
+    joint_state: dict[str, float] = _bounded(MAX_JOINT_STATES, "joint states", "MAX_JOINT_STATES",
+                                             default_factory=dict)
     """Initial joint positions by joint name, for articulated assets only."""
     randomize: RandomizeSpec = field(default_factory=RandomizeSpec)
     """Pose noise applied at reset (layouts are drawn free of overlaps between objects)."""
@@ -236,7 +257,8 @@ class StageSpec:
     """Number of control steps of the stage, >= 1."""
     target: str | None = None
     """Optional name of the object the stage acts on."""
-    success: tuple[ConditionSpec, ...] | None = None
+    success: tuple[ConditionSpec, ...] | None = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS",
+                                                         default=None)
     """When the stage has done its job (all must hold); None: when the task's success holds."""
 
 
@@ -246,7 +268,7 @@ class SuccessSpec:
 
     description: str
     """Non-empty natural-language description of success."""
-    conditions: tuple[ConditionSpec, ...]
+    conditions: tuple[ConditionSpec, ...] = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
     """At least one condition; all must hold."""
     hold_steps: int = 0
     """Number of consecutive steps the conditions must hold, >= 0."""
@@ -264,12 +286,13 @@ class TaskSpec:
     """The table."""
     robot: RobotSpec = field(default_factory=RobotSpec)
     """The robot."""
-    objects: tuple[ObjectSpec, ...]
-    """Objects in the scene, at least one; names unique."""
+    objects: tuple[ObjectSpec, ...] = _bounded(MAX_OBJECTS, "objects",
+                                               "MAX_OBJECTS: SAPIEN crashes past its material limit")
+    """Objects in the scene, at least one and at most MAX_OBJECTS; names unique."""
     goal: GoalSpec | None = None
     """Optional goal site."""
-    stages: tuple[StageSpec, ...]
-    """Stages in execution order, at least one."""
+    stages: tuple[StageSpec, ...] = _bounded(MAX_STAGES, "stages", "MAX_STAGES")
+    """Stages in execution order, at least one and at most MAX_STAGES."""
     success: SuccessSpec
     """Success criterion."""
     max_episode_steps: int = 200
@@ -281,7 +304,7 @@ class TaskSpec:
             if obj.name == name:
                 return obj
         names = [o.name for o in self.objects]
-        raise TaskSpecError(f"task {self.name!r} has no object {name!r}; objects: {', '.join(names)}."
+        raise TaskSpecError(f"task {self.name!r} has no object {quote(name)}; objects: {', '.join(names)}."
                             f"{suggest_value(name, names)}")
 
     def stage_conditions(self, stage: StageSpec) -> tuple[ConditionSpec, ...]:
@@ -304,15 +327,26 @@ def resolve_stage(spec: TaskSpec, stage: str | int) -> tuple[int, StageSpec]:
 
 
 # ---------------------------------------------------------------------------------- semantic checks
-def _floats(value: Any, path: str) -> Iterator[tuple[str, float]]:
-    if isinstance(value, float):
-        yield path, value
-    elif isinstance(value, Mapping):
+def _leaves(value: Any, path: str) -> Iterator[tuple[str, Any]]:
+    if isinstance(value, Mapping):
         for k, v in value.items():
-            yield from _floats(v, join_path(path, str(k)))
+            yield from _leaves(v, join_path(path, str(k)))
     elif isinstance(value, (list, tuple)):
         for i, v in enumerate(value):
-            yield from _floats(v, f"{path}[{i}]")
+            yield from _leaves(v, f"{path}[{i}]")
+    else:
+        yield path, value
+
+
+def _leaf_problems(spec: TaskSpec) -> list[str]:
+    """Non-finite numbers and over-long strings anywhere in ``spec`` (a parsed mapping may not come from YAML)."""
+    p: list[str] = []
+    for path, v in _leaves(spec_to_dict(spec), ""):
+        if isinstance(v, float) and not math.isfinite(v):
+            p.append(f"{path} = {v!r} is not allowed; must be a finite number")
+        elif isinstance(v, str) and len(v) > MAX_STRING_CHARS:
+            p.append(f"{path} = {quote(v)} is not allowed; at most {MAX_STRING_CHARS} characters (MAX_STRING_CHARS)")
+    return p
 
 
 _POSITIVE = {"min_height_m", "max_dist_m", "min_force_n", "max_palm_force_n", "max_force_n", "max_xy_m",
@@ -327,14 +361,14 @@ def _condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
     for f in dataclasses.fields(ConditionSpec):
         if f.name in ("type", "negate") or f.name in fields or getattr(c, f.name) is None:
             continue
-        p.append(f"{at}.{f.name} = {getattr(c, f.name)!r} does not apply to type {c.type!r} ({meaning}); its "
+        p.append(f"{at}.{f.name} = {quote(getattr(c, f.name))} does not apply to type {c.type!r} ({meaning}); its "
                  f"fields: {', '.join(fields)}")
     for name in required:
         if getattr(c, name) is None:
             p.append(f"{at}.{name} is required for type {c.type!r} ({meaning})")
 
     def bad(name: str, allowed: str) -> None:
-        p.append(f"{at}.{name} = {getattr(c, name)!r} is not allowed; must be {allowed}")
+        p.append(f"{at}.{name} = {quote(getattr(c, name))} is not allowed; must be {allowed}")
 
     for name in _POSITIVE & set(fields):
         if getattr(c, name) is not None and not getattr(c, name) > 0:
@@ -364,13 +398,13 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
 
     def need(ok: bool, path: str, value: Any, allowed: str) -> None:
         if not ok:
-            p.append(f"{path} = {value!r} is not allowed; {allowed}")
+            p.append(f"{path} = {quote(value)} is not allowed; {allowed}")
 
-    p += [f"{path} = {v!r} is not allowed; must be a finite number" for path, v in _floats(spec_to_dict(spec), "")
-          if not math.isfinite(v)]
+    p += _leaf_problems(spec)
     need(bool(TASK_NAME_RE.match(spec.name)), "name", spec.name, "must be CamelCase (^[A-Z][A-Za-z0-9]*$)")
     need(bool(spec.instruction.strip()), "instruction", spec.instruction, "must be a non-empty string")
-    need(spec.max_episode_steps >= 1, "max_episode_steps", spec.max_episode_steps, "must be >= 1")
+    need(1 <= spec.max_episode_steps <= MAX_STEPS, "max_episode_steps", spec.max_episode_steps,
+         f"must be >= 1 and <= {MAX_STEPS} (MAX_STEPS)")
     need(all(s > 0 for s in spec.table.size_m), "table.size_m", list(spec.table.size_m), "both must be > 0")
     need(spec.table.height_m > 0, "table.height_m", spec.table.height_m, "must be > 0")
     need(spec.table.friction > 0, "table.friction", spec.table.friction, "must be > 0")
@@ -389,7 +423,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         seen.add(o.name)
         need(bool(o.asset.strip()), f"{at}.asset", o.asset, "must be a non-empty asset id (`gendex assets` lists them)")
         if known_assets is not None and o.asset.strip() and o.asset not in known_assets:
-            p.append(f"{at}.asset = {o.asset!r} is not a known asset.{suggest_value(o.asset, known_assets)} "
+            p.append(f"{at}.asset = {quote(o.asset)} is not a known asset.{suggest_value(o.asset, known_assets)} "
                      f"Run `gendex assets` to list the available asset ids.")
         need(lo <= o.scale <= hi, f"{at}.scale", o.scale, f"allowed range {lo} <= scale <= {hi}")
         need(o.pos_m[2] >= 0, f"{at}.pos_m", list(o.pos_m), "z is the clearance above the table and must be >= 0")
@@ -408,14 +442,14 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
             return
         options = names + ([GOAL_TARGET] if allow_goal and spec.goal is not None else [])
         extra = (f" ({GOAL_TARGET!r} needs a top-level `goal:`)" if allow_goal and value == GOAL_TARGET else "")
-        p.append(f"{path} = {value!r} does not name an object{extra}; allowed: {', '.join(map(repr, options))}."
+        p.append(f"{path} = {quote(value)} does not name an object{extra}; allowed: {', '.join(map(repr, options))}."
                  f"{suggest_value(value, options)}")
 
     distractors = {o.name for o in spec.objects if o.distractor}
 
     def not_distractor(value: str | None, path: str) -> None:
         if value in distractors:
-            p.append(f"{path} = {value!r} names a distractor (objects with distractor: true take part in no stage "
+            p.append(f"{path} = {quote(value)} names a distractor (objects with distractor: true take part in no stage "
                      "or condition); name a task object or drop the distractor flag")
 
     need(len(spec.stages) >= 1, "stages", [], "at least one stage is required")
@@ -426,7 +460,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         need(s.name not in stage_names, f"{at}.name", s.name, "stage names must be unique (duplicate name)")
         stage_names.add(s.name)
         need(bool(s.instruction.strip()), f"{at}.instruction", s.instruction, "must be a non-empty string")
-        need(s.horizon >= 1, f"{at}.horizon", s.horizon, "must be >= 1")
+        need(1 <= s.horizon <= MAX_STEPS, f"{at}.horizon", s.horizon, f"must be >= 1 and <= {MAX_STEPS} (MAX_STEPS)")
         ref(s.target, f"{at}.target")
         not_distractor(s.target, f"{at}.target")
         if s.success is not None:
@@ -439,7 +473,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
 
     need(bool(spec.success.description.strip()), "success.description", spec.success.description,
          "must be a non-empty string")
-    need(spec.success.hold_steps >= 0, "success.hold_steps", spec.success.hold_steps, "must be >= 0")
+    need(0 <= spec.success.hold_steps <= MAX_STEPS, "success.hold_steps", spec.success.hold_steps,
+         f"must be >= 0 and <= {MAX_STEPS} (MAX_STEPS)")
     need(len(spec.success.conditions) >= 1, "success.conditions", [], "at least one condition is required")
     for i, c in enumerate(spec.success.conditions):
         p += _condition_problems(c, f"success.conditions[{i}]", ref)
@@ -460,19 +495,21 @@ def parse_task_spec(raw: Mapping, source: str = "<dict>", known_assets: Collecti
 
 
 def load_task_spec(path: str | Path, known_assets: Collection[str] | None = None) -> TaskSpec:
-    """Read, parse and validate a task YAML file; every problem raises TaskSpecError naming the file."""
+    """Read, parse and validate a task YAML file; every problem raises TaskSpecError naming the file.
+
+    The file is untrusted: one larger than MAX_INPUT_BYTES is refused before it is read whole, and the YAML is
+    parsed with the bounds of :func:`~gendex_envs.typed_yaml.load_yaml_bounded` (no anchors or aliases, capped
+    depth, node count, string length)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
+        with path.open("rb") as fh:
+            data = fh.read(MAX_INPUT_BYTES + 1)  # never read more than the bound (a file may be huge or endless)
+    except OSError as e:
         raise TaskSpecError(f"cannot read task spec {path}: {e}") from None
-    try:
-        raw = yaml.load(text, Loader=UniqueKeyLoader)  # a SafeLoader subclass
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        what = " ".join(x for x in (getattr(e, "context", None), getattr(e, "problem", None)) if x) or str(e)
-        raise TaskSpecError(f"invalid YAML in {path}{where}: {what}") from None
+    if len(data) > MAX_INPUT_BYTES:
+        raise TaskSpecError(f"task spec {path} is larger than {MAX_INPUT_BYTES} bytes; at most {MAX_INPUT_BYTES} "
+                            "bytes are allowed (MAX_INPUT_BYTES; refused before parsing)")
+    raw = load_yaml_bounded(data, str(path), TaskSpecError)
     if raw is None:
         raise TaskSpecError(f"invalid task spec {path}: the file is empty")
     return parse_task_spec(raw, source=str(path), known_assets=known_assets)
@@ -504,7 +541,11 @@ def omit_unset(value: Any) -> Any:
 
 
 class _Dumper(yaml.SafeDumper):
-    """SafeDumper writing lists of scalars (vectors) inline and everything else as blocks."""
+    """SafeDumper writing lists of scalars (vectors) inline and everything else as blocks; never anchors or aliases
+    (the loader refuses them)."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
 
 
 def _represent_list(dumper: yaml.SafeDumper, data: list) -> yaml.Node:

@@ -26,6 +26,13 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from gendex_envs.typed_yaml import (
+    MAX_INPUT_BYTES,
+    MAX_TRANSCRIPT_BYTES,
+    MAX_TRANSCRIPT_EXCHANGES,
+    MAX_TRANSCRIPT_LINE_BYTES,
+    parse_json_bounded,
+)
 from generator.backends.base import Backend, ModelRequest, ModelResponse
 from generator.errors import BackendError, TranscriptMismatchError
 
@@ -166,25 +173,43 @@ def _dumps(obj: Any) -> str:
 
 
 def _load(path: Path) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Parse and check a transcript; returns the header and the exchanges (responses already parsed)."""
+    """Parse and check a transcript; returns the header and the exchanges (responses already parsed).
+
+    A transcript is untrusted (it may come with a shared task folder): the file, each line, the number of exchanges
+    and each replayed reply are bounded (``MAX_TRANSCRIPT_*``, ``MAX_INPUT_BYTES``) and each line is parsed with the
+    depth and node bounds of :func:`~gendex_envs.typed_yaml.parse_json_bounded`."""
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as fh:
+            data = fh.read(MAX_TRANSCRIPT_BYTES + 1)
     except FileNotFoundError as err:
         raise BackendError(f"transcript {path} not found (record one with a live backend and a transcript path)"
                            ) from err
-    except (OSError, UnicodeDecodeError) as err:
+    except OSError as err:
         raise BackendError(f"cannot read transcript {path}: {err}") from err
+    if len(data) > MAX_TRANSCRIPT_BYTES:
+        raise TranscriptMismatchError(f"transcript {path} is larger than {MAX_TRANSCRIPT_BYTES} bytes; at most "
+                                      f"{MAX_TRANSCRIPT_BYTES} are allowed (MAX_TRANSCRIPT_BYTES)")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise BackendError(f"cannot read transcript {path}: not UTF-8 text (byte at offset {err.start})") from None
     header: dict[str, Any] | None = None
     exchanges: list[dict[str, Any]] = []
     for lineno, raw in enumerate(text.splitlines(), start=1):
         if not raw.strip():
             continue
         where = f"{path}:{lineno}"
+        if len(exchanges) >= MAX_TRANSCRIPT_EXCHANGES:
+            raise TranscriptMismatchError(f"{where}: more than {MAX_TRANSCRIPT_EXCHANGES} exchanges; at most "
+                                          f"{MAX_TRANSCRIPT_EXCHANGES} are allowed (MAX_TRANSCRIPT_EXCHANGES)")
         try:
-            obj = json.loads(raw)
+            obj = parse_json_bounded(raw, f"line {lineno}", max_bytes=MAX_TRANSCRIPT_LINE_BYTES, max_string=None,
+                                     finite=False)  # json.dumps writes NaN; a recorded context may hold one
         except json.JSONDecodeError as err:
             raise TranscriptMismatchError(f"{where}: not valid JSON ({err.msg} at column {err.colno}); "
                                           "the transcript is corrupt or truncated") from err
+        except ValueError as err:  # InputBoundsError: too long, too deep, too many nodes, duplicate keys
+            raise TranscriptMismatchError(f"{where}: refused: {getattr(err, 'problem', None) or err}") from None
         if not isinstance(obj, dict):
             raise TranscriptMismatchError(f"{where}: expected a JSON object, got {type(obj).__name__}")
         if header is None:
@@ -232,6 +257,10 @@ def _check_exchange(obj: dict[str, Any], where: str, lineno: int, expected_index
         out["response"] = ModelResponse.from_record(obj.get("response"))
     except TypeError as err:
         raise TranscriptMismatchError(f"{where}: {err}") from err
+    text = out["response"].text
+    if isinstance(text, str) and len(text.encode("utf-8", "surrogatepass")) > MAX_INPUT_BYTES:
+        raise TranscriptMismatchError(f"{where}: the recorded reply is {len(text.encode('utf-8', 'surrogatepass'))} "
+                                      f"bytes; at most {MAX_INPUT_BYTES} are allowed (MAX_INPUT_BYTES)")
     return out
 
 

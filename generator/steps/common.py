@@ -9,6 +9,13 @@ from typing import Any
 
 import yaml
 
+from gendex_envs.typed_yaml import (
+    MAX_INPUT_BYTES,
+    InputBoundsError,
+    parse_json_bounded,
+    parse_yaml_bounded,
+    yaml_error_text,
+)
 from generator.backends.base import Backend, ImagePart, ModelRequest
 from generator.errors import ModelOutputError
 from generator.prompts import render, template
@@ -41,22 +48,37 @@ def fenced(text: str, lang: str) -> str:
     return text
 
 
+def _check_reply_size(text: str, what: str, error: type[ModelOutputError]) -> None:
+    size = len(text) if len(text) > MAX_INPUT_BYTES else len(text.encode("utf-8", "surrogatepass"))
+    if size > MAX_INPUT_BYTES:
+        raise error(f"the {what} is {size} bytes; at most {MAX_INPUT_BYTES} bytes are allowed (MAX_INPUT_BYTES)")
+
+
 def parse_json_block(text: str, what: str, error: type[ModelOutputError] = ModelOutputError) -> Any:
+    """The JSON of a model reply's ```json block, parsed within the bounds of untrusted input
+    (:func:`~gendex_envs.typed_yaml.parse_json_bounded`); any failure raises ``error``."""
+    _check_reply_size(text, what, error)
     body = fenced(text, "json").strip()
     if not body.startswith(("{", "[")):
         start = body.find("{")
         body = body[start:] if start >= 0 else body
     try:
-        return json.loads(body)
+        return parse_json_bounded(body, f"the {what}")
     except json.JSONDecodeError as exc:
         raise error(f"the {what} is not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except InputBoundsError as exc:
+        raise error(f"the {what} is refused: {exc.problem}") from None
 
 
 def parse_yaml_block(text: str, what: str, error: type[ModelOutputError] = ModelOutputError) -> Any:
+    """The YAML of a model reply's ```yaml block, parsed within the bounds of untrusted input (no anchors or
+    aliases, capped size, depth, node count and string length: :func:`~gendex_envs.typed_yaml.parse_yaml_bounded`);
+    any failure raises ``error``."""
+    _check_reply_size(text, what, error)
     body = fenced(text, "yaml")
     try:
-        return yaml.safe_load(body)
+        return parse_yaml_bounded(body, f"the {what}")
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1} column {mark.column + 1}" if mark else ""
-        raise error(f"the {what} is not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+        where, problem = yaml_error_text(exc)
+        kind = "is refused" if isinstance(exc, InputBoundsError) else "is not valid YAML"
+        raise error(f"the {what} {kind}{where.replace(',', '')}: {problem}") from None
