@@ -14,6 +14,6 @@ def evaluate(env):
 
 
 def compute_dense_reward(env, obs, action, info):
-    target = env.task_spec.stages[0].target or env.task_spec.objects[0].name
+    target = (env.stage_targets[0] if env.stage_targets else None) or env.object_names[0]
     reach = rt.reach(torch.linalg.norm(env.palm_pose.p - env.obj_pose(target).p, dim=-1))
     return torch.where(info["success"], torch.ones_like(reach), reach)

@@ -13,6 +13,11 @@ learning; it does not decide success, which the spec declares (:mod:`gendex_envs
 ``REWARD_MAX: float``  (optional, default 1.0)
     upper bound of the dense reward, used by ``compute_normalized_dense_reward``.
 
+The functions receive a :class:`~gendex_envs.reward_view.RewardView` as ``env``, never the env itself: the
+documented members as fresh tensors, no handle to the scene, agent or controller. ``obs``, ``action`` and ``info``
+are copies. The wrapping happens here, once, so every caller (the env, the judge, the probe, the solver) passes the
+env and the module sees only the view.
+
 Modules written by a language model are validated by the generator before they are committed; this loader only
 checks that the interface is present.
 """
@@ -29,6 +34,7 @@ from pathlib import Path
 from types import ModuleType
 
 from gendex_envs.errors import RewardModuleError
+from gendex_envs.reward_view import copy_tensors, view_of
 
 log = logging.getLogger(__name__)
 
@@ -71,5 +77,18 @@ def load_reward_module(path: str | Path) -> RewardModule:
     if not reward_max > 0:
         raise RewardModuleError(f"reward module {path}: REWARD_MAX={reward_max} must be > 0")
     extra = getattr(module, "_get_obs_extra", None)
-    return RewardModule(path=path, evaluate=module.evaluate, compute_dense_reward=module.compute_dense_reward,
-                        get_obs_extra=extra if callable(extra) else None, reward_max=reward_max)
+    return RewardModule(path=path, evaluate=_through_view(module.evaluate, 0),
+                        compute_dense_reward=_through_view(module.compute_dense_reward, 3),
+                        get_obs_extra=_through_view(extra, 1) if callable(extra) else None, reward_max=reward_max)
+
+
+def _through_view(fn: Callable, copied: int) -> Callable:
+    """``fn`` called with the env's :class:`~gendex_envs.reward_view.RewardView` in place of the env and copies of
+    its ``copied`` further arguments (obs, action, info)."""
+    def call(env, *args):
+        if len(args) != copied:
+            raise TypeError(f"{fn.__name__} takes env and {copied} more arguments, got {len(args)}")
+        return fn(view_of(env), *(copy_tensors(a) for a in args))
+    call.__name__ = call.__qualname__ = fn.__name__
+    call.__wrapped__ = fn
+    return call

@@ -491,7 +491,7 @@ class TaskEnv(BaseEnv):
 
     def joint_record(self, name: str, joint: str | None = None) -> JointEntry:
         """The catalog entry of ``name``'s joint (default: its main joint)."""
-        rec = self._records[name]
+        rec = self.asset_record(name)  # names the objects when ``name`` is not one
         if not rec.articulated:
             raise TaskSpecError(f"object {name!r} (asset {rec.id!r}) is not articulated")
         return rec.joints[0] if joint is None else rec.joint(joint)
@@ -504,7 +504,8 @@ class TaskEnv(BaseEnv):
 
     def handle_link(self, name: str, joint: str | None = None) -> Link:
         """The link carrying the handle of ``name``'s joint (default: its main joint)."""
-        return self.articulations[name].links_map[self.joint_record(name, joint).handle_link]
+        record = self.joint_record(name, joint)  # TaskSpecError for an unknown or rigid object
+        return self.articulations[name].links_map[record.handle_link]
 
     def handle_pos(self, name: str, joint: str | None = None) -> torch.Tensor:
         """[N, 3] world position of the handle's grip point."""

@@ -4,6 +4,7 @@ import pytest
 from typer.testing import CliRunner
 
 from gendex.cli import app
+from gendex.data.datasets import load_manifest
 
 
 @pytest.mark.slow
@@ -14,7 +15,8 @@ def test_building_the_smoke_manifest_reproduces_its_recorded_checksums(tmp_path)
     out = tmp_path / "smoke"
     built = CliRunner().invoke(app, ["dataset", "build", "gendex-smoke", "--out", str(out), "--workers", "2"])
     assert built.exit_code == 0, built.output
-    assert "10 files match the manifest" in built.output
+    recorded = load_manifest("gendex-smoke").checksums
+    assert len(recorded) >= 10 and f"{len(recorded)} files match the manifest" in built.output
     video = next(out.rglob("*.mp4"))
     video.write_bytes(video.read_bytes()[:-1] + b"\x00")
     checked = CliRunner().invoke(app, ["dataset", "verify", str(out)])
