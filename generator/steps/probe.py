@@ -7,6 +7,26 @@ random actions and checks every call (``evaluate`` returns a ``fail`` bool ``[N]
 ``success``, which the spec declares; a finite float ``[N]`` reward; finite ``[N, ...]`` observations). The
 parent enforces the time and memory limits and turns every failure into
 :class:`~generator.errors.RewardProbeError`.
+
+Process hygiene: nothing the probe starts or writes may outlive the parent, even a parent killed with ``SIGKILL``
+(whose ``finally`` blocks and :class:`tempfile.TemporaryDirectory` cleanup never run) or a parent that hangs.
+
+* The child dies with its parent: it asks the kernel for ``SIGKILL`` at the parent's death (``PR_SET_PDEATHSIG``)
+  before it imports anything untrusted, and checks right after that its parent is still the one named in the job
+  (the parent may have died before the ``prctl``). Without ``prctl`` (not Linux) a thread polls ``os.getppid``.
+* The child limits its own CPU time (``RLIMIT_CPU``, budgets computed here from the job: ``startup_timeout_s`` and
+  ``timeout_s`` per module, times :data:`CPU_MARGIN`), so a hung module is ended by the kernel even when no parent
+  watches it; the parent reports such a death as "exceeded its CPU budget of N s".
+* The temporary folder (job, progress, log) is removed by a *reaper*: a tiny process (stdlib only) started next to
+  each child, in its own session, whose stdin is a pipe whose write end only the parent holds. The parent writes
+  the child's process-group id into it, and ``done`` once it has cleaned up itself. When the parent dies, however it
+  dies, the kernel closes the pipe; the reaper reads end-of-file without ``done``, kills the child's process group
+  (a second path besides ``PDEATHSIG``, portable to any POSIX system) and removes the folder, then exits. A
+  watchdog inside the child could not do this: the child may be the process that is stuck, and ``PDEATHSIG``
+  kills it with no chance to run code.
+* In the parent, ``finally`` blocks kill the child and remove the folder on any exception, ``KeyboardInterrupt``
+  included; while a probe runs in the main thread, ``SIGTERM`` (when nothing else handles it) raises
+  :class:`SystemExit` so that those blocks run too.
 """
 
 from __future__ import annotations
@@ -14,12 +34,14 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import math
 import os
 import re
 import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +58,13 @@ DEFAULT_TIMEOUT_S = 60.0
 DEFAULT_MEMORY_LIMIT_MB = 4096
 DEFAULT_STARTUP_TIMEOUT_S = 300.0
 """Time allowed to import the simulator and build the env (not charged to any module)."""
+CPU_MARGIN = 2.0
+"""CPU budgets are this multiple of the wall-clock limits (CPU time counts every thread), plus :data:`CPU_SLACK_S`."""
+CPU_SLACK_S = 5.0
+MAX_FILE_MB = 256
+"""Largest file the child may write (``RLIMIT_FSIZE``; its log and progress files)."""
 _POLL_S = 0.05
+_REAPER_WAIT_S = 5.0
 _STACK_WAIT_S = 2.0
 _FRAME_RE = re.compile(r'File "(?P<file>[^"]+)", line (?P<line>\d+) in (?P<fn>\S+)')
 
@@ -152,6 +180,23 @@ def _rss_kb(pid: int) -> int:
     return 0
 
 
+def _cpu_s(pid: int) -> float:
+    """CPU seconds (user + system) that process ``pid`` has used so far, from ``/proc`` (0 where unavailable)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return 0.0
+
+
+def cpu_budgets(timeout_s: float, startup_timeout_s: float, module_cpu_s: float | None = None) -> tuple[int, int]:
+    """(CPU seconds to build the env, CPU seconds per module) that a probe child allows itself."""
+    startup = math.ceil(CPU_MARGIN * startup_timeout_s + CPU_SLACK_S)
+    module = math.ceil(module_cpu_s if module_cpu_s is not None else CPU_MARGIN * timeout_s + CPU_SLACK_S)
+    return startup, max(module, 1)
+
+
 def _setup_error(task_dir: Path, record: dict) -> GenDexError:
     """The env could not be built: not the reward's fault; keep GenDex's own error type where there is one."""
     import gendex_envs.errors as gerr
@@ -168,24 +213,29 @@ class _Child:
 
     def __init__(self, task_dir: Path, modules: list[Path], displays: list[str], *, steps: int, timeout_s: float,
                  seed: int, num_envs: int, sim_backend: str, memory_limit_mb: int | None, startup_timeout_s: float,
-                 stop_on_error: bool, workdir: Path):
+                 stop_on_error: bool, workdir: Path, module_cpu_s: float | None = None):
         self.task_dir, self.modules, self.displays = task_dir, modules, displays
         self.timeout_s, self.memory_limit_mb, self.startup_timeout_s = timeout_s, memory_limit_mb, startup_timeout_s
         self.workdir = workdir
         self.progress_path = workdir / "progress.jsonl"
         self.log_path = workdir / "child.log"
         layout = TaskLayout(task_dir)
+        self.cpu_startup_s, self.cpu_module_s = cpu_budgets(timeout_s, startup_timeout_s, module_cpu_s)
         self.job = {"spec": str(layout.spec), "modules": [str(m) for m in modules], "displays": displays,
                     "stages": [layout.module_stage(m) for m in modules],
                     "steps": steps, "seed": seed, "num_envs": num_envs, "sim_backend": sim_backend,
                     "memory_limit_mb": memory_limit_mb, "stop_on_error": stop_on_error,
-                    "progress": str(self.progress_path)}
+                    "progress": str(self.progress_path), "parent_pid": os.getpid(),
+                    "cpu_startup_s": self.cpu_startup_s, "cpu_module_s": self.cpu_module_s,
+                    "max_file_mb": MAX_FILE_MB}
         self.results: dict[int, ProbeReport | RewardCodeError] = {}
         self.current: int | None = None
         self.started_at = 0.0
         self.last_call: tuple[str | None, int | None] = (None, None)
         self.ready = False
         self.baseline_rss_kb = 0
+        self.cpu_seen_s = 0.0
+        self.cpu_at_module_s = 0.0
 
     def run(self) -> dict[int, ProbeReport | RewardCodeError]:
         job_path = self.workdir / "job.json"
@@ -194,16 +244,51 @@ class _Child:
         env = dict(os.environ)
         root = str(Path(__file__).resolve().parents[2])  # the checkout holding generator/ and gendex_envs/
         env["PYTHONPATH"] = os.pathsep.join([root, *[p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]])
-        with open(self.log_path, "wb") as logf:
-            proc = subprocess.Popen([sys.executable, "-m", "generator.steps.probe_child", str(job_path)],
-                                    stdin=subprocess.DEVNULL, stdout=logf, stderr=subprocess.STDOUT, env=env,
-                                    start_new_session=True)
+        reaper, pipe = self._start_reaper(env)
         try:
-            self._watch(proc)
+            # Popen forks from this thread, which then watches the child until it has exited: the child's
+            # PR_SET_PDEATHSIG fires when the forking *thread* ends, so it must not end first (see probe_child)
+            with open(self.log_path, "wb") as logf:
+                proc = subprocess.Popen([sys.executable, "-m", "generator.steps.probe_child", str(job_path)],
+                                        stdin=subprocess.DEVNULL, stdout=logf, stderr=subprocess.STDOUT, env=env,
+                                        start_new_session=True)
+            try:
+                pipe.write(f"{proc.pid}\n")  # start_new_session: its process-group id is its pid
+                pipe.flush()
+                self._watch(proc)
+            finally:
+                if proc.poll() is None:
+                    self._kill(proc)
         finally:
-            if proc.poll() is None:
-                self._kill(proc)
+            self._stop_reaper(reaper, pipe)
         return self.results
+
+    # -------------------------------------------------------------- the reaper (see the module docstring)
+    def _start_reaper(self, env: dict) -> tuple[subprocess.Popen, object]:
+        read_fd, write_fd = os.pipe()  # not inheritable (PEP 446): only this process holds the write end
+        try:
+            reaper = subprocess.Popen([sys.executable, "-m", "generator.steps.probe_child", "--reaper",
+                                       str(self.workdir)], stdin=read_fd, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+        except BaseException:
+            os.close(write_fd)
+            raise
+        finally:
+            os.close(read_fd)
+        return reaper, os.fdopen(write_fd, "w", encoding="ascii")
+
+    @staticmethod
+    def _stop_reaper(reaper: subprocess.Popen, pipe) -> None:
+        try:
+            pipe.write("done\n")
+            pipe.close()
+        except OSError:  # the reaper is gone already (killed by someone): nothing to tell it
+            pass
+        try:
+            reaper.wait(timeout=_REAPER_WAIT_S)
+        except subprocess.TimeoutExpired:
+            reaper.kill()
+            reaper.wait()
 
     # -------------------------------------------------------------- watching
     def _events(self, offset: int) -> tuple[list[dict], int]:
@@ -234,6 +319,7 @@ class _Child:
             if self.current is not None and now - self.started_at > self.timeout_s:
                 self._timed_out(proc)
                 return
+            self.cpu_seen_s = _cpu_s(proc.pid) or self.cpu_seen_s
             if self.current is not None and self.memory_limit_mb:
                 rss = _rss_kb(proc.pid)
                 if rss - self.baseline_rss_kb > self.memory_limit_mb * 1024:
@@ -250,6 +336,7 @@ class _Child:
         elif kind == "module":
             self.current = int(ev["i"])
             self.started_at = time.monotonic()
+            self.cpu_at_module_s = self.cpu_seen_s
             self.last_call = (None, None)
         elif kind == "call":
             self.last_call = (ev.get("fn"), ev.get("step"))
@@ -303,8 +390,20 @@ class _Child:
             f"{when + ', ' if when else ''}over the {self.memory_limit_mb} MB limit; it was stopped. Reward code "
             "must not accumulate data or allocate large tensors")
 
+    def _over_cpu(self, rc: int) -> bool:
+        """Whether the child's own CPU limit ended it: SIGXCPU, or SIGKILL at the hard limit."""
+        if rc == -signal.SIGXCPU:
+            return True
+        budget = self.cpu_module_s if self.current is not None else self.cpu_startup_s
+        start = self.cpu_at_module_s if self.current is not None else 0.0
+        return rc == -signal.SIGKILL and self.cpu_seen_s - start >= budget - 1
+
     def _died(self, proc: subprocess.Popen) -> None:
         if self.current is None and not self.ready:
+            if self._over_cpu(proc.returncode):
+                raise GeneratorError(f"the reward probe process for {self.task_dir} exceeded its CPU budget of "
+                                     f"{self.cpu_startup_s} s before the env was built; log tail:\n"
+                                     f"{self._log_tail()}")
             raise GeneratorError(f"the reward probe process for {self.task_dir} exited with code {proc.returncode} "
                                  f"before the env was built; log tail:\n{self._log_tail()}")
         if self.current is None:
@@ -315,9 +414,16 @@ class _Child:
             return  # exited after its last result
         i = self.current
         rc = proc.returncode
-        how = f"was killed by {signal.Signals(-rc).name}" if rc < 0 else f"exited with code {rc}"
         where = _stack_location(self._log_text(0), self.modules[i])
         what, when = self._where()
+        if self._over_cpu(rc):
+            self.results[i] = RewardProbeError(
+                f"{self.displays[i]}: the probe process exceeded its CPU budget of {self.cpu_module_s} s while "
+                f"{'running ' + what if self.last_call[0] else what}{' ' + when if when else ''} (infinite loop?); "
+                f"the kernel stopped it{where}. Reward "
+                "functions must return quickly: batched tensor code, no unbounded loops")
+            return
+        how = f"was killed by {signal.Signals(-rc).name}" if rc < 0 else f"exited with code {rc}"
         self.results[i] = RewardProbeError(
             f"{self.displays[i]}: the probe process {how} while running {what}{' ' + when if when else ''}{where}; "
             f"log tail:\n{self._log_tail()}")
@@ -340,12 +446,38 @@ class _Child:
         return "\n".join(self._log_text(0).splitlines()[-lines:])
 
 
+class _TerminateAsExit:
+    """While a probe runs in the main thread, ``SIGTERM`` raises :class:`SystemExit` so that ``finally`` blocks run.
+
+    Only where ``SIGTERM`` still has its default action (an application's own handler is left alone); the previous
+    handler is restored afterwards. Elsewhere the reaper and the child's ``PDEATHSIG`` clean up after the parent.
+    """
+
+    def __enter__(self):
+        self.previous = None
+        if threading.current_thread() is threading.main_thread() and \
+                signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+            self.previous = signal.signal(signal.SIGTERM, self._raise)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.previous is not None:
+            signal.signal(signal.SIGTERM, self.previous)
+
+    @staticmethod
+    def _raise(signum, _frame) -> None:
+        log.warning("the reward probe got SIGTERM: stopping its child and removing its temporary folder")
+        raise SystemExit(128 + signum)
+
+
 def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s: float, seed: int, num_envs: int,
            sim_backend: str, memory_limit_mb: int | None, startup_timeout_s: float,
-           stop_on_error: bool) -> list[ProbeReport | RewardCodeError | None]:
+           stop_on_error: bool, module_cpu_s: float | None = None) -> list[ProbeReport | RewardCodeError | None]:
     """Probe ``modules`` in as few processes as possible (a new one only after a module was killed).
 
     Returns one entry per module: its report, its error, or None when ``stop_on_error`` left it unprobed.
+    ``module_cpu_s`` is the CPU time a module may use before the child's own limit ends it (default
+    ``CPU_MARGIN * timeout_s + CPU_SLACK_S``: a backstop behind the parent's wall-clock limit).
     """
     if not TaskLayout(task_dir).spec.is_file():
         raise TaskNotFoundError(f"{task_dir} holds no task spec ({TaskLayout(task_dir).spec.name})")
@@ -356,10 +488,11 @@ def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s:
     results: list[ProbeReport | RewardCodeError | None] = [None] * len(modules)
     start = 0
     while start < len(modules):
-        with tempfile.TemporaryDirectory(prefix="gendex_probe_") as tmp:
+        with _TerminateAsExit(), tempfile.TemporaryDirectory(prefix="gendex_probe_") as tmp:
             child = _Child(task_dir, modules[start:], displays[start:], steps=steps, timeout_s=timeout_s, seed=seed,
                            num_envs=num_envs, sim_backend=sim_backend, memory_limit_mb=memory_limit_mb,
-                           startup_timeout_s=startup_timeout_s, stop_on_error=stop_on_error, workdir=Path(tmp))
+                           startup_timeout_s=startup_timeout_s, stop_on_error=stop_on_error, workdir=Path(tmp),
+                           module_cpu_s=module_cpu_s)
             got = child.run()
         for i, r in got.items():
             results[start + i] = r
@@ -379,14 +512,15 @@ def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s:
 def probe_task(task_dir: str | Path, modules: list[str | Path], *, steps: int = DEFAULT_STEPS,
                timeout_s: float = DEFAULT_TIMEOUT_S, seed: int = 0, num_envs: int = 1,
                sim_backend: str = "physx_cpu", memory_limit_mb: int | None = DEFAULT_MEMORY_LIMIT_MB,
-               startup_timeout_s: float = DEFAULT_STARTUP_TIMEOUT_S, check_static: bool = True) -> list[ProbeReport]:
+               startup_timeout_s: float = DEFAULT_STARTUP_TIMEOUT_S, check_static: bool = True,
+               module_cpu_s: float | None = None) -> list[ProbeReport]:
     """Probe several reward modules of one task in one child process; raises for the first bad module.
 
     Each module gets ``timeout_s`` seconds (import, reset and ``steps`` seeded random-action steps); building the
     env is not charged to it (``startup_timeout_s``). ``check_static`` runs :func:`check_reward_file` on each module
     first (on by default: the probe never executes code that did not pass it unless asked to). Raises
     :class:`~generator.errors.RewardProbeError` (or the static check's error) whose message starts with the
-    module's path relative to ``task_dir``.
+    module's path relative to ``task_dir``. ``module_cpu_s``: see :func:`probe_modules`.
     """
     task_dir = Path(task_dir)
     paths = [Path(m) for m in modules]
@@ -395,7 +529,7 @@ def probe_task(task_dir: str | Path, modules: list[str | Path], *, steps: int = 
             check_reward_file(p, module_display(task_dir, p))
     results = probe_modules(task_dir, paths, steps=steps, timeout_s=timeout_s, seed=seed, num_envs=num_envs,
                      sim_backend=sim_backend, memory_limit_mb=memory_limit_mb, startup_timeout_s=startup_timeout_s,
-                     stop_on_error=True)
+                     stop_on_error=True, module_cpu_s=module_cpu_s)
     for r in results:
         if isinstance(r, RewardCodeError):
             raise r

@@ -14,8 +14,19 @@ It reports JSON lines to the job's ``progress`` file, one object per line (``ev`
 * ``{"ev": "done"}``.
 
 The checks are batched tensor operations (no per-env Python loops), so they work on the GPU backend as well.
-Time, memory and crash limits are the parent's job: it kills this process group; ``SIGUSR1`` makes
+The parent enforces the wall-clock and memory limits: it kills this process group; ``SIGUSR1`` makes
 :mod:`faulthandler` dump the stack first, so the parent can name the line that hung.
+
+Process hygiene does not depend on the parent staying alive or responsive (see :mod:`generator.steps.probe`):
+
+* before anything else this process asks the kernel for ``SIGKILL`` when its parent dies (``PR_SET_PDEATHSIG``,
+  Linux; a thread polling :func:`os.getppid` elsewhere), then checks the parent is still the one in the job;
+* it limits its own CPU time (``RLIMIT_CPU``; the job's budgets): a hung module gets ``SIGXCPU`` (stack dumped,
+  then the default action ends the process) even when nobody watches it; no core files (``RLIMIT_CORE`` 0) and
+  no file larger than the job's ``max_file_mb`` (``RLIMIT_FSIZE``);
+* ``python -m generator.steps.probe_child --reaper WORKDIR`` is the reaper the parent starts next to each child: it
+  reads child process-group ids from stdin, a pipe whose write end only the parent holds, and exits at ``done``;
+  at end of file without ``done`` the parent died, so it kills the groups and removes ``WORKDIR``.
 """
 
 from __future__ import annotations
@@ -24,9 +35,12 @@ import faulthandler
 import json
 import logging
 import math
+import os
 import resource
+import shutil
 import signal
 import sys
+import threading
 import time
 import traceback
 import warnings
@@ -36,6 +50,13 @@ from typing import ClassVar
 log = logging.getLogger(__name__)
 
 EXCEPTION_TEXT_LIMIT = 600
+ORPHANED_EXIT = 70
+"""Exit status when the parent was already gone at start (or, without prctl, died later)."""
+_PR_SET_PDEATHSIG = 1
+_PARENT_POLL_S = 0.5
+_CPU_GRACE_S = 5
+"""Seconds between ``SIGXCPU`` (soft limit) and the kernel's ``SIGKILL`` (hard limit)."""
+_REAP_WAIT_S = 3.0
 _BLOCKED_EVENT_PREFIXES = (
     "open", "os.", "subprocess.", "socket.", "shutil.", "ctypes.", "builtins.input", "pty.", "urllib.",
     "webbrowser.", "glob.", "tempfile.", "sys.addaudithook", "marshal.", "pickle.", "winreg.", "msvcrt.", "sqlite3.",
@@ -309,6 +330,125 @@ class _CheckedModule:
         }
 
 
+# ------------------------------------------------------------------ process hygiene
+def _die_with_parent(parent_pid: int | None) -> str:
+    """Make this process die with its parent; returns how (``prctl`` or ``thread``).
+
+    Runs first in :func:`main`, before the audit hook (which refuses ``ctypes`` events) and before any untrusted code.
+    ``PR_SET_PDEATHSIG`` fires when the *thread* that forked this process exits, not the whole parent process: the
+    parent calls ``Popen`` from the thread that then watches this child until it has exited (``probe._Child.run``),
+    so that thread outlives the child unless the parent process itself dies, which is the case this is meant for.
+    The signal is ``SIGKILL`` because a stuck child (a loop holding the GIL, a hang inside C code) runs no handler.
+    """
+    how = "thread"
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) != 0:
+                raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
+            how = "prctl"
+        except (OSError, AttributeError) as exc:
+            log.warning("the reward probe child cannot ask for SIGKILL at its parent's death (%s); polling instead",
+                        exc)
+    # the parent may have died before prctl took effect: then this process was already re-parented
+    if parent_pid is not None and os.getppid() != parent_pid:
+        os._exit(ORPHANED_EXIT)
+    if how == "thread" and parent_pid is not None:
+        threading.Thread(target=_poll_parent, args=(parent_pid,), name="probe-parent-watch", daemon=True).start()
+    return how
+
+
+def _poll_parent(parent_pid: int) -> None:
+    """Portable fallback: exit as soon as the parent is gone (a Python loop in reward code still yields the GIL)."""
+    while os.getppid() == parent_pid:
+        time.sleep(_PARENT_POLL_S)
+    os._exit(ORPHANED_EXIT)  # os._exit raises no audit event, so the hook cannot refuse it
+
+
+def _cpu_used_s() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _set_cpu_limit(soft_s: float, hard_s: float | None = None) -> None:
+    """``RLIMIT_CPU``: ``SIGXCPU`` at ``soft_s`` CPU seconds (this process, all threads), ``SIGKILL`` at the hard."""
+    _soft, hard = resource.getrlimit(resource.RLIMIT_CPU)
+    if hard_s is not None:
+        hard = math.ceil(hard_s) if hard == resource.RLIM_INFINITY else min(math.ceil(hard_s), hard)
+    soft = math.ceil(soft_s)
+    if hard != resource.RLIM_INFINITY:
+        soft = min(soft, max(hard - _CPU_GRACE_S, 1))
+    resource.setrlimit(resource.RLIMIT_CPU, (soft, hard))
+
+
+def _limit_startup(job: dict) -> None:
+    """Limits set before the simulator is imported: CPU for the whole run (hard) and for building the env (soft)."""
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # SIGXCPU's default action would dump core into the cwd
+    # SIGXCPU: dump the stack (the parent names the line), then chain to the default action, which ends the process
+    faulthandler.register(signal.SIGXCPU, file=sys.stderr, all_threads=True, chain=True)
+    startup = job.get("cpu_startup_s")
+    module = job.get("cpu_module_s")
+    if startup and module:
+        total = float(startup) + len(job["modules"]) * float(module) + _CPU_GRACE_S
+        _set_cpu_limit(float(startup), total)
+
+
+def _limit_before_untrusted_code(job: dict) -> None:
+    """Limits set once the env is built, before the first candidate module is imported.
+
+    Not set: ``RLIMIT_AS`` (torch, SAPIEN and the CUDA runtime reserve far more virtual address space than they use,
+    so an address-space cap breaks them; ``RLIMIT_DATA`` bounds heap growth instead, see :func:`main`) and
+    ``RLIMIT_NPROC`` (it counts every process and thread of the user, machine-wide, so any useful value would break
+    thread pools and other work of the same user; spawning is refused by the audit hook instead).
+    """
+    max_file_mb = job.get("max_file_mb")
+    if max_file_mb:
+        limit = int(max_file_mb) * 1024 * 1024
+        _soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit if hard == resource.RLIM_INFINITY else min(limit, hard),
+                                                   hard))
+
+
+def _limit_module_cpu(job: dict) -> None:
+    """Before each module: ``cpu_module_s`` more CPU seconds from now (never past the hard limit)."""
+    module = job.get("cpu_module_s")
+    if module:
+        _set_cpu_limit(_cpu_used_s() + float(module))
+
+
+def reap(workdir: str, stream=None) -> int:
+    """The reaper: wait for the parent's ``done``; if the pipe closes without it, kill the children, remove ``workdir``.
+
+    Reads lines from ``stream`` (stdin): a process-group id per child the parent started, ``done`` when the parent
+    cleaned up itself. Only the parent holds the pipe's write end (pipes are not inherited across ``exec``), so end
+    of file without ``done`` means the parent died, however it died (``SIGKILL`` included). Imports nothing heavy.
+    """
+    stream = stream if stream is not None else sys.stdin
+    for sig in (signal.SIGINT, signal.SIGHUP):  # a terminal's Ctrl-C or hang-up goes to the parent, which cleans up
+        signal.signal(sig, signal.SIG_IGN)
+    groups: list[int] = []
+    for line in stream:
+        word = line.strip()
+        if word == "done":
+            return 0
+        if word.isdigit():
+            groups.append(int(word))
+    for pgid in groups:
+        try:
+            os.killpg(pgid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+    deadline = time.monotonic() + _REAP_WAIT_S
+    while True:  # a dying child may still hold files open; retry until the folder is gone
+        shutil.rmtree(workdir, ignore_errors=True)
+        if not os.path.exists(workdir) or time.monotonic() > deadline:
+            break
+        time.sleep(0.05)
+    return 1
+
+
 class _Progress:
     def __init__(self, path: str):
         self.f = open(path, "a", buffering=1, encoding="utf-8")
@@ -381,10 +521,14 @@ def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
 
 
 def main(argv: list[str]) -> int:
+    if argv[:1] == ["--reaper"]:
+        return reap(argv[1])
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
-    progress = _Progress(job["progress"])
+    _die_with_parent(job.get("parent_pid"))  # first: before any simulator, reward code or audit hook
     faulthandler.enable(file=sys.stderr, all_threads=True)
     faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
+    _limit_startup(job)
+    progress = _Progress(job["progress"])
     logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
     try:
         import torch
@@ -411,9 +555,11 @@ def main(argv: list[str]) -> int:
         _soft, hard = resource.getrlimit(resource.RLIMIT_DATA)
         resource.setrlimit(resource.RLIMIT_DATA, (limit if hard == resource.RLIM_INFINITY else min(limit, hard),
                                                   hard))
+    _limit_before_untrusted_code(job)
     sys.addaudithook(_Audit.hook)
-    progress.emit(ev="ready", rss_kb=_vm_kb("VmRSS"))
+    progress.emit(ev="ready", rss_kb=_vm_kb("VmRSS"), cpu_s=round(_cpu_used_s(), 3))
     for index in range(len(job["modules"])):
+        _limit_module_cpu(job)
         result = _probe_module(env, job, index, progress)
         progress.emit(**result)
         if not result["ok"] and job.get("stop_on_error"):
