@@ -1,4 +1,5 @@
-"""Every TaskEnv member the environment-API prompt names exists and has the documented shape."""
+"""Every member the environment-API prompt names exists on the view reward code receives, with the documented shape,
+and the view offers nothing the prompt does not document."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import re
 import pytest
 import torch
 
+from gendex_envs.reward_view import RewardView, view_of
 from generator.prompts import render
 
 _LINE = re.compile(r"^- `(?P<expr>[^`]+)` : (?P<shape>[^:]+?) : ", re.M)
@@ -21,6 +23,8 @@ def _members() -> list[tuple[str, str]]:
 def _check(value, shape: str, n: int, expr: str) -> None:
     if shape == "int":
         assert isinstance(value, int), expr
+    elif shape == "tuple":
+        assert isinstance(value, tuple), expr
     elif shape == "float":
         assert isinstance(value, float), expr
     elif shape == "torch.device":
@@ -40,19 +44,28 @@ def _check(value, shape: str, n: int, expr: str) -> None:
 @pytest.mark.parametrize("env_id, placeholder, name", [
     ("GenDex/PutAppleBowl-v0", "NAME", "apple"),
     ("GenDex/OpenCabinet-v0", "ARTICULATED", "cabinet"),
+    ("GenDex/PushBlockToGoal-v0", "NAME", "block"),
 ])
-def test_env_api_prompt_matches_task_env(make_env, env_id, placeholder, name):
+def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, name):
     env = make_env(env_id, control_mode="pd_joint_delta_pos")
     env.reset(seed=0)
     env.step(env.action_space.sample())
     u = env.unwrapped
+    view = view_of(u)
     checked = 0
     for expr, shape in _members():
         other = "ARTICULATED" if placeholder == "NAME" else "NAME"
-        if other in expr:
+        if other in expr or ("goal_pos" in expr and u.goal_site is None):
             continue
         code = expr.replace(placeholder, repr(name))
-        value = eval(code, {"torch": torch}, {"env": u})
+        value = eval(code, {"torch": torch}, {"env": view})
         _check(value, shape, u.num_envs, expr)
         checked += 1
     assert checked >= 12
+
+
+def test_the_view_offers_exactly_what_the_prompt_documents():
+    documented = {m for expr, _ in _members() for m in re.findall(r"\benv\.(\w+)", expr)}
+    offered = {n for n in dir(RewardView) if not n.startswith("_")}
+    assert offered == documented, (f"undocumented: {sorted(offered - documented)}; "
+                                   f"documented but missing: {sorted(documented - offered)}")
