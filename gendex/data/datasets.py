@@ -36,6 +36,7 @@ import dacite
 import yaml
 
 from gendex.data.episode import EpisodeError
+from gendex_envs.typed_yaml import load_yaml_bounded
 
 log = logging.getLogger(__name__)
 
@@ -116,7 +117,7 @@ def load_manifest(name: str | Path) -> DatasetManifest:
     if not path.is_file():
         known = sorted(p.stem for p in DATASETS_DIR.glob("*.yaml"))
         raise DatasetError(f"no dataset manifest {name!r}; known: {', '.join(known) or 'none'} (in {DATASETS_DIR})")
-    raw = yaml.safe_load(path.read_text())
+    raw = load_yaml_bounded(path.read_bytes(), str(path), DatasetError)  # a manifest may come from anyone
     try:
         m = dacite.from_dict(DatasetManifest, raw, config=dacite.Config(strict=True, cast=[tuple]))
     except (dacite.DaciteError, TypeError) as exc:

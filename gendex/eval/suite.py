@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import dacite
-import yaml
 
 from gendex_envs.errors import GenDexError
+from gendex_envs.typed_yaml import load_yaml_bounded
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 SUITES_DIR = REPO_ROOT / "suites"
@@ -60,7 +60,7 @@ def load_suite(name: str | Path) -> Suite:
         known = sorted(p.stem for p in SUITES_DIR.glob("*.yaml"))
         raise SuiteError(f"no suite {str(name)!r}; known: {', '.join(known) or 'none'} (in {SUITES_DIR})")
     data = path.read_bytes()
-    raw = yaml.safe_load(data)
+    raw = load_yaml_bounded(data, str(path), SuiteError)  # a suite file may come from anyone
     try:
         suite = dacite.from_dict(Suite, {**raw, "hash": hashlib.sha256(data).hexdigest()},
                                  config=dacite.Config(strict=True, cast=[tuple]))

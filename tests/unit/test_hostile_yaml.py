@@ -311,6 +311,20 @@ def test_transcript_bounds(tmp_path, lines, reason):
     assert time.perf_counter() - start < 5.0
 
 
+@pytest.mark.parametrize("loader", ["suite", "manifest"])
+def test_suite_and_dataset_manifest_files_are_bounded_too(tmp_path, loader):
+    from gendex.data.datasets import DatasetError, load_manifest
+    from gendex.eval.suite import SuiteError, load_suite
+
+    path = tmp_path / "hostile.yaml"
+    path.write_text(BOMB)
+    load, error = (load_suite, SuiteError) if loader == "suite" else (load_manifest, DatasetError)
+    start = time.perf_counter()
+    with pytest.raises(error, match="more than 20000 nodes"):
+        load(path)
+    assert time.perf_counter() - start < 1.0
+
+
 def test_a_committed_transcript_still_replays():
     path = next(iter(sorted((ROOT / "generated_tasks").glob("*/v*/transcript.jsonl"))), None)
     if path is None:
