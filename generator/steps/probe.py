@@ -253,8 +253,12 @@ class _Child:
                                         stdin=subprocess.DEVNULL, stdout=logf, stderr=subprocess.STDOUT, env=env,
                                         start_new_session=True)
             try:
-                pipe.write(f"{proc.pid}\n")  # start_new_session: its process-group id is its pid
-                pipe.flush()
+                try:
+                    pipe.write(f"{proc.pid}\n")  # start_new_session: its process-group id is its pid
+                    pipe.flush()
+                except OSError as exc:  # the reaper was killed: PDEATHSIG alone still ends the child with us
+                    log.warning("the reward probe's reaper is gone (%s); its folder %s would stay behind if this "
+                                "process were killed", exc, self.workdir)
                 self._watch(proc)
             finally:
                 if proc.poll() is None:
@@ -279,11 +283,11 @@ class _Child:
 
     @staticmethod
     def _stop_reaper(reaper: subprocess.Popen, pipe) -> None:
-        try:
-            pipe.write("done\n")
-            pipe.close()
-        except OSError:  # the reaper is gone already (killed by someone): nothing to tell it
-            pass
+        for tell in (lambda: pipe.write("done\n"), pipe.close):
+            try:
+                tell()
+            except OSError:  # the reaper is gone already (killed by someone): nothing to tell it
+                pass
         try:
             reaper.wait(timeout=_REAPER_WAIT_S)
         except subprocess.TimeoutExpired:
