@@ -1,0 +1,15 @@
+# expect: exponent/shift
+# class: resources
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: a huge shift."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    x = 1 << 100000
+    return torch.zeros(env.num_envs, device=env.device)

@@ -1,0 +1,15 @@
+# expect: `locals` is not allowed
+# class: names
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: locals()."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    loc = locals()
+    return torch.zeros(env.num_envs, device=env.device)

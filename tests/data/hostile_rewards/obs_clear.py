@@ -1,0 +1,15 @@
+# expect: `.clear()` changes
+# class: mutation
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: clearing the observation dict."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    obs.clear()
+    return torch.zeros(env.num_envs, device=env.device)

@@ -1,0 +1,17 @@
+# expect: passes `inplace` positionally
+# class: mutation
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: F.relu(t, True) modifies t in place."""
+
+import torch
+
+import torch.nn.functional as F
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    F.relu(env.palm_pose.p, True)
+    return torch.zeros(env.num_envs, device=env.device)

@@ -1,0 +1,15 @@
+# expect: `print` is not allowed
+# class: names
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: print writes to the process's stdout."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    print(obs)
+    return torch.zeros(env.num_envs, device=env.device)

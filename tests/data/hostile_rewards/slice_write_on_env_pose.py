@@ -1,0 +1,15 @@
+# expect: which this function did not create
+# class: mutation
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: writing through a slice of the env's pose."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    env.obj_pose("cube").p[:] = 0
+    return torch.zeros(env.num_envs, device=env.device)

@@ -1,0 +1,15 @@
+# expect: attribute `.unwrapped`
+# class: simulator
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: unwrapping the env."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    u = env.unwrapped
+    return torch.zeros(env.num_envs, device=env.device)

@@ -1,0 +1,17 @@
+# expect: loops forever
+# class: resources
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: the only break leaves an inner loop."""
+
+import torch
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    while 1:
+        for i in range(3):
+            break
+    return torch.zeros(env.num_envs, device=env.device)
