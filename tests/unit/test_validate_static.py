@@ -320,3 +320,38 @@ def test_every_problem_is_listed_with_its_line():
 def test_unsafe_wins_over_interface_errors():
     message = rejected("import os\n", UnsafeCodeError)
     assert "`import os`" in message and "no top-level function `evaluate(env)`" in message
+
+
+# ------------------------------------------------------------------------------------------------ rebuilt check
+@pytest.mark.parametrize("body", [
+    "    up = torch.zeros_like(env.palm_pose.p)\n    up[:, 2] = 1.0\n",
+    "    r = torch.zeros(env.num_envs, device=env.device)\n    r += 0.5 * env.obj_height('mug')\n",
+    "    r = env.palm_pose.p * 1.0\n    r[r < 0] = 0.0\n",
+    "    p = env.palm_pose.p.clone()\n    p[:, 0] = 0.0\n",
+    "    parts = {}\n    parts['reach'] = env.palm_pose.p\n    names = []\n    names.append('reach')\n",
+    "    n = 0\n    for t in (env.palm_pose.p, env.tip_positions):\n        n += 1\n",
+    "    f = lambda x, k=2: x * k\n    s = f'{env.num_envs}: {f(2)}'\n",
+    "    type_ = 1\n    with torch.no_grad():\n        z = [x * type_ for x in (1, 2)]\n",
+])
+def test_code_that_writes_only_what_it_created_passes(body):
+    check_reward_source(in_reward(body))
+
+
+def test_a_builtin_bound_in_a_function_is_usable_there_only():
+    source = HEAD + "def _helper(x):\n    type = abs\n    return type(x)\n\n" + EVALUATE + REWARD
+    check_reward_source(source)
+    message = rejected(source.replace("return {'fail'", "t = type(s)\n    return {'fail'"))
+    assert "the builtin `type` is not allowed in reward code (in `evaluate`)" in message
+
+
+@pytest.mark.parametrize(("body", "pattern"), [
+    ("    match obs:\n        case {'a': x}:\n            pass\n", r"\(Match\)"),
+    ("    p = env.palm_pose.p\n    p[:, 0] = 0.0\n", r"which this function did not create"),
+    ("    p = env.palm_pose.p\n    p += 1.0\n", r"may change `p` in place"),
+    ("    info['success'] = info['success'] | True\n", r"which this function did not create"),
+    ("    env.palm_pose.p.mul_(0)\n", r"in-place method"),
+    ("    torch.mul(obs, 2, out=obs)\n", r"keyword `out=`"),
+    ("    s = 'a__b'\n", r"contains `__`"),
+])
+def test_rebuilt_rules_name_the_reason(body, pattern):
+    assert re.search(pattern, rejected(in_reward(body))), body
