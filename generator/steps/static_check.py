@@ -708,7 +708,11 @@ class _Checker:
             return  # the outermost attribute of a chain resolves the whole chain
         root, names = self.attr_chain(node)
         if root is not None and not any(_attribute_problem(n) for n in names):
-            self.resolve_chain(node, self.module_aliases[root], names, shown=root)
+            obj = self.resolve_chain(node, self.module_aliases[root], names, shown=root)
+            if isinstance(obj, types.ModuleType):  # `t = F.torch` would alias a module into a variable
+                path = ".".join([root, *names])
+                self.add(node, f"the module `{path}` may only be used as `{path}.<name>` (line {node.lineno}: "
+                         f"`{_snippet(self.source, self.parent.get(node, node))}`), not passed around or stored")
 
     def resolve_chain(self, node: ast.AST, module: str, names: list[str], shown: str | None = None) -> object:
         """Follow ``module.names...`` in the real (trusted) modules; reject other modules and unknown attributes.
@@ -764,7 +768,10 @@ class _Checker:
             return
         first = node.args[0]
         if isinstance(first, ast.Name) and first.id in self.module_aliases:
-            self.resolve_chain(node, self.module_aliases[first.id], [name], shown=first.id)
+            obj = self.resolve_chain(node, self.module_aliases[first.id], [name], shown=first.id)
+            if fn == "getattr" and isinstance(obj, types.ModuleType):
+                self.add(node, f"`{_snippet(self.source, node)}` returns the module `{obj.__name__}`; use "
+                         f"`{first.id}.{name}.<name>` directly")
 
     def check_positional_inplace(self, node: ast.Call) -> None:
         """``F.relu(t, True)``, ``F.dropout(t, 0.5, True, True)``, ``torch.nn.ReLU(True)``: a torch callable with an

@@ -1,0 +1,18 @@
+# expect: returns the module `torch`
+# class: modules
+# ruff: noqa (deliberately hostile code: it only has to fail the static check)
+"""Hostile reward module: getattr hands out a module, whose attributes are then not followed."""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+
+def evaluate(env):
+    return {"success": env.obj_height("cube") > 0.1}
+
+
+def compute_dense_reward(env, obs, action, info):
+    m = getattr(rt, "torch")
+    m.random.fork_rng()
+    return torch.zeros(env.num_envs, device=env.device)
