@@ -653,7 +653,7 @@ class _Checker:
                 self.check_annotation(ann)
         what = f"`{node.name}`" if isinstance(node, ast.FunctionDef) else "the lambda"
         for d in [*args.defaults, *[d for d in args.kw_defaults if d is not None]]:
-            if not (self.is_constant_expr(d) and not isinstance(d, ast.Name)):
+            if not self.is_constant_expr(d):
                 self.add(d, f"default value `{_snippet(self.source, d)}` of {what} must be a literal constant "
                          "(defaults are evaluated at import time and kept between calls)")
 
@@ -704,6 +704,15 @@ class _Checker:
         if why:
             self.add(node, f"attribute `.{node.attr}` in `{_snippet(self.source, node)}` is not allowed: {why}")
             return
+        if node.attr in CONTAINER_MUTATORS:  # called or passed on (`map(info.update, ...)`)
+            root, names = self.attr_chain(node)
+            module_function = root is not None and len(names) == 1  # `torch.add(...)`, not `rt.CACHE.update()`
+            if not module_function and not self.is_fresh(node.value, self.function_of(node)):
+                call = self.parent.get(node)
+                shown = call if isinstance(call, ast.Call) and call.func is node else node
+                self.add(node, f"`{_snippet(self.source, shown)}`: `.{node.attr}()` changes "
+                         f"`{_snippet(self.source, node.value, 40)}`, which this function did not create (it may be "
+                         "the env's data or an argument such as `info`); build a new list/dict/tensor instead")
         if isinstance(self.parent.get(node), ast.Attribute):
             return  # the outermost attribute of a chain resolves the whole chain
         root, names = self.attr_chain(node)
@@ -745,13 +754,6 @@ class _Checker:
 
     def check_call(self, node: ast.Call) -> None:
         func = node.func
-        if isinstance(func, ast.Attribute) and func.attr in CONTAINER_MUTATORS:
-            root, names = self.attr_chain(func)
-            module_function = root is not None and len(names) == 1  # `torch.add(...)`, not `rt.CACHE.update()`
-            if not module_function and not self.is_fresh(func.value, self.function_of(node)):
-                self.add(node, f"`{_snippet(self.source, node)}`: `.{func.attr}()` changes "
-                         f"`{_snippet(self.source, func.value, 40)}`, which this function did not create (it may be "
-                         "the env's data or an argument such as `info`); build a new list/dict/tensor instead")
         self.check_positional_inplace(node)
         if not isinstance(func, ast.Name) or func.id not in ("getattr", "hasattr"):
             return
@@ -762,7 +764,8 @@ class _Checker:
                      f"`{fn}(env, \"goal_pos\")`")
             return
         name = node.args[1].value
-        why = _attribute_problem(name)
+        why = _attribute_problem(name) or ("it changes its object; call it as a method on a list/dict this function "
+                                           "created" if name in CONTAINER_MUTATORS else None)
         if why:
             self.add(node, f"`{_snippet(self.source, node)}` is not allowed: `{name}`: {why}")
             return
