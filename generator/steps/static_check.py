@@ -803,8 +803,9 @@ class _Checker:
 
     def check_while(self, node: ast.While) -> None:
         test = node.test
-        if not (isinstance(test, ast.Constant) and test.value):
-            return
+        constant = not any(isinstance(n, ast.Name | ast.Attribute | ast.Call | ast.Subscript) for n in ast.walk(test))
+        if not constant or (isinstance(test, ast.Constant) and not test.value):
+            return  # `while 1 == 1`, `while not False`: a condition without variables never changes
         stack: list[tuple[ast.AST, bool]] = [(s, False) for s in node.body]  # (node, inside a nested loop)
         while stack:
             cur, nested = stack.pop()
