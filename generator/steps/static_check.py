@@ -113,10 +113,6 @@ class _Problem:
     unsafe: bool
 
 
-class _CheckerLimit(Exception):
-    """Internal: the source is too large or too deep to analyse (becomes an UnsafeCodeError)."""
-
-
 def _snippet(source: str, node: ast.AST, limit: int = 70) -> str:
     try:
         seg = ast.get_source_segment(source, node) or ""
@@ -200,25 +196,20 @@ class _Checker:
 
     def _child_scope(self, node: ast.AST, child: ast.AST) -> ast.AST:
         """The scope ``child`` of ``node`` is evaluated in (Python's rules: defaults, decorators, annotations and a
-        comprehension's first iterable belong to the enclosing scope)."""
+        comprehension's first iterable belong to the enclosing scope; parameters are found through their function)."""
         outer = self.scope[node]
         if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
             return node if child in node.body else outer
         if isinstance(node, ast.Lambda):
             return node if child is node.body else outer
-        if isinstance(node, ast.arguments):
-            return outer if (child in node.defaults or child in node.kw_defaults) else self.scope[node]
-        if isinstance(node, ast.arg):  # annotations: evaluated (or not at all) outside the function
-            return self.scope[self.parent.get(self.parent.get(node, node), node)]
         if isinstance(node, ast.ListComp | ast.SetComp | ast.DictComp | ast.GeneratorExp):
-            if node.generators and child is node.generators[0]:
-                return node  # its `iter` is re-scoped below
             return node
         if isinstance(node, ast.comprehension):
             comp = self.parent.get(node)
-            if comp is not None and getattr(comp, "generators", [None])[0] is node and child is node.iter:
+            generators = getattr(comp, "generators", None) or [None]
+            if generators[0] is node and child is node.iter:  # the first iterable is evaluated outside
                 return self.scope[comp]
-            return self.scope[node]
+            return outer
         if isinstance(node, ast.ClassDef):
             return outer if child not in node.body else node
         return outer
@@ -235,9 +226,6 @@ class _Checker:
                 return None
             cur = self.scope.get(cur)
         return cur
-
-    def in_function(self, node: ast.AST) -> bool:
-        return self.function_of(node) is not None
 
     # -------------------------------------------------------------- entry
     def run(self) -> list[_Problem]:
@@ -435,11 +423,6 @@ class _Checker:
                     return True
                 return func.attr in FRESH_METHODS and self.is_fresh(func.value, fn, seen)
         return False
-
-    def root_name(self, node: ast.AST) -> ast.Name | None:
-        while isinstance(node, ast.Attribute | ast.Subscript | ast.Call):
-            node = node.func if isinstance(node, ast.Call) else node.value
-        return node if isinstance(node, ast.Name) else None
 
     # -------------------------------------------------------------- top level
     def check_top_level(self) -> None:
