@@ -33,6 +33,14 @@ class RewardModuleError(GenDexError, ImportError):
     """A task's reward module is missing, fails to import or lacks a required function."""
 
 
+class RewardCodeError(GenDexError, ValueError):
+    """Reward code does not parse or lacks its interface (the static check, :mod:`gendex_envs.code_check`)."""
+
+
+class UnsafeCodeError(RewardCodeError):
+    """Reward code uses something outside the allowed subset (files, processes, dunders, writes into the env...)."""
+
+
 class ControlModeError(GenDexError, ValueError):
     """An unknown control_joint mode or controller name."""
 

@@ -13,7 +13,7 @@ environment-API prompt (``prompts/env_api.txt``) documents, under the same names
 * the view stores no reference to the env at all. Which env a view reads is kept in this module's private
   registry (view -> weak reference to the env), so reaching the env from reward code would take either importing
   this module or a dunder (``__globals__``, ``__closure__``); the static check and the runtime guard refuse both
-  (:mod:`generator.steps.static_check`, :mod:`gendex_envs.guard`). Views have no ``__dict__``: attributes cannot
+  (:mod:`gendex_envs.code_check`, :mod:`gendex_envs.guard`). Views have no ``__dict__``: attributes cannot
   be added or replaced.
 
 ``info``, ``obs`` and ``action`` passed to reward functions are copies as well (:func:`copy_tensors`), so writing

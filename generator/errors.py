@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from gendex_envs import errors as runtime_errors
 from gendex_envs.errors import GenDexError
 
 
@@ -40,11 +41,11 @@ class DirectiveError(ModelOutputError):
     """A critic directive is malformed, names an unknown object or action, or leaves the allowed range."""
 
 
-class RewardCodeError(ModelOutputError):
+class RewardCodeError(ModelOutputError, runtime_errors.RewardCodeError):
     """Reward code was rejected: unsafe constructs, missing functions, or a failed simulator probe."""
 
 
-class UnsafeCodeError(RewardCodeError):
+class UnsafeCodeError(RewardCodeError, runtime_errors.UnsafeCodeError):
     """Reward code uses something it may not (imports, file/network/process access, dunder tricks, exec/eval)."""
 
 

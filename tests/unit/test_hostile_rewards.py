@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 import gendex_envs
+from gendex_envs.code_check.rules import MAX_SOURCE_CHARS
 from generator.errors import RewardCodeError, UnsafeCodeError
-from generator.steps.reward_rules import MAX_SOURCE_CHARS
 from generator.steps.static_check import check_reward_file, check_reward_source
 
 ROOT = Path(__file__).resolve().parents[2]

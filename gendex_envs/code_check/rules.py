@@ -1,4 +1,4 @@
-"""What reward code may use: the allow- and deny-lists of the static check (:mod:`generator.steps.static_check`).
+"""What reward code may use: the allow- and deny-lists of the static check (:mod:`gendex_envs.code_check`).
 
 Reward modules are written by a language model and are untrusted; these lists define the small, pure-tensor subset
 of Python they may be written in. Each forbidden attribute carries the reason the feedback to the model states.
