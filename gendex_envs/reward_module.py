@@ -18,8 +18,9 @@ documented members as fresh tensors, no handle to the scene, agent or controller
 are copies. The wrapping happens here, once, so every caller (the env, the judge, the probe, the solver) passes the
 env and the module sees only the view.
 
-Modules written by a language model are validated by the generator before they are committed; this loader only
-checks that the interface is present.
+Modules written by a language model are validated by the generator before they are committed. A module from a
+folder that is not trusted (anything but the repository's committed tasks, unless the user trusts it) is checked
+again here, statically, before it is imported, and runs under the runtime guard (:mod:`gendex_envs.guard`).
 """
 
 from __future__ import annotations
@@ -33,7 +34,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
 
-from gendex_envs.errors import RewardModuleError
+from gendex_envs import guard
+from gendex_envs.code_check import check_reward_file
+from gendex_envs.errors import RewardCodeError, RewardModuleError
 from gendex_envs.reward_view import copy_tensors, view_of
 
 log = logging.getLogger(__name__)
@@ -53,15 +56,36 @@ class RewardModule:
     reward_max: float
 
 
-def load_reward_module(path: str | Path) -> RewardModule:
-    """Import ``path`` as a private module and check its interface; raises :class:`RewardModuleError`."""
+def load_reward_module(path: str | Path, trusted: bool | None = None, static_check: bool = True) -> RewardModule:
+    """Import ``path`` as a private module and check its interface; raises :class:`RewardModuleError`.
+
+    ``trusted`` defaults to the folder's trust (:func:`gendex_envs.guard.is_trusted`: the repository's committed
+    tasks, or ``trust_remote_code``). An untrusted module is first statically checked
+    (:func:`gendex_envs.code_check.check_reward_file`; :class:`~gendex_envs.errors.UnsafeCodeError` or
+    :class:`~gendex_envs.errors.RewardCodeError` before any of its code runs), then its folder goes under the
+    runtime guard's audit hook and it runs with restricted builtins and read-only copies of its modules
+    (:mod:`gendex_envs.guard`). ``static_check=False`` skips the static check of an untrusted module (the probe's
+    tests of the runtime fences); the guard applies either way."""
     path = Path(path).resolve()
     if not path.is_file():
         raise RewardModuleError(f"reward module {path} does not exist; every task version needs a task reward module")
+    trusted = guard.is_trusted(path) if trusted is None else trusted
+    if not trusted:
+        if static_check:
+            try:
+                check_reward_file(path, str(path))
+            except RewardCodeError as exc:
+                raise RewardModuleError(
+                    f"reward module {path} is not trusted (not a committed task of this repository) and the static "
+                    f"check rejected it before any of it ran; trust_remote_code=True runs a folder you wrote as it "
+                    f"is.\n{exc}") from exc
+        guard.untrust(path.parent)
     digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
     name = f"gendex_reward_{path.parent.parent.name}_{path.parent.name}_{digest}"
     spec = importlib.util.spec_from_file_location(name, path)
     module: ModuleType = importlib.util.module_from_spec(spec)
+    if not trusted:
+        module.__dict__["__builtins__"] = guard.restricted_builtins()
     try:
         spec.loader.exec_module(module)
     except Exception as exc:

@@ -47,6 +47,7 @@ from mani_skill.utils import common, sapien_utils
 from mani_skill.utils.structs import Actor, Articulation, Link, Pose
 from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
 
+from gendex_envs import guard
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
@@ -102,6 +103,9 @@ class TaskEnv(BaseEnv):
             from; default for ``stage`` > 0: the task version's.
         gym_api: how ``gym.make`` wraps the env: the plain numpy Gymnasium API (default for one CPU env) or the
             torch-batched one (:class:`~gendex_envs.wrappers.GymApi`).
+        trust_remote_code: run the task's reward code without the runtime guard's audit hook even though its folder
+            is not the repository's (:mod:`gendex_envs.guard`; like ``transformers``' flag of the same name). The
+            restricted builtins and the read-only view apply either way.
     """
 
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
@@ -110,7 +114,8 @@ class TaskEnv(BaseEnv):
     def __init__(self, *args, task: TaskVersion | str | Path | None = None, task_spec: TaskSpec | None = None,
                  control_joint: str | None = None, stage: str | int | None = None,
                  start_states: StartStates | str | Path | None = None, view_resolution: int = 512,
-                 sensor_resolution: int = 128, gym_api: bool | None = None, **kwargs):
+                 sensor_resolution: int = 128, gym_api: bool | None = None, trust_remote_code: bool = False,
+                 **kwargs):
         if (task is None) == (task_spec is None):
             raise TaskSpecError("TaskEnv needs exactly one of task (a task version or its folder) or task_spec "
                                 "(a spec held in memory)")
@@ -119,6 +124,8 @@ class TaskEnv(BaseEnv):
                                          else TaskVersion.at(task))
         """The task version this env runs; None for an in-memory spec."""
         self.task_spec: TaskSpec = self.task.spec if self.task is not None else task_spec
+        if trust_remote_code and self.task is not None:
+            guard.trust(self.task.root)
         self.stage_index: int | None = None
         """Index of the stage this env runs on its own (``stage=``), else None (the whole task)."""
         self.stage_spec: StageSpec | None = None

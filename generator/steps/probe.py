@@ -213,7 +213,7 @@ class _Child:
 
     def __init__(self, task_dir: Path, modules: list[Path], displays: list[str], *, steps: int, timeout_s: float,
                  seed: int, num_envs: int, sim_backend: str, memory_limit_mb: int | None, startup_timeout_s: float,
-                 stop_on_error: bool, workdir: Path, module_cpu_s: float | None = None):
+                 stop_on_error: bool, workdir: Path, module_cpu_s: float | None = None, check_static: bool = True):
         self.task_dir, self.modules, self.displays = task_dir, modules, displays
         self.timeout_s, self.memory_limit_mb, self.startup_timeout_s = timeout_s, memory_limit_mb, startup_timeout_s
         self.workdir = workdir
@@ -224,7 +224,7 @@ class _Child:
         self.job = {"spec": str(layout.spec), "modules": [str(m) for m in modules], "displays": displays,
                     "stages": [layout.module_stage(m) for m in modules],
                     "steps": steps, "seed": seed, "num_envs": num_envs, "sim_backend": sim_backend,
-                    "memory_limit_mb": memory_limit_mb, "stop_on_error": stop_on_error,
+                    "memory_limit_mb": memory_limit_mb, "stop_on_error": stop_on_error, "check_static": check_static,
                     "progress": str(self.progress_path), "parent_pid": os.getpid(),
                     "cpu_startup_s": self.cpu_startup_s, "cpu_module_s": self.cpu_module_s,
                     "max_file_mb": MAX_FILE_MB}
@@ -476,8 +476,12 @@ class _TerminateAsExit:
 
 def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s: float, seed: int, num_envs: int,
            sim_backend: str, memory_limit_mb: int | None, startup_timeout_s: float,
-           stop_on_error: bool, module_cpu_s: float | None = None) -> list[ProbeReport | RewardCodeError | None]:
+           stop_on_error: bool, module_cpu_s: float | None = None,
+           check_static: bool = True) -> list[ProbeReport | RewardCodeError | None]:
     """Probe ``modules`` in as few processes as possible (a new one only after a module was killed).
+
+    The child loads every module as untrusted: statically checked again (unless ``check_static`` is False) and run
+    under the runtime guard (:mod:`gendex_envs.guard`), whichever folder it is in.
 
     Returns one entry per module: its report, its error, or None when ``stop_on_error`` left it unprobed.
     ``module_cpu_s`` is the CPU time a module may use before the child's own limit ends it (default
@@ -496,7 +500,7 @@ def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s:
             child = _Child(task_dir, modules[start:], displays[start:], steps=steps, timeout_s=timeout_s, seed=seed,
                            num_envs=num_envs, sim_backend=sim_backend, memory_limit_mb=memory_limit_mb,
                            startup_timeout_s=startup_timeout_s, stop_on_error=stop_on_error, workdir=Path(tmp),
-                           module_cpu_s=module_cpu_s)
+                           module_cpu_s=module_cpu_s, check_static=check_static)
             got = child.run()
         for i, r in got.items():
             results[start + i] = r
@@ -533,7 +537,7 @@ def probe_task(task_dir: str | Path, modules: list[str | Path], *, steps: int = 
             check_reward_file(p, module_display(task_dir, p))
     results = probe_modules(task_dir, paths, steps=steps, timeout_s=timeout_s, seed=seed, num_envs=num_envs,
                      sim_backend=sim_backend, memory_limit_mb=memory_limit_mb, startup_timeout_s=startup_timeout_s,
-                     stop_on_error=True, module_cpu_s=module_cpu_s)
+                     stop_on_error=True, module_cpu_s=module_cpu_s, check_static=check_static)
     for r in results:
         if isinstance(r, RewardCodeError):
             raise r

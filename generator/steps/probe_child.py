@@ -470,6 +470,7 @@ def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
     """Probe one module; returns the result record."""
     import torch
 
+    from gendex_envs import guard
     from gendex_envs.reward_module import RewardModule, load_reward_module
     from gendex_envs.spec import resolve_stage
     from gendex_envs.success import Judge
@@ -479,7 +480,10 @@ def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
     t0 = time.monotonic()
     progress.emit(ev="module", i=index)
     try:
-        module = load_reward_module(path)
+        # model code, wherever its folder is: statically checked (unless the job says not to) and guarded, unless
+        # the user trusts all code (GENDEX_TRUST_REMOTE_CODE=1); this process's own audit fence applies either way
+        module = load_reward_module(path, trusted=guard.trusts_everything(),
+                                    static_check=job.get("check_static", True))
     except Exception as exc:
         cause = exc.__cause__ or exc
         text = _exception_text(cause, path) if exc.__cause__ else f"{type(exc).__name__}: {exc}"

@@ -80,7 +80,7 @@ def validate_task(task_dir: str | Path, modules: list[str | Path] | None = None,
     if to_probe:
         results = probe_modules(task_dir, [paths[i] for i in to_probe], steps=steps, timeout_s=timeout_s, seed=seed,
                          num_envs=num_envs, sim_backend=sim_backend, memory_limit_mb=memory_limit_mb,
-                         startup_timeout_s=startup_timeout_s, stop_on_error=False)
+                         startup_timeout_s=startup_timeout_s, stop_on_error=False, check_static=check_static)
         for i, r in zip(to_probe, results, strict=True):
             name = module_display(task_dir, paths[i])
             if isinstance(r, ProbeReport):

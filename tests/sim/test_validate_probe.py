@@ -181,8 +181,13 @@ def test_memory_blowup_fails_inside_the_reward_code(batch):
     assert "at line 7 (`big = torch.ones(2**31, device=env.device)`)" in message
 
 
-def test_killed_children_are_replaced_and_report_the_cause(tmp_path):
-    """Time limit, audit hook and crash, without the static check that would stop the first two before running."""
+def test_killed_children_are_replaced_and_report_the_cause(tmp_path, monkeypatch):
+    """Time limit, audit hook and crash, without the static check that would stop the first two before running,
+    and with all code trusted: the runtime guard's restricted builtins would refuse `open` and `faulthandler`
+    before the child's own fences (time limit, its audit hook, crash report) are reached."""
+    from gendex_envs.guard import TRUST_ENV
+
+    monkeypatch.setenv(TRUST_ENV, "1")
     loop, audit, crash, good = write_modules(tmp_path, {
         "loop": HEAD + EVALUATE + (
             "def compute_dense_reward(env, obs, action, info):\n"

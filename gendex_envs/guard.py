@@ -1,0 +1,313 @@
+"""The runtime guard around reward code: restricted builtins for every reward module, and a PEP 578 audit hook that
+refuses process, network, file, ctypes and introspection events while untrusted code is running.
+
+Two fences, in addition to the static check (:mod:`gendex_envs.code_check`) and the read-only view
+(:mod:`gendex_envs.reward_view`):
+
+1. **Restricted builtins and module copies** (untrusted modules). :func:`restricted_builtins` is the
+   ``__builtins__`` such a module executes with: only :data:`SAFE_BUILTINS` (no ``open``, ``exec``, ``eval``,
+   ``compile``, ``vars``, ``globals``, no ``__build_class__``; ``getattr``/``hasattr`` refuse ``_`` names) and an
+   ``__import__`` that admits only :data:`ALLOWED_IMPORTS` and hands out read-only copies of them (:func:`_proxy`:
+   no ``torch.save``, ``torch.load``, ``torch.hub``, ``torch.os``, no ``set_*``). Python looks ``__import__`` up in
+   the running frame's builtins, so an ``import os`` inside a reward function fails even when ``os`` is already
+   loaded, which no audit hook sees; C code that imports on the module's behalf is refused the same way.
+
+2. **An audit hook** (:func:`untrust`), installed the first time a task folder that is not trusted is loaded and
+   kept for the rest of the process (audit hooks cannot be removed). It judges each sensitive event by the Python
+   stack: when a frame of an untrusted folder's code is on it, process spawning (``subprocess``, ``os.system``,
+   ``os.exec*``, ``os.fork``, ``pty``), network (``socket``, ``urllib``, ``http.client``...), ``ctypes``, file
+   writes and deletions, reading files outside the Python installation, directory listings, ``exec``/``compile``
+   of code that is not a library module, adding audit hooks, tracing and frame introspection are refused with
+   :class:`UntrustedCodeError`. Deferred misbehaviour does not escape it: the test is *whose code is running*, not
+   how long the task has run, so step 10 000 is judged as step 1. The same process keeps full rights for the
+   user's own code (writing a dataset after ``gym.make`` of a downloaded task works), which a process-wide ban
+   could not offer.
+
+C extensions that write files themselves (``numpy``'s ``tofile``, torch's serialization) raise no audit event: the
+static check refuses those names and the module copies do not offer them. Python has no in-process isolation, so
+these fences hold together, not one by one; a process boundary (the probe's child) is the stronger one.
+
+Trust: the repository's own committed tasks (``generated_tasks/``) and the package's preview module are trusted;
+any other folder (``GENDEX_TASKS_PATH``, a downloaded task, a generator run's output) is untrusted unless the user
+says so: ``gym.make(id, trust_remote_code=True)``, ``TaskEnv(..., trust_remote_code=True)``, or
+``GENDEX_TRUST_REMOTE_CODE=1`` in the environment (as ``transformers`` names it).
+"""
+
+from __future__ import annotations
+
+import builtins
+import logging
+import os
+import sys
+import threading
+from pathlib import Path
+from types import FrameType
+
+from gendex_envs.errors import GenDexError
+
+log = logging.getLogger(__name__)
+
+TRUST_ENV = "GENDEX_TRUST_REMOTE_CODE"
+"""Set to 1 to trust every task folder (as ``trust_remote_code=True`` on every env)."""
+
+SAFE_BUILTINS = frozenset({
+    "abs", "all", "any", "bool", "dict", "divmod", "enumerate", "filter", "float", "frozenset", "int",
+    "isinstance", "len", "list", "map", "max", "min", "pow", "range", "reversed", "round", "set", "slice", "sorted",
+    "str", "sum", "tuple", "zip", "getattr", "hasattr", "True", "False", "None", "NotImplemented", "Ellipsis",
+    "ArithmeticError", "AssertionError", "Exception", "IndexError", "KeyError", "LookupError",
+    "NotImplementedError", "RuntimeError", "TypeError", "ValueError", "ZeroDivisionError",
+})
+"""The builtins a reward module runs with (the static check's allow-list plus the constants)."""
+
+ALLOWED_IMPORTS = {
+    "__future__": None, "math": None, "torch": None, "torch.nn": None, "torch.nn.functional": None,
+    "torch.linalg": None, "torch.special": None, "torch.fft": None, "gendex_envs.reward_terms": None,
+    "gendex_envs": frozenset({"reward_terms"}),
+}
+"""Module -> the names ``from MODULE import ...`` may take (None: any)."""
+
+_PROCESS = ("subprocess.", "os.system", "os.exec", "os.spawn", "os.fork", "os.forkpty", "os.posix_spawn", "os.kill",
+            "os.killpg", "os.wait", "pty.", "os.startfile", "signal.")
+_NETWORK = ("socket.", "urllib.", "http.client.", "ftplib.", "smtplib.", "poplib.", "imaplib.", "nntplib.",
+            "telnetlib.", "webbrowser.", "ssl.")
+_FILES = ("os.remove", "os.unlink", "os.rename", "os.replace", "os.rmdir", "os.mkdir", "os.makedirs", "os.chmod",
+          "os.chown", "os.chdir", "os.link", "os.symlink", "os.truncate", "os.utime", "os.listdir", "os.scandir",
+          "os.putenv", "os.unsetenv", "os.chflags", "os.lchmod", "os.lchown", "os.setxattr", "os.removexattr",
+          "shutil.", "glob.", "tempfile.", "fcntl.", "mmap.", "sqlite3.", "shelve.", "dbm.")
+_CODE = ("ctypes.", "cffi.", "sys.addaudithook", "sys.settrace", "sys.setprofile", "sys._getframe",
+         "sys._current_frames", "sys.set_asyncgen_hooks", "sys.setrecursionlimit", "builtins.input",
+         "builtins.breakpoint", "code.__new__", "function.__new__", "marshal.", "pickle.find_class",
+         "object.__setattr__", "object.__delattr__", "object.__getattr__", "gc.", "cpython.", "_thread.",
+         "threading.", "resource.", "os.setuid", "os.setgid", "os.setsid", "os.nice", "faulthandler.")
+_DENIED = _PROCESS + _NETWORK + _FILES + _CODE
+_CALLER_JUDGED = ("sys._getframe", "object.__getattr__", "object.__setattr__", "object.__delattr__", "marshal.",
+                  "os.listdir", "os.scandir")
+_JUDGED = _DENIED + ("open", "exec", "compile", "import")
+_IMPORT_MACHINERY = ("<frozen importlib", "<frozen zipimport")
+
+
+class UntrustedCodeError(GenDexError, PermissionError):
+    """Untrusted reward code tried something the runtime guard refuses (a process, the network, a file...)."""
+
+
+# ---------------------------------------------------------------------------------------------- restricted builtins
+_SUBMODULES = {"torch": ("nn", "linalg", "special", "fft"), "torch.nn": ("functional",), "torch.nn.functional": (),
+               "torch.linalg": (), "torch.special": (), "torch.fft": (), "gendex_envs.reward_terms": (),
+               "gendex_envs": ("reward_terms",)}
+"""The modules reward code gets, as read-only copies: module -> the submodules reachable from it."""
+_WITHHELD = frozenset({"save", "load", "from_file", "compile", "manual_seed", "seed", "initial_seed", "get_rng_state",
+                       "use_deterministic_algorithms", "fork_rng", "cond", "while_loop", "vmap", "export"})
+
+
+def _withheld(name: str, value) -> bool:
+    return (name.startswith(("_", "set_")) or name in _WITHHELD or "Storage" in name
+            or isinstance(value, type(builtins)) or (name.startswith("is_") and name.endswith("_enabled")))
+
+
+_proxies: dict[str, object] = {}
+
+
+def _proxy(name: str):
+    """A copy of module ``name`` holding its public functions, types and constants (no submodules but the allowed
+    ones, themselves copies; nothing that saves, loads, compiles or sets global state). Reward code's ``torch``
+    is this copy, so ``torch.save``, ``torch.hub`` or ``torch.os`` do not exist for it even if the static check
+    were bypassed. (A determined attacker with a dunder could still reach the real module: Python has no
+    in-process isolation, which is why the static check refuses every dunder and the audit hook watches.)"""
+    if name not in _proxies:
+        import importlib
+        import types
+
+        real = importlib.import_module(name)
+        copy = types.ModuleType(name, f"reward-code view of {name}")
+        if name == "gendex_envs.reward_terms":
+            public = {k: v for k, v in vars(real).items() if not k.startswith("_") and callable(v)
+                      and getattr(v, "__module__", None) == name}
+        elif name == "gendex_envs":
+            public = {}
+        else:
+            public = {k: v for k, v in vars(real).items() if not _withheld(k, v)}
+        for sub in _SUBMODULES[name]:
+            public[sub] = _proxy(f"{name}.{sub}")
+        copy.__dict__.update(public)
+        _proxies[name] = copy
+    return _proxies[name]
+
+
+def _guarded_import(name: str, globals=None, locals=None, fromlist=(), level: int = 0):
+    if level != 0:
+        raise UntrustedCodeError(f"reward code may not use relative imports (from {'.' * level}{name} import ...)")
+    allowed = ALLOWED_IMPORTS.get(name, ())
+    if allowed == ():
+        raise UntrustedCodeError(f"reward code may not import {name!r}; allowed: {sorted(ALLOWED_IMPORTS)}")
+    extra = sorted(set(fromlist or ()) - allowed) if allowed is not None else []
+    if extra:
+        raise UntrustedCodeError(f"reward code may not import {extra} from {name!r}; allowed: {sorted(allowed)}")
+    if name in ("__future__", "math"):
+        return builtins.__import__(name, globals, locals, fromlist, level)
+    # `import a.b.c` binds the top package; `from a.b import c` gets a.b itself
+    return _proxy(name if fromlist else name.split(".")[0])
+
+
+def _public(name) -> str:
+    if not isinstance(name, str) or name.startswith("_"):
+        raise UntrustedCodeError(f"reward code may read public attributes only, not {str(name)[:80]!r}")
+    return name
+
+
+def _getattr(obj, name, *default):
+    return getattr(obj, _public(name), *default)
+
+
+def _hasattr(obj, name) -> bool:
+    return hasattr(obj, _public(name))
+
+
+def restricted_builtins() -> dict:
+    """A fresh ``__builtins__`` mapping for one reward module (see the module doc): ``getattr``/``hasattr`` refuse
+    private and dunder names."""
+    table = {name: getattr(builtins, name) for name in SAFE_BUILTINS}
+    table.update(__import__=_guarded_import, getattr=_getattr, hasattr=_hasattr)
+    return table
+
+
+# ---------------------------------------------------------------------------------------------- trust
+_untrusted: tuple[str, ...] = ()
+_trusted_extra: set[str] = set()
+_lock = threading.Lock()
+_busy = threading.local()
+_installed = False
+
+
+def _folder(path: str | Path) -> str:
+    return str(Path(path).resolve()) + os.sep
+
+
+def trust(folder: str | Path) -> None:
+    """Mark ``folder``'s code as trusted for this process (``trust_remote_code=True``)."""
+    global _untrusted
+    f = _folder(folder)
+    with _lock:
+        _trusted_extra.add(f)
+        _untrusted = tuple(u for u in _untrusted if not u.startswith(f))
+
+
+def trusts_everything() -> bool:
+    """``GENDEX_TRUST_REMOTE_CODE=1``: the user trusts every task folder."""
+    return os.environ.get(TRUST_ENV, "").strip().lower() in ("1", "true", "yes")
+
+
+def is_trusted(path: str | Path) -> bool:
+    """Whether code under ``path`` runs without the guard: the repository's committed tasks, the package itself,
+    folders passed to :func:`trust`, or everything when ``GENDEX_TRUST_REMOTE_CODE=1``."""
+    if trusts_everything():
+        return True
+    from gendex_envs.registry import REPO_TASKS_DIR
+
+    p = _folder(path)
+    package = _folder(Path(__file__).parent)
+    return p.startswith((_folder(REPO_TASKS_DIR), package, *_trusted_extra))
+
+
+def untrust(folder: str | Path) -> None:
+    """Run every later event raised while code under ``folder`` is on the stack through the guard (installs the
+    audit hook on first use; it stays for the rest of the process)."""
+    global _untrusted, _installed
+    f = _folder(folder)
+    with _lock:
+        if f not in _untrusted:
+            _untrusted = (*_untrusted, f)
+            log.info("runtime guard: code under %s is untrusted", f)
+        if not _installed:
+            sys.addaudithook(_hook)
+            _installed = True
+
+
+def untrusted_folders() -> tuple[str, ...]:
+    return _untrusted
+
+
+# ---------------------------------------------------------------------------------------------- the hook
+def _library_prefixes() -> tuple[str, ...]:
+    roots = {sys.prefix, sys.base_prefix, sys.exec_prefix, str(Path(__file__).resolve().parent)}
+    return tuple(str(Path(r).resolve()) + os.sep for r in roots)
+
+
+_LIBRARY = _library_prefixes()
+
+
+def _culprit(frame: FrameType | None) -> str | None:
+    """The first untrusted file on the stack from ``frame`` outwards, or None."""
+    while frame is not None:
+        name = frame.f_code.co_filename
+        if name.startswith(_untrusted):
+            return name
+        frame = frame.f_back
+    return None
+
+
+def _caller(frame: FrameType | None) -> FrameType | None:
+    """The nearest frame that is not the import machinery (who asked for an import)."""
+    while frame is not None and frame.f_code.co_filename.startswith(_IMPORT_MACHINERY):
+        frame = frame.f_back
+    return frame
+
+
+def _writes(mode, flags) -> bool:
+    if isinstance(mode, str) and any(c in mode for c in "wax+"):
+        return True
+    return isinstance(flags, int) and bool(flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_TRUNC | os.O_APPEND))
+
+
+def _refusal(event: str, args: tuple, frame: FrameType) -> str | None:
+    """Why ``event`` is refused with untrusted code on the stack, or None when it is allowed."""
+    if event.startswith(_DENIED):
+        if event.startswith(_CALLER_JUDGED):
+            # introspection by a library the reward code called (logging, warnings) and unmarshalling by the
+            # import machinery loading a library module are theirs: judged by who called, not who is on the stack
+            asker = _caller(frame)
+            if asker is None or not asker.f_code.co_filename.startswith(_untrusted):
+                return None
+            return "listing folders" if event.startswith(("os.listdir", "os.scandir")) else "introspection"
+        for group, why in ((_PROCESS, "starting processes"), (_NETWORK, "network access"), (_FILES, "touching files")):
+            if event.startswith(group):
+                return why
+        return "ctypes, tracing or introspection"
+    if event == "open":
+        path, mode, flags = (tuple(args) + (None, None, None))[:3]
+        if _writes(mode, flags):
+            return "writing files"
+        if isinstance(path, int):
+            return None  # an fd already open: the opener was judged
+        text = os.fsdecode(path) if isinstance(path, str | bytes | os.PathLike) else str(path)
+        return None if str(Path(text).resolve()).startswith(_LIBRARY) else "reading files"
+    if event in ("exec", "compile"):
+        # libraries build code (dataclasses, namedtuple, torch's serialization): judged by who asked
+        asker = _caller(frame)
+        if asker is not None and asker.f_code.co_filename.startswith(_untrusted):
+            return "running code it built itself"
+        return None
+    if event == "import":
+        asker = _caller(frame)
+        if asker is not None and asker.f_code.co_filename.startswith(_untrusted):
+            name = args[0] if args else ""
+            return None if name in ALLOWED_IMPORTS else f"importing {name!r}"
+    return None
+
+
+def _hook(event: str, args: tuple) -> None:
+    if not event.startswith(_JUDGED) or getattr(_busy, "on", False):
+        return
+    _busy.on = True
+    try:
+        frame = sys._getframe(1)  # noqa: SLF001 - the stack is what the hook judges
+        culprit = _culprit(frame)
+        if culprit is None:
+            return
+        why = _refusal(event, args, frame)
+    finally:
+        _busy.on = False
+    if why is not None:
+        detail = ", ".join(repr(a)[:80] for a in tuple(args)[:2])
+        raise UntrustedCodeError(f"runtime guard: untrusted code in {culprit} may not do {event}({detail}) "
+                                 f"({why}); reward code reads the env view and returns tensors, nothing else. Trust "
+                                 f"the folder with trust_remote_code=True or {TRUST_ENV}=1 if you wrote it")
