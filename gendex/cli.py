@@ -13,6 +13,7 @@ from pathlib import Path
 import typer
 
 from gendex.cli_bc import bc_app
+from gendex.cli_common import backend_of, ray_address_option, ray_option
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
@@ -227,6 +228,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
                                                         "AV1, lerobot's default; libx264: H.264) or 'png' (PNG "
                                                         "inside the parquet files)."),
             workers: int = typer.Option(1, min=1, help="Worker processes running attempts (one env each)."),
+            ray: bool = ray_option(), ray_address: str = ray_address_option(),
             seed: int = typer.Option(0, help="Attempt k resets with seed + k."),
             solver: str = typer.Option("stages", help="Solver: stages (planned + scripted task stages), hold, random."),
             max_attempts: int = typer.Option(None, help="Give up after this many attempts.")) -> None:
@@ -260,7 +262,7 @@ def collect(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0
                 bar.n = state.successes
                 bar.set_postfix(attempts=state.attempts, steps=state.env_steps)
                 bar.refresh()
-            state = run_collect(cfg, SOLVERS[solver], progress, workers=workers)
+            state = run_collect(cfg, SOLVERS[solver], progress, backend=backend_of(workers, ray, ray_address))
         if "lerobot" in cfg.formats and state.successes:
             write_card(cfg, spec.instruction, solver, state)
     except GenDexError as exc:
@@ -469,7 +471,9 @@ def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutA
            seed: int = typer.Option(0, "--seed"),
            out: Path = typer.Option(Path("out/ablate"), "--out", help="Run folder (policies, curves, cells)."),
            results: Path = typer.Option(Path("docs/results.md"), "--results", help="Markdown file for the table."),
-           fresh: bool = typer.Option(False, "--fresh", help="Re-run cells already saved in --out.")) -> None:
+           fresh: bool = typer.Option(False, "--fresh", help="Re-run cells already saved in --out."),
+           workers: int = typer.Option(1, "--workers", min=1, help="Cells trained at once (processes)."),
+           ray: bool = ray_option(), ray_address: str = ray_address_option()) -> None:
     """The paper's four-variant comparison: success and env steps to 1000 successes per task and variant."""
     from gendex.train.ablate import VARIANTS, run_ablation, write_results
     from gendex_envs.errors import GenDexError
@@ -483,6 +487,7 @@ def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutA
             raise ValueError(f"unknown variants {bad}; variants: {list(VARIANTS)}")
         command = _command("ablate")
         cells = run_ablation(versions, budget, out, variants=chosen, seed=seed, eval_episodes=eval_episodes,
+                             backend=backend_of(workers, ray, ray_address),
                              resume=not fresh,
                              progress=lambda c: typer.echo(f"{c.task} {VARIANTS[c.variant]}: {c.successes}/"
                                                            f"{c.eval_episodes}, {c.train_steps:,} PPO steps"))

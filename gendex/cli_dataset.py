@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from gendex.cli_common import die
+from gendex.cli_common import backend_of, die, ray_address_option, ray_option
 
 dataset_app = typer.Typer(no_args_is_help=True, help="Published datasets: build, verify, push and pull the "
                                                        "manifests in datasets/ (docs/datasets.md).")
@@ -22,6 +22,7 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
                   out: Path = typer.Option(None, "--out", help="Where to build (default out/datasets/NAME); "
                                                               "resumes a build that was stopped."),
                   workers: int = typer.Option(1, "--workers", min=1, help="Worker processes per task."),
+                  ray: bool = ray_option(), ray_address: str = ray_address_option(),
                   record: bool = typer.Option(False, "--record", help="Write the built files' checksums into the "
                                                                      "manifest (the expected ones).")) -> None:
     """Collect every task of a dataset manifest, then check the result against the manifest's checksums."""
@@ -31,7 +32,7 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
     try:
         m = load_manifest(name)
         target = out or Path("out/datasets") / m.name
-        sums = build(m, target, workers=workers,
+        sums = build(m, target, backend=backend_of(workers, ray, ray_address),
                      progress=lambda task, ok, n: typer.echo(f"  {task}: {ok} episodes after {n} attempts", err=True))
         if record:
             save_manifest(record_checksums(m, sums), manifest_path(m.name))

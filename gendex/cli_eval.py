@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from gendex.cli_common import die
+from gendex.cli_common import backend_of, die, ray_address_option, ray_option
 
 
 def policy_factory(spec: str):
@@ -30,6 +30,7 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
                  episodes: int = typer.Option(None, "--episodes", min=1, help="Episodes per task (default: the "
                                                                                "suite's; fewer marks it incomplete)."),
                  workers: int = typer.Option(1, "--workers", min=1, help="Processes sharing the tasks."),
+                 ray: bool = ray_option(), ray_address: str = ray_address_option(),
                  tasks: str = typer.Option(None, "--tasks", help="Comma-separated subset of the suite's tasks."),
                  videos: int = typer.Option(0, "--videos", min=0, help="Record the first K episodes of each task.")
                  ) -> None:
@@ -58,7 +59,8 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
             typer.echo(f"  {row['task']} seed {row['seed']}: {ok}" + (f" ({row['failure']})" if row["failure"]
                                                                          else ""), err=True)
 
-        info = run_suite(s, policy, policy_factory, out, episodes=episodes, workers=workers,
+        info = run_suite(s, policy, policy_factory, out, episodes=episodes,
+                         backend=backend_of(workers, ray, ray_address),
                          training_seeds=trained_on, videos=videos, progress=show)
     except (GenDexError, ValueError) as exc:
         die(exc)

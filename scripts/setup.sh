@@ -35,7 +35,7 @@ install_python_env() {
   log "installing torch==2.13.0 (CPU)"
   "$VENV/bin/python" -m pip install -q "torch==2.13.0"
   log "installing gendex and pinned dependencies"
-  "$VENV/bin/python" -m pip install -q -c "$ROOT/constraints.txt" -e "$ROOT[dev,stats]"
+  "$VENV/bin/python" -m pip install -q -c "$ROOT/constraints.txt" -e "$ROOT[dev,stats,ray]"
   want_hash > "$STAMP"
 }
 

@@ -13,6 +13,7 @@ so a collection is reproducible and resumable:
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
 import time
@@ -26,6 +27,7 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import EpisodeRecorder, env_info
+from gendex.fanout import Backend, ordered_map
 from gendex.solve.attempt import run_attempt
 from gendex.solve.failure import Failure
 from gendex_envs import observation
@@ -164,43 +166,37 @@ class _Attempter:
         return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0, failure)
 
 
-_WORKER: _Attempter | None = None
-
-
-def _worker_init(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> None:
-    global _WORKER
-    import torch
-
+def _make_attempter(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> _Attempter:
+    """A worker process's attempter (:func:`gendex.fanout.ordered_map`): registers a task registered at run time
+    in the parent (e.g. a scratch root) first."""
     import gendex_envs  # noqa: F401
     from gendex_envs.registry import register_tasks
 
-    torch.set_num_threads(1)  # one process per core
-    if cfg.task_id not in gym.registry:  # a task registered at run time in the parent (e.g. a scratch root)
+    if cfg.task_id not in gym.registry:
         register_tasks([Path(task_root)])
-    _WORKER = _Attempter(cfg, make_solver)
-
-
-def _worker_attempt(seed: int) -> AttemptResult:
-    return _WORKER(seed)
+    return _Attempter(cfg, make_solver)
 
 
 def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
-            progress: Callable[[CollectState], None] | None = None, workers: int = 1) -> CollectState:
+            progress: Callable[[CollectState], None] | None = None, workers: int = 1,
+            backend: Backend | None = None) -> CollectState:
     """Run attempts until ``cfg.num_success`` episodes succeeded (or ``max_attempts``); returns the final state.
 
-    With ``workers > 1`` attempts run in that many processes (one env each); results are still committed in attempt
-    order, so the dataset is the same as with one worker.
+    Attempts run on ``backend`` (:class:`gendex.fanout.Backend`; default: ``workers`` local processes, or this
+    process for one): each worker keeps one env; results are committed in attempt order, so the dataset is the
+    same as with one worker, and on Ray a worker killed mid-attempt has its attempts re-run by another.
     """
     from gendex_envs.registry import resolve_task
 
     if workers < 1:
         raise EpisodeError(f"workers={workers}; allowed: 1 or more")
+    backend = backend or Backend.from_options(workers)
     cfg.out.mkdir(parents=True, exist_ok=True)
     state = _load_state(cfg)
     limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
     local = _Attempter(cfg, make_solver)
     writers = _open_exporters(cfg, local.env)
-    pool = None
+    results = None
     try:
         pending = {name: _exported(w) - state.successes for name, w in writers.items()}
         if any(n < 0 or n > 1 for n in pending.values()):
@@ -208,14 +204,11 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
             raise EpisodeError(f"{cfg.out}: exported episode counts {counts} do not match the {state.successes} "
                                f"committed in {STATE_FILE}")
         seeds = (cfg.seed + k for k in range(state.attempts, limit))
-        if workers == 1:
+        if backend.kind == "local":
             results = map(local, seeds)
         else:
-            import multiprocessing
-
             root = str(resolve_task(cfg.task_id).tasks_root)
-            pool = multiprocessing.get_context("spawn").Pool(workers, _worker_init, (cfg, make_solver, root))
-            results = pool.imap(_worker_attempt, seeds)  # in order, computed ahead in parallel
+            results = ordered_map(functools.partial(_make_attempter, cfg, make_solver, root), seeds, backend)
         for result in results if state.successes < cfg.num_success else ():
             if result.episode is not None:
                 result.episode.info.update(attempt=state.attempts)
@@ -243,8 +236,8 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
             if state.successes >= cfg.num_success:
                 break
     finally:
-        if pool is not None:
-            pool.terminate()
+        if hasattr(results, "close"):
+            results.close()  # ends the workers
         for writer in writers.values():
             writer.close()
         local.env.close()

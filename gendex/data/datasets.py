@@ -36,6 +36,7 @@ import dacite
 import yaml
 
 from gendex.data.episode import EpisodeError
+from gendex.fanout import Backend, session
 from gendex_envs.typed_yaml import load_yaml_bounded
 
 log = logging.getLogger(__name__)
@@ -193,35 +194,45 @@ def verify(root: Path, manifest: DatasetManifest) -> Verification:
 
 # --------------------------------------------------------------------------------------------- build
 def build(manifest: DatasetManifest, out: Path, *, workers: int = 1,
-          progress: Callable[[str, int, int], None] | None = None) -> dict[str, str]:
+          progress: Callable[[str, int, int], None] | None = None, backend: Backend | None = None) -> dict[str, str]:
     """Collect every task of ``manifest`` into ``out`` (resumable), write its card and the build record; returns
-    the built dataset's checksums. ``progress(task, successes, attempts)`` after each attempt."""
-    from gendex.data.collector import CollectConfig, collect, write_card
-    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
-    from gendex_envs.registry import resolve_task
-
+    the built dataset's checksums. ``progress(task, successes, attempts)`` after each attempt. ``backend``
+    (:class:`gendex.fanout.Backend`, default ``workers`` local processes) runs the attempts; a Ray instance is
+    started once for the whole build."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     record = {"manifest": manifest.name, "description": manifest.description, "gendex_version":
               manifest.gendex_version, "solver": manifest.solver, "tasks": []}
-    for t in manifest.tasks:
-        version = resolve_task(t.task)
-        cfg = CollectConfig(task_id=version.env_id, num_success=t.episodes, out=out / manifest.folder(t),
-                            formats=("lerobot",), cameras=manifest.cameras, seed=t.seed, max_attempts=t.max_attempts,
-                            resolution=manifest.resolution, video_codec=manifest.video_codec,
-                            **SOLVER_ENV_KWARGS[manifest.solver])
-        state = collect(cfg, SOLVERS[manifest.solver],
-                        None if progress is None else lambda s, name=t.task: progress(name, s.successes, s.attempts),
-                        workers=workers)
-        if state.successes < t.episodes:
-            raise DatasetError(f"{t.task}: {state.successes} of {t.episodes} episodes after {state.attempts} "
-                               f"attempts; raise max_attempts or fix the task (failures: {state.failures})")
-        write_card(cfg, version.spec.instruction, manifest.solver, state)
-        record["tasks"].append({"task": t.task, "episodes": t.episodes, "seed": t.seed, "attempts": state.attempts,
-                                "env_steps": state.env_steps, "kept_seeds": state.kept_seeds,
-                                "failures": dict(sorted(state.failures.items()))})
+    backend = backend or Backend.from_options(workers)
+    with session(backend):
+        for t in manifest.tasks:
+            _build_task(manifest, t, out, backend, progress, record)
     (out / BUILD_RECORD).write_text(json.dumps(record, indent=1) + "\n")
     return checksums(out)
+
+
+def _build_task(manifest: DatasetManifest, t: DatasetTask, out: Path, backend: Backend,
+                progress: Callable[[str, int, int], None] | None, record: dict) -> None:
+    """Collect one task of ``manifest``, write its card, and add its line to the build ``record``."""
+    from gendex.data.collector import CollectConfig, collect, write_card
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+    from gendex_envs.registry import resolve_task
+
+    version = resolve_task(t.task)
+    cfg = CollectConfig(task_id=version.env_id, num_success=t.episodes, out=out / manifest.folder(t),
+                        formats=("lerobot",), cameras=manifest.cameras, seed=t.seed, max_attempts=t.max_attempts,
+                        resolution=manifest.resolution, video_codec=manifest.video_codec,
+                        **SOLVER_ENV_KWARGS[manifest.solver])
+    state = collect(cfg, SOLVERS[manifest.solver],
+                    None if progress is None else lambda s, name=t.task: progress(name, s.successes, s.attempts),
+                    backend=backend)
+    if state.successes < t.episodes:
+        raise DatasetError(f"{t.task}: {state.successes} of {t.episodes} episodes after {state.attempts} "
+                           f"attempts; raise max_attempts or fix the task (failures: {state.failures})")
+    write_card(cfg, version.spec.instruction, manifest.solver, state)
+    record["tasks"].append({"task": t.task, "episodes": t.episodes, "seed": t.seed, "attempts": state.attempts,
+                            "env_steps": state.env_steps, "kept_seeds": state.kept_seeds,
+                            "failures": dict(sorted(state.failures.items()))})
 
 
 def record_checksums(manifest: DatasetManifest, sums: dict[str, str]) -> DatasetManifest:

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 import logging
-import multiprocessing as mp
 import time
 from collections.abc import Callable
 from importlib.metadata import PackageNotFoundError, version
@@ -29,6 +28,7 @@ import numpy as np
 from gendex.eval.metrics import wilson
 from gendex.eval.runner import EpisodeResult, evaluate_task
 from gendex.eval.suite import Suite
+from gendex.fanout import Backend, ordered_map
 from gendex_envs.errors import GenDexError
 
 log = logging.getLogger(__name__)
@@ -63,6 +63,11 @@ def _done(out: Path, suite: Suite, spec: str) -> list[dict]:
     return rows
 
 
+def _task_worker():
+    """A worker of :func:`gendex.fanout.ordered_map`: evaluates one task's seeds per job."""
+    return _task_job
+
+
 def _task_job(job: tuple) -> list[dict]:
     task, seeds, spec, resolver, env_kwargs, max_steps, videos, video_dir = job
     import torch
@@ -75,9 +80,12 @@ def _task_job(job: tuple) -> list[dict]:
 
 def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episodes: int | None = None,
               workers: int = 1, training_seeds: list[int] | None = None, videos: int = 0,
-              progress: Callable[[EpisodeResult | dict], None] | None = None) -> dict:
+              progress: Callable[[EpisodeResult | dict], None] | None = None, backend: Backend | None = None) -> dict:
     """Evaluate the policy ``spec`` (made by ``resolver(spec)()``) on ``suite``; returns and writes eval_info.
-    ``videos``: the first k episodes of each task are also recorded (``<out>/videos/``)."""
+    ``videos``: the first k episodes of each task are also recorded (``<out>/videos/``). ``backend``
+    (:class:`gendex.fanout.Backend`; default ``workers`` local processes) shares the tasks among workers; a
+    task's episodes are kept when its job returns, so a worker killed on Ray has the task re-run, not doubled."""
+    backend = backend or Backend.from_options(workers)
     seeds = suite.seeds(episodes)
     leaked = sorted(set(seeds) & set(training_seeds or ()))
     if leaked:
@@ -99,15 +107,14 @@ def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episode
             if progress is not None:
                 progress(row)
 
-        if workers <= 1:
+        if backend.kind == "local":
             for task, todo, _, _, env_kwargs, max_steps, k, video_dir in jobs:
                 evaluate_task(task, resolver(spec), todo, env_kwargs=env_kwargs, max_episode_steps=max_steps,
                               progress=lambda r: keep(r.to_dict()), videos=k, video_dir=video_dir)
         else:
-            with mp.get_context("spawn").Pool(workers) as pool:
-                for done in pool.imap_unordered(_task_job, jobs):
-                    for row in done:
-                        keep(row)
+            for done in ordered_map(_task_worker, jobs, backend, ahead=len(jobs)):
+                for row in done:
+                    keep(row)
     info = eval_info(suite, spec, rows, seeds, time.perf_counter() - t0)
     (out / EVAL_INFO).write_text(json.dumps(info, indent=1) + "\n")
     return info

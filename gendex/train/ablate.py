@@ -17,6 +17,7 @@ N / success rate × env steps per evaluation episode (the paper's measure, with 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import logging
 import math
@@ -24,6 +25,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from gendex.fanout import Backend, ordered_map
 from gendex.solve.executor import StageExecutor
 from gendex.solve.policy import StagePolicy
 from gendex.train.envs import TASK_STAGE
@@ -213,29 +215,40 @@ def load_cell(path: Path) -> Cell:
     return Cell(**d, stages=stages)
 
 
+def _cell_worker(budget: int, out: Path, seed: int, eval_episodes: int, preset: str, n_envs: int | None):
+    """A worker of :func:`gendex.fanout.ordered_map`: trains and evaluates one (version, variant) cell per job."""
+    def run(job: tuple[TaskVersion, str]) -> Cell:
+        version, variant = job
+        return run_cell(version, variant, budget, out, seed=seed, eval_episodes=eval_episodes, preset=preset,
+                        n_envs=n_envs)
+    return run
+
+
 def run_ablation(versions: list[TaskVersion], budget: int, out: Path, *, variants: tuple[str, ...] = tuple(VARIANTS),
                  seed: int = 0, eval_episodes: int = 20, preset: str = "cpu", n_envs: int | None = None,
-                 resume: bool = True, progress=None) -> list[Cell]:
-    """Every (task, variant) cell; with ``resume``, a cell already saved with the same budget and episodes is kept."""
-    cells = []
+                 resume: bool = True, progress=None, backend: Backend | None = None) -> list[Cell]:
+    """Every (task, variant) cell; with ``resume``, a cell already saved with the same budget and episodes is kept.
+    ``backend`` (:class:`gendex.fanout.Backend`, default this process) trains the missing cells in parallel; each
+    cell is seeded by ``seed`` alone, so where it runs does not change it."""
+    found: dict[tuple[str, str], Cell] = {}
+    todo: list[tuple[TaskVersion, str]] = []
     for version in versions:
-        name = version.name
         for variant in variants:
-            saved = out / name / variant / "cell.json"
-            if resume and saved.is_file():
-                cell = load_cell(saved)
-                if cell.budget == budget and cell.eval_episodes == eval_episodes:
-                    log.info("%s %s: kept from %s", name, variant, saved)
-                    cells.append(cell)
-                    if progress:
-                        progress(cell)
-                    continue
-            cell = run_cell(version, variant, budget, out, seed=seed, eval_episodes=eval_episodes, preset=preset,
-                            n_envs=n_envs)
-            cells.append(cell)
-            if progress:
-                progress(cell)
-    return cells
+            saved = out / version.name / variant / "cell.json"
+            cell = load_cell(saved) if resume and saved.is_file() else None
+            if cell is not None and cell.budget == budget and cell.eval_episodes == eval_episodes:
+                log.info("%s %s: kept from %s", version.name, variant, saved)
+                found[(version.name, variant)] = cell
+                if progress:
+                    progress(cell)
+            else:
+                todo.append((version, variant))
+    worker = functools.partial(_cell_worker, budget, out, seed, eval_episodes, preset, n_envs)
+    for (version, variant), cell in zip(todo, ordered_map(worker, todo, backend), strict=True):
+        found[(version.name, variant)] = cell
+        if progress:
+            progress(cell)
+    return [found[(v.name, variant)] for v in versions for variant in variants]
 
 
 def _stage_cell(s: StageRecord) -> str:

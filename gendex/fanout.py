@@ -1,0 +1,211 @@
+"""Fan-out of independent jobs, in order: in this process, in local worker processes, or on a Ray cluster.
+
+Collection attempts, dataset builds, evaluation tasks and ablation cells are all "run this job on a worker that
+keeps its env alive, give me the results in job order". :func:`ordered_map` does exactly that for one
+:class:`Backend`:
+
+``local``
+    one worker in this process (the default; what every result is compared against).
+``process``
+    ``workers`` local processes (``multiprocessing``, spawn), one worker object each.
+``ray``
+    ``workers`` Ray actors, on a local instance this call starts (``--ray``) or on a running cluster
+    (``--ray-address ADDR``). Actors are created with ``max_restarts=-1, max_task_retries=-1``: when a worker
+    process dies mid-job (killed, out of memory, a lost node), Ray starts a new one, which builds its worker again,
+    and re-runs the jobs that process had not finished. Results are consumed strictly in job order and each job
+    result is taken once, so nothing is lost or duplicated; with history-independent jobs (an attempt depends only
+    on its seed) the output is identical to the local backend's.
+
+Jobs are submitted ahead of consumption, at most ``2 * workers`` in flight, so a caller that stops early (enough
+successes) wastes at most that many jobs. A worker is made once per process by ``make_worker()`` (a picklable
+callable: a module-level function or a :func:`functools.partial` of one) and called as ``worker(job)``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any, Literal
+
+log = logging.getLogger(__name__)
+
+BackendKind = Literal["local", "process", "ray"]
+KINDS: tuple[str, ...] = ("local", "process", "ray")
+
+
+class FanOutError(RuntimeError):
+    """A fan-out backend was asked for something it cannot do (unknown kind, Ray missing, a bad worker count)."""
+
+
+@dataclass(frozen=True)
+class Backend:
+    """Where jobs run: ``kind``, with ``workers`` workers; ``address``: a Ray cluster to join (None: start one)."""
+
+    kind: BackendKind = "local"
+    workers: int = 1
+    address: str | None = None
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise FanOutError(f"backend {self.kind!r} is not one of {list(KINDS)}")
+        if not isinstance(self.workers, int) or self.workers < 1:
+            raise FanOutError(f"workers={self.workers!r}; allowed: an integer >= 1")
+        if self.address is not None and self.kind != "ray":
+            raise FanOutError(f"a Ray address ({self.address!r}) needs the ray backend, not {self.kind!r}")
+        if self.kind == "local" and self.workers != 1:
+            raise FanOutError(f"the local backend runs one worker in this process, not {self.workers}")
+
+    @classmethod
+    def from_options(cls, workers: int = 1, ray: bool = False, ray_address: str | None = None) -> Backend:
+        """The CLI's ``--workers K [--ray] [--ray-address ADDR]``: Ray when either Ray option is given, else local
+        processes when K > 1, else this process."""
+        if ray or ray_address:
+            return cls("ray", workers, ray_address)
+        return cls("process", workers) if workers > 1 else cls()
+
+    def describe(self) -> str:
+        if self.kind == "local":
+            return "this process"
+        where = f"Ray at {self.address}" if self.address else ("a local Ray instance" if self.kind == "ray"
+                                                              else "local processes")
+        return f"{self.workers} worker{'s' if self.workers > 1 else ''} on {where}"
+
+
+# ---------------------------------------------------------------------------------------------- process backend
+_WORKER: Callable | None = None
+
+
+def _process_init(make_worker: Callable[[], Callable]) -> None:
+    global _WORKER
+    _one_thread()
+    _WORKER = make_worker()
+
+
+def _process_call(job):
+    return _WORKER(job)
+
+
+def _one_thread() -> None:
+    """One worker per core: torch's and OpenBLAS's own thread pools would oversubscribe it. OpenBLAS matters most:
+    with two busy processes on two cores, its spinning threads make a 4x4 ``numpy.linalg.inv`` (the solver's hand
+    model calls it per link) about 400 times slower (11 s instead of 0.03 s for 2000 batched inverses)."""
+    import torch
+    from threadpoolctl import threadpool_limits
+
+    torch.set_num_threads(1)
+    threadpool_limits(1)
+
+
+# ---------------------------------------------------------------------------------------------- ray backend
+def _ray():
+    try:
+        import ray
+    except ImportError as exc:
+        raise FanOutError("the ray backend needs Ray: pip install 'gendex[ray]' (ray>=2.60)") from exc
+    return ray
+
+
+def ray_init(address: str | None, workers: int) -> bool:
+    """Start (``address`` None) or join a Ray instance unless one is up; True when this call started it."""
+    ray = _ray()
+    if ray.is_initialized():
+        return False
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # no usage reports: nothing here reaches the network
+    kwargs: dict[str, Any] = dict(include_dashboard=False, log_to_driver=False, configure_logging=False)
+    if address is None:
+        kwargs["num_cpus"] = max(workers, os.cpu_count() or 1)
+    log.info("starting Ray (%s)", address or "local instance")
+    ray.init(address=address, **kwargs)
+    return True
+
+
+def _actor_class():
+    ray = _ray()
+
+    @ray.remote(num_cpus=1, max_restarts=-1, max_task_retries=-1)
+    class FanOutWorker:
+        """One worker object in its own process; Ray rebuilds it (and re-runs its unfinished jobs) if it dies."""
+
+        def __init__(self, make_worker):
+            _one_thread()
+            self.worker = make_worker()
+
+        def run(self, job):
+            return self.worker(job)
+
+        def pid(self) -> int:
+            return os.getpid()
+
+    return FanOutWorker
+
+
+def _ray_map(make_worker: Callable, jobs: Iterable, backend: Backend, ahead: int) -> Iterator:
+    ray = _ray()
+    started = ray_init(backend.address, backend.workers)
+    actors = [_actor_class().remote(make_worker) for _ in range(backend.workers)]
+    in_flight: deque = deque()
+    try:
+        it = iter(jobs)
+        turn = 0
+        exhausted = False
+        while True:
+            while not exhausted and len(in_flight) < ahead:
+                try:
+                    job = next(it)
+                except StopIteration:
+                    exhausted = True
+                    break
+                in_flight.append(actors[turn % len(actors)].run.remote(job))
+                turn += 1
+            if not in_flight:
+                return
+            yield ray.get(in_flight.popleft())
+    finally:
+        for actor in actors:  # ends their unfinished jobs too
+            ray.kill(actor)
+        if started:
+            ray.shutdown()
+
+
+@contextlib.contextmanager
+def session(backend: Backend | None):
+    """Keep the backend's cluster up across several :func:`ordered_map` calls (a dataset's tasks, a suite's
+    tasks): Ray is started (or joined) once and shut down at the end if this session started it."""
+    started = backend is not None and backend.kind == "ray" and ray_init(backend.address, backend.workers)
+    try:
+        yield backend
+    finally:
+        if started:
+            _ray().shutdown()
+
+
+# ---------------------------------------------------------------------------------------------- entry point
+def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Backend | None = None, *,
+                ahead: int | None = None) -> Iterator:
+    """``worker(job)`` for each job, in job order, on ``backend`` (default: this process); see the module doc.
+
+    A generator: stop consuming to stop submitting (at most ``ahead``, default ``2 * workers``, jobs run past
+    the last one consumed). Closing it ends the backend's workers."""
+    backend = backend or Backend()
+    ahead = ahead or 2 * backend.workers
+    if backend.kind == "local":
+        worker = make_worker()
+        for job in jobs:
+            yield worker(job)
+    elif backend.kind == "process":
+        import multiprocessing
+
+        pool = multiprocessing.get_context("spawn").Pool(backend.workers, _process_init, (make_worker,))
+        try:
+            yield from pool.imap(_process_call, jobs)  # in order, computed ahead in parallel
+        finally:
+            pool.terminate()
+    else:
+        yield from _ray_map(make_worker, jobs, backend, ahead)
+
+
+__all__ = ["KINDS", "Backend", "FanOutError", "ordered_map", "ray_init", "session"]
