@@ -7,6 +7,7 @@ Tests reach committed tasks only through :func:`task_version` (a registered vers
 from __future__ import annotations
 
 import logging
+import os
 import shutil
 from pathlib import Path
 
@@ -18,6 +19,14 @@ from gendex_envs.registry import register_tasks, resolve_task, unregister_tasks
 from gendex_envs.task_version import NAMESPACE, TaskLayout, TaskVersion
 
 logging.getLogger("gymnasium_robotics").setLevel(logging.ERROR)
+
+# Tests start processes beside this one (probe and gate children, worker pools, Ray actors). With more busy processes
+# than cores, OpenBLAS's spinning threads make the solver's small matrix inverses hundreds of times slower; one BLAS
+# thread per process (here, and inherited by every child) keeps them fast and changes no result.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+threadpool_limits(1)
 
 
 @pytest.fixture(scope="session")
