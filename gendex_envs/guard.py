@@ -83,6 +83,10 @@ _DENIED = _PROCESS + _NETWORK + _FILES + _CODE
 _CALLER_JUDGED = ("sys._getframe", "object.__getattr__", "object.__setattr__", "object.__delattr__", "marshal.",
                   "os.listdir", "os.scandir")
 _JUDGED = _DENIED + ("open", "exec", "compile", "import")
+_JUDGED_EXACT = frozenset(e for e in _JUDGED if "." not in e or e.startswith(("sys.", "builtins.")))
+_JUDGED_HEADS = frozenset(e.split(".")[0] for e in _JUDGED if "." in e and not e.startswith(("sys.", "builtins.")))
+"""The hook's fast path: most audit events (``builtins.id`` fires ~50 times per env step) are dismissed by one set
+lookup of their name or of the module part of it; ``sys.*`` and ``builtins.*`` events are matched exactly."""
 _IMPORT_MACHINERY = ("<frozen importlib", "<frozen zipimport")
 
 
@@ -295,6 +299,8 @@ def _refusal(event: str, args: tuple, frame: FrameType) -> str | None:
 
 
 def _hook(event: str, args: tuple) -> None:
+    if event not in _JUDGED_EXACT and event.partition(".")[0] not in _JUDGED_HEADS:
+        return
     if not event.startswith(_JUDGED) or getattr(_busy, "on", False):
         return
     _busy.on = True
