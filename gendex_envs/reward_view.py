@@ -51,13 +51,15 @@ def _env(view: RewardView) -> TaskEnv:
 
 
 def _fresh(x: torch.Tensor) -> torch.Tensor:
-    return x.detach().clone()
+    return x.clone()  # simulator state never requires grad: a clone shares nothing with it
 
 
 def copy_tensors(value: Any) -> Any:
     """A deep copy of tensors inside dicts, lists and tuples (other leaves are returned as they are)."""
     if isinstance(value, torch.Tensor):
-        return _fresh(value)
+        return value.clone()
+    if isinstance(value, dict):
+        return {k: v.clone() if isinstance(v, torch.Tensor) else copy_tensors(v) for k, v in value.items()}
     if isinstance(value, Mapping):
         return {k: copy_tensors(v) for k, v in value.items()}
     if isinstance(value, list | tuple):
