@@ -16,8 +16,9 @@ keeps its env alive, give me the results in job order". :func:`ordered_map` does
     result is taken once, so nothing is lost or duplicated; with history-independent jobs (an attempt depends only
     on its seed) the output is identical to the local backend's.
 
-Jobs are submitted ahead of consumption, at most ``2 * workers`` in flight, so a caller that stops early (enough
-successes) wastes at most that many jobs. A worker is made once per process by ``make_worker()`` (a picklable
+Jobs are submitted ahead of consumption, at most ``8 * workers`` past the last one consumed, so a slow job at the
+head of the line does not leave the other workers idle, and a caller that stops early (enough successes) wastes
+at most that many jobs. A worker is made once per process by ``make_worker()`` (a picklable
 callable: a module-level function or a :func:`functools.partial` of one) and called as ``worker(job)``.
 """
 
@@ -34,6 +35,12 @@ from typing import Any, Literal
 log = logging.getLogger(__name__)
 
 BackendKind = Literal["local", "process", "ray"]
+PER_ACTOR = 2
+"""Unfinished jobs per Ray actor: one running and one queued behind it."""
+_POLL_S = 0.05
+AHEAD_PER_WORKER = 8
+"""Jobs submitted past the last one consumed, per worker: a slow job at the head of the line does not idle the
+others (the price: up to this many jobs computed for nothing when the caller stops early)."""
 KINDS: tuple[str, ...] = ("local", "process", "ray")
 
 
@@ -144,31 +151,48 @@ def _actor_class():
 
 
 def _ray_map(make_worker: Callable, jobs: Iterable, backend: Backend, ahead: int) -> Iterator:
+    """Jobs go to the least loaded actor (at most :data:`PER_ACTOR` unfinished each, so none idles while the head
+    of the line is slow); results are yielded strictly in job order, at most ``ahead`` jobs past the last one."""
     ray = _ray()
     started = ray_init(backend.address, backend.workers)
     actors = [_actor_class().remote(make_worker) for _ in range(backend.workers)]
     in_flight: deque = deque()
+    running: dict = {}  # ref -> actor index, for jobs not yet seen finished
+    load = [0] * len(actors)
+    it = iter(jobs)
+    exhausted = False
     try:
-        it = iter(jobs)
-        turn = 0
-        exhausted = False
         while True:
-            while not exhausted and len(in_flight) < ahead:
+            if running:
+                done, _ = ray.wait(list(running), num_returns=len(running), timeout=0)
+                for ref in done:
+                    load[running.pop(ref)] -= 1
+            while not exhausted and len(in_flight) < ahead and min(load) < PER_ACTOR:
                 try:
                     job = next(it)
                 except StopIteration:
                     exhausted = True
                     break
-                in_flight.append(actors[turn % len(actors)].run.remote(job))
-                turn += 1
+                a = load.index(min(load))
+                ref = actors[a].run.remote(job)
+                in_flight.append(ref)
+                running[ref] = a
+                load[a] += 1
             if not in_flight:
                 return
-            yield ray.get(in_flight.popleft())
+            head = in_flight[0]
+            ready, _ = ray.wait([head], timeout=_POLL_S)
+            if ready:
+                in_flight.popleft()
+                if head in running:
+                    load[running.pop(head)] -= 1
+                yield ray.get(head)
     finally:
-        for actor in actors:  # ends their unfinished jobs too
-            ray.kill(actor)
         if started:
-            ray.shutdown()
+            ray.shutdown()  # ends the actors and their unfinished jobs with the instance
+        else:
+            for actor in actors:  # on a shared cluster: end ours only
+                ray.kill(actor)
 
 
 @contextlib.contextmanager
@@ -188,10 +212,10 @@ def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Ba
                 ahead: int | None = None) -> Iterator:
     """``worker(job)`` for each job, in job order, on ``backend`` (default: this process); see the module doc.
 
-    A generator: stop consuming to stop submitting (at most ``ahead``, default ``2 * workers``, jobs run past
+    A generator: stop consuming to stop submitting (at most ``ahead``, default ``8 * workers``, jobs run past
     the last one consumed). Closing it ends the backend's workers."""
     backend = backend or Backend()
-    ahead = ahead or 2 * backend.workers
+    ahead = ahead or AHEAD_PER_WORKER * backend.workers
     if backend.kind == "local":
         worker = make_worker()
         for job in jobs:

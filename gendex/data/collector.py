@@ -194,8 +194,10 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
     cfg.out.mkdir(parents=True, exist_ok=True)
     state = _load_state(cfg)
     limit = cfg.max_attempts if cfg.max_attempts is not None else 20 * cfg.num_success
-    local = _Attempter(cfg, make_solver)
-    writers = _open_exporters(cfg, local.env)
+    # the exporters need the env's names and shapes; the attempts need an env and a solver only in this process
+    local = _Attempter(cfg, make_solver) if backend.kind == "local" else None
+    env = local.env if local is not None else _make_env(cfg)
+    writers = _open_exporters(cfg, env)
     results = None
     try:
         pending = {name: _exported(w) - state.successes for name, w in writers.items()}
@@ -240,7 +242,7 @@ def collect(cfg: CollectConfig, make_solver: Callable[[], Solver],
             results.close()  # ends the workers
         for writer in writers.values():
             writer.close()
-        local.env.close()
+        env.close()
     return state
 
 
