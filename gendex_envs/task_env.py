@@ -515,16 +515,28 @@ class TaskEnv(BaseEnv):
         return self.articulations[name].links_map[record.handle_link]
 
     def handle_pos(self, name: str, joint: str | None = None) -> torch.Tensor:
-        """[N, 3] world position of the handle's grip point."""
-        jr = self.joint_record(name, joint)
-        link = self.handle_link(name, joint)
-        scale = self.task_spec.object(name).scale
-        local = torch.tensor(jr.handle_point_m, dtype=torch.float32, device=self.device) * scale
-        return transform_points(link.pose.p, link.pose.q, local)
+        """[N, 3] world position of the handle's grip point; read once per step."""
+        def compute():
+            link, local = self._handle_frame(name, joint)
+            pose = link.pose
+            return transform_points(pose.p, pose.q, local)
+        return self._cached(("handle_pos", name, joint), compute)
+
+    def _handle_frame(self, name: str, joint: str | None) -> tuple[Link, torch.Tensor]:
+        """(handle link, grip point in its frame, scaled): fixed for the env's life, so memoised."""
+        key = (name, joint)
+        cache = self.__dict__.setdefault("_handle_frames", {})
+        if key not in cache:
+            jr = self.joint_record(name, joint)
+            scale = self.task_spec.object(name).scale
+            local = torch.tensor(jr.handle_point_m, dtype=torch.float32, device=self.device) * scale
+            cache[key] = (self.handle_link(name, joint), local)
+        return cache[key]
 
     def joint_qpos(self, name: str, joint: str | None = None) -> torch.Tensor:
-        """[N] current position of ``name``'s joint (default: its main joint)."""
-        return self.articulations[name].get_qpos()[:, self.joint_index(name, joint)]
+        """[N] current position of ``name``'s joint (default: its main joint); read once per step."""
+        return self._cached(("joint_qpos", name, joint),
+                            lambda: self.articulations[name].get_qpos()[:, self.joint_index(name, joint)])
 
     def open_qpos(self, name: str, joint: str | None = None) -> float:
         return self.joint_record(name, joint).open_qpos

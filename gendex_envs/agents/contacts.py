@@ -40,10 +40,18 @@ class ContactTable:
         pair: dict[tuple[int, int], np.ndarray] = {}
         ids = self._ids
         for contact in self.scene.px.get_contacts():
-            a, b = contact.bodies[0].entity.per_scene_id, contact.bodies[1].entity.per_scene_id
+            body0, body1 = contact.bodies
+            a, b = body0.entity.per_scene_id, body1.entity.per_scene_id
             if a not in ids and b not in ids:
                 continue
-            impulse = np.sum([point.impulse for point in contact.points], axis=0)
+            points = contact.points
+            if not points:
+                impulse = np.float64(0.0)  # what np.sum([], axis=0) gave
+                points = ()
+            else:
+                impulse = points[0].impulse
+            for point in points[1:]:  # row by row, as np.sum(..., axis=0) adds them: the same float32 result
+                impulse = impulse + point.impulse
             # the impulse acts on body 0; body 1 receives the opposite (same convention as ManiSkill)
             net[a] = net.get(a, 0.0) + impulse
             net[b] = net.get(b, 0.0) - impulse
@@ -66,32 +74,37 @@ class ContactTable:
             hit = self._keys[id(body)] = (body, px_bodies(body)[0].entity.per_scene_id)
         return hit[1]
 
-    def _check(self, bodies: list[Actor | Link]) -> None:
-        outside = [b.name for b in bodies if self._id(b) not in self._ids]
-        if outside:
+    def _tracked_ids(self, bodies: list[Actor | Link]) -> list[int]:
+        """The entity ids of ``bodies``; ValueError naming any the table does not track."""
+        ids = [self._id(b) for b in bodies]
+        if not self._ids.issuperset(ids):
+            outside = [b.name for b, i in zip(bodies, ids, strict=True) if i not in self._ids]
             raise ValueError(f"contact table does not track {outside}")
+        return ids
 
     def net_impulses(self, bodies: list[Actor | Link]) -> torch.Tensor:
         """[N, B, 3] total contact impulse on each body during the last physics step."""
         if self.scene.gpu_sim_enabled:
             return torch.stack([b.get_net_contact_impulses() for b in bodies], dim=1)
-        self._check(bodies)
+        ids = self._tracked_ids(bodies)
         if self._net is None:
             self._refresh()
-        return self._rows([self._net.get(self._id(b)) for b in bodies])
+        return self._rows([self._net.get(i) for i in ids])
 
     def pair_impulses(self, bodies: list[Actor | Link], others: list[Actor | Link]) -> torch.Tensor:
         """[N, B, 3] contact impulse on each body from all of ``others`` during the last physics step."""
         if self.scene.gpu_sim_enabled:
             return torch.stack([sum(self.scene.get_pairwise_contact_impulses(b, o) for o in others)
                                 for b in bodies], dim=1)
-        self._check(bodies)
+        ids = self._tracked_ids(bodies)
         if self._net is None:
             self._refresh()
+        pair = self._pair
+        if not pair:  # nothing touches the tracked bodies (most steps of a reach)
+            return self._rows([None] * len(ids))
         other_ids = [self._id(o) for o in others]
         rows = []
-        for b in bodies:
-            bid = self._id(b)
-            hits = [self._pair[(bid, o)] for o in other_ids if (bid, o) in self._pair]
+        for bid in ids:
+            hits = [pair[(bid, o)] for o in other_ids if (bid, o) in pair]
             rows.append(np.sum(hits, axis=0) if hits else None)
         return self._rows(rows)
