@@ -61,8 +61,8 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
 
     ``trusted`` defaults to the folder's trust (:func:`gendex_envs.guard.is_trusted`: the repository's committed
     tasks, or ``trust_remote_code``). An untrusted module is first statically checked
-    (:func:`gendex_envs.code_check.check_reward_file`; :class:`~gendex_envs.errors.UnsafeCodeError` or
-    :class:`~gendex_envs.errors.RewardCodeError` before any of its code runs), then its folder goes under the
+    (:func:`gendex_envs.code_check.check_reward_file`; a rejection is a :class:`RewardModuleError` listing every
+    problem, raised before any of its code runs), then its folder goes under the
     runtime guard's audit hook and it runs with restricted builtins and read-only copies of its modules
     (:mod:`gendex_envs.guard`). ``static_check=False`` skips the static check of an untrusted module (the probe's
     tests of the runtime fences); the guard applies either way."""
