@@ -325,6 +325,8 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              gate_attempts: int = typer.Option(10, "--gate-attempts", min=0,
                                                help="Solver attempts (unseen seeds) a drafted task must pass at >= "
                                                     "80 % before it is committed; 0 skips the solvability gate."),
+             workers: int = typer.Option(1, "--workers", min=1, help="Processes running each task's gate attempts "
+                                                                    "(the same result as one)."),
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a recorded transcript (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
@@ -381,7 +383,8 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
             run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
-                         candidates=candidates, gate_attempts=gate_attempts, reading=reading, failed=failed)
+                         candidates=candidates, gate_attempts=gate_attempts, reading=reading, failed=failed,
+                         gate_workers=workers)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")

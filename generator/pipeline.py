@@ -105,7 +105,7 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
                   instruction: str | None, command: str, existing: tuple[str, ...] = (),
                   candidates: int = N_CANDIDATES, reading: Reading | None = None,
                   gate_attempts: int = GATE_ATTEMPTS, novelty: Novelty | None = None,
-                  dropped_names: set[str] | None = None) -> TaskSummary:
+                  dropped_names: set[str] | None = None, gate_workers: int = 1) -> TaskSummary:
     """Generate, validate, gate and commit one task with a fresh ``backend_factory()``, recording every exchange.
 
     With an ``instruction``: its ``reading`` (read here when not given; :class:`~generator.instruction.
@@ -114,7 +114,8 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
     (:mod:`generator.steps.gate`; 0 skips the gate), is dropped with its reason and the next one is asked for, told
     what failed; after :data:`MAX_TASK_ATTEMPTS` proposals :class:`GeneratorError` lists every reason.
     ``novelty``: the existing tasks an autonomous proposal may not duplicate (:mod:`generator.novelty`).
-    ``dropped_names``: names of proposals dropped so far in the batch (not proposed again); this task's are added."""
+    ``dropped_names``: names of proposals dropped so far in the batch (not proposed again); this task's are added.
+    ``gate_workers``: processes running the gate's attempts (the same result as one)."""
     dropped_names = set() if dropped_names is None else dropped_names
     t0 = time.perf_counter()
     if instruction is not None and reading is None:
@@ -150,7 +151,7 @@ def generate_task(backend_factory: Callable[[], Backend], root: Path, *, index: 
                       f"# {proposal.description}\n")
             _write(files.spec, header + dump_task_spec(planned))
             rewards = write_rewards(backend, planned, proposal, draft)
-            gate = run_gate(draft, proposal.name, gate_attempts) if gate_attempts else None
+            gate = run_gate(draft, proposal.name, gate_attempts, workers=gate_workers) if gate_attempts else None
             if gate is not None and not gate.passed:
                 dropped.append(f"{proposal.name}: the solver failed the solvability gate, {gate.summary()}")
                 log.warning("task %d: %s; proposing again", index, dropped[-1])
@@ -205,7 +206,8 @@ def _clear_draft(draft: Path, keep: Path) -> None:
 def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, seed: int = 0,
              instruction: str | None = None, command: str = "", progress: Callable[[TaskSummary], None] | None = None,
              candidates: int = N_CANDIDATES, gate_attempts: int = GATE_ATTEMPTS,
-             reading: Reading | None = None, failed: list[str] | None = None) -> list[TaskSummary]:
+             reading: Reading | None = None, failed: list[str] | None = None,
+             gate_workers: int = 1) -> list[TaskSummary]:
     """Generate ``n`` tasks into ``root``; tasks that exist (in ``root`` or the repository) are not proposed again.
     ``reading``: the instruction's reading when the caller has it already (read here otherwise). ``failed``: when
     given, a task slot whose proposals all failed is recorded there (with every reason) and the batch goes on;
@@ -223,7 +225,7 @@ def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, 
             summary = generate_task(backend_factory, root, index=i, seed=seed, instruction=instruction,
                                     command=command, existing=(*existing, *sorted(dropped_names)),
                                     candidates=candidates, reading=reading, gate_attempts=gate_attempts,
-                                    novelty=novelty, dropped_names=dropped_names)
+                                    novelty=novelty, dropped_names=dropped_names, gate_workers=gate_workers)
         except GeneratorError as exc:
             if failed is None or instruction is not None:
                 raise

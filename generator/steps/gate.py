@@ -23,6 +23,7 @@ record as JSON.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import logging
 import shutil
@@ -112,15 +113,33 @@ def solver_version() -> str:
     return f"gendex {generator_version()} stage executor"
 
 
+class _GateAttempter:
+    """One worker's env and solver for gate attempts (``seed -> (succeeded, steps, failure key)``)."""
+
+    def __init__(self, folder: str):
+        from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+        from gendex_envs.registry import HISTORY_FREE, make_env
+        from gendex_envs.task_version import TaskVersion
+
+        self.env = make_env(TaskVersion.at(folder), obs_mode="state", **SOLVER_ENV_KWARGS["stages"], **HISTORY_FREE)
+        self.solver = SOLVERS["stages"]()
+
+    def __call__(self, seed: int) -> tuple[bool, int, str | None]:
+        from gendex.solve.attempt import run_attempt
+
+        r = run_attempt(self.env, self.solver, seed)
+        return r.succeeded, r.steps, None if r.succeeded else r.failure.key
+
+
 def measure(folder: Path, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_MIN_RATE,
-            seeds: list[int] | None = None) -> GateResult:
+            seeds: list[int] | None = None, workers: int = 1) -> GateResult:
     """Run the gate on task-version ``folder`` in this process (what the child process does). With ``seeds``, run
-    the solver on exactly those (every one: no early stop) instead of the task's gate seeds: a re-measurement."""
+    the solver on exactly those (every one: no early stop) instead of the task's gate seeds: a re-measurement.
+    ``workers`` > 1 runs the attempts in that many processes (:mod:`gendex.fanout`); they are judged in seed order
+    with the same early stop, so the result is the one a single process gives."""
     import torch
 
-    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
-    from gendex.solve.attempt import run_attempt
-    from gendex_envs.registry import HISTORY_FREE, make_env
+    from gendex.fanout import Backend, ordered_map
     from gendex_envs.task_version import TaskVersion
 
     torch.set_num_threads(1)
@@ -128,24 +147,28 @@ def measure(folder: Path, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_
     stop_early = seeds is None
     seeds = gate_seeds(version.name, attempts) if seeds is None else list(seeds)
     attempts = len(seeds)
-    env = make_env(version, obs_mode="state", **SOLVER_ENV_KWARGS["stages"], **HISTORY_FREE)
-    solver = SOLVERS["stages"]()
     done, ok, steps, failures = 0, 0, 0, {}
+    results = ordered_map(functools.partial(_GateAttempter, str(folder)), seeds, Backend.from_options(workers))
     try:
-        for seed in seeds:
-            r = run_attempt(env, solver, seed)
+        for succeeded, n, failure in results:
             done += 1
-            steps += r.steps
-            if r.succeeded:
+            steps += n
+            if succeeded:
                 ok += 1
             else:
-                failures[r.failure.key] = failures.get(r.failure.key, 0) + 1
+                failures[failure] = failures.get(failure, 0) + 1
             if stop_early and done - ok > (1 - min_rate) * attempts + 1e-9:
                 break  # the rate can no longer reach min_rate
-        null_seeds = seeds[:NULL_ATTEMPTS] if ok >= min_rate * attempts - 1e-9 else []
-        null_ok = sum(null_solves(env, seed, version.spec.max_episode_steps) for seed in null_seeds)
     finally:
-        env.close()
+        results.close()
+    null_seeds = seeds[:NULL_ATTEMPTS] if ok >= min_rate * attempts - 1e-9 else []
+    null_ok = 0
+    if null_seeds:
+        worker = _GateAttempter(str(folder))
+        try:
+            null_ok = sum(null_solves(worker.env, seed, version.spec.max_episode_steps) for seed in null_seeds)
+        finally:
+            worker.env.close()
     return GateResult(done, ok, steps, seeds[:done], failures, "stages", solver_version(), min_rate, attempts,
                       len(null_seeds), null_ok)
 
@@ -160,13 +183,14 @@ def null_solves(env, seed: int, steps: int) -> bool:
 
 
 def run_gate(draft: Path, name: str, attempts: int = GATE_ATTEMPTS, min_rate: float = GATE_MIN_RATE,
-             timeout_s: float = GATE_TIMEOUT_S) -> GateResult:
-    """The gate on a draft folder (task files, no version layout yet) of task ``name``, in a fresh child process."""
+             timeout_s: float = GATE_TIMEOUT_S, workers: int = 1) -> GateResult:
+    """The gate on a draft folder (task files, no version layout yet) of task ``name``, in a fresh child process
+    (its attempts in ``workers`` processes)."""
     with tempfile.TemporaryDirectory(prefix="gendex-gate-") as tmp:
         folder = Path(tmp) / name / "v0"
         shutil.copytree(draft, folder)
         cmd = [sys.executable, "-m", "generator.steps.gate", str(folder), "--attempts", str(attempts),
-               "--min-rate", str(min_rate)]
+               "--min-rate", str(min_rate), "--workers", str(workers)]
         t0 = time.perf_counter()
         try:
             out = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, check=False)
@@ -189,9 +213,10 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("folder", type=Path, help="a task-version folder (<Name>/v<N>)")
     ap.add_argument("--attempts", type=int, default=GATE_ATTEMPTS)
     ap.add_argument("--min-rate", type=float, default=GATE_MIN_RATE)
+    ap.add_argument("--workers", type=int, default=1, help="processes running the attempts")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
-    result = measure(args.folder, args.attempts, args.min_rate)
+    result = measure(args.folder, args.attempts, args.min_rate, workers=args.workers)
     sys.stdout.write(json.dumps(result.to_dict(), sort_keys=True) + "\n")
 
 

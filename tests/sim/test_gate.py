@@ -46,7 +46,7 @@ def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_comm
                      GateResult(10, 9, 900, list(range(10)), {"grasp_x/grasp/slipped": 1})])
     seen = []
 
-    def fake_gate(draft, name, attempts):
+    def fake_gate(draft, name, attempts, workers=1):
         seen.append((name, sorted(p.name for p in draft.iterdir())))
         return next(verdicts)
 
@@ -66,7 +66,7 @@ def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_comm
 
 def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reason_is_given(tmp_path, monkeypatch):
     monkeypatch.setattr("generator.pipeline.run_gate",
-                        lambda draft, name, attempts: GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3}))
+                        lambda draft, name, attempts, workers=1: GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3}))
     with pytest.raises(GeneratorError, match="no proposal passed after 3 attempts.*solvability gate"):
         generate(lambda: OfflineBackend(seed=11), tmp_path, n=1, seed=0, command="test")
     assert [p for p in tmp_path.iterdir() if not p.name.startswith(".")] == []
@@ -77,7 +77,7 @@ def test_a_batch_goes_on_past_a_task_slot_without_a_task_and_reports_it(tmp_path
     second slot's task is still committed (a whole batch is not lost to one slot)."""
     verdicts = iter([GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3})] * 3
                     + [GateResult(10, 10, 900, list(range(10)), {})])
-    monkeypatch.setattr("generator.pipeline.run_gate", lambda draft, name, attempts: next(verdicts))
+    monkeypatch.setattr("generator.pipeline.run_gate", lambda draft, name, attempts, workers=1: next(verdicts))
     failed: list[str] = []
     [s] = generate(lambda: OfflineBackend(seed=11), tmp_path, n=2, seed=0, command="test", failed=failed,
                    candidates=1)
@@ -117,3 +117,23 @@ def test_a_task_that_solves_itself_fails_the_gate(repo_root):
     assert not laptop.passed and "solved by doing nothing on 1 of 1 seeds" in laptop.summary()
     apple = measure(repo_root / "generated_tasks" / "LiftApple" / "v1", attempts=1, min_rate=0.8)
     assert apple.passed and (apple.null_attempts, apple.null_successes) == (1, 0)
+
+
+def test_the_gate_on_two_worker_processes_gives_the_single_process_result(tmp_path, repo_root):
+    """`gendex generate --workers 2`: the gate's attempts run in two processes and are judged in seed order with
+    the same early stop, so the record is the one a single process writes (the failing task stops after its 3rd
+    failure either way; later attempts computed ahead are dropped)."""
+    folder = tmp_path / "FarApple" / "v0"
+    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
+    spec_path = TaskLayout(folder).spec
+    spec = yaml.safe_load(spec_path.read_text())
+    spec["name"] = "FarApple"
+    spec["success"]["conditions"][0]["min_height_m"] = 1.5
+    spec["max_episode_steps"] = 150
+    spec_path.write_text(yaml.safe_dump(spec, sort_keys=False))
+    one = measure(folder, attempts=5, min_rate=0.6)
+    two = measure(folder, attempts=5, min_rate=0.6, workers=2)
+    assert one.to_dict() == two.to_dict() and one.attempts == 3
+    ok_folder = repo_root / "generated_tasks" / "LiftApple" / "v1"
+    assert measure(ok_folder, attempts=3, min_rate=0.6).to_dict() == \
+        measure(ok_folder, attempts=3, min_rate=0.6, workers=2).to_dict()
