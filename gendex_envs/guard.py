@@ -43,6 +43,7 @@ import threading
 from pathlib import Path
 from types import FrameType
 
+from gendex_envs.code_check.rules import ALLOWED_BUILTINS, ALLOWED_MODULES, ALLOWED_PACKAGES
 from gendex_envs.errors import GenDexError
 
 log = logging.getLogger(__name__)
@@ -50,21 +51,15 @@ log = logging.getLogger(__name__)
 TRUST_ENV = "GENDEX_TRUST_REMOTE_CODE"
 """Set to 1 to trust every task folder (as ``trust_remote_code=True`` on every env)."""
 
-SAFE_BUILTINS = frozenset({
-    "abs", "all", "any", "bool", "dict", "divmod", "enumerate", "filter", "float", "frozenset", "int",
-    "isinstance", "len", "list", "map", "max", "min", "pow", "range", "reversed", "round", "set", "slice", "sorted",
-    "str", "sum", "tuple", "zip", "getattr", "hasattr", "True", "False", "None", "NotImplemented", "Ellipsis",
-    "ArithmeticError", "AssertionError", "Exception", "IndexError", "KeyError", "LookupError",
-    "NotImplementedError", "RuntimeError", "TypeError", "ValueError", "ZeroDivisionError",
-})
+SAFE_BUILTINS = ALLOWED_BUILTINS | {"True", "False", "None", "NotImplemented", "Ellipsis"}
 """The builtins a reward module runs with (the static check's allow-list plus the constants)."""
 
-ALLOWED_IMPORTS = {
-    "__future__": None, "math": None, "torch": None, "torch.nn": None, "torch.nn.functional": None,
-    "torch.linalg": None, "torch.special": None, "torch.fft": None, "gendex_envs.reward_terms": None,
-    "gendex_envs": frozenset({"reward_terms"}),
+ALLOWED_IMPORTS: dict[str, frozenset[str] | None] = {
+    "__future__": None, **dict.fromkeys(ALLOWED_MODULES),
+    **{package: frozenset(m[len(package) + 1:] for m in ALLOWED_MODULES if m.startswith(package + "."))
+       for package in ALLOWED_PACKAGES},
 }
-"""Module -> the names ``from MODULE import ...`` may take (None: any)."""
+"""Module -> the names ``from MODULE import ...`` may take (None: any); the static check's modules and packages."""
 
 _PROCESS = ("subprocess.", "os.system", "os.exec", "os.spawn", "os.fork", "os.forkpty", "os.posix_spawn", "os.kill",
             "os.killpg", "os.wait", "pty.", "os.startfile", "signal.")
@@ -95,10 +90,9 @@ class UntrustedCodeError(GenDexError, PermissionError):
 
 
 # ---------------------------------------------------------------------------------------------- restricted builtins
-_SUBMODULES = {"torch": ("nn", "linalg", "special", "fft"), "torch.nn": ("functional",), "torch.nn.functional": (),
-               "torch.linalg": (), "torch.special": (), "torch.fft": (), "gendex_envs.reward_terms": (),
-               "gendex_envs": ("reward_terms",)}
-"""The modules reward code gets, as read-only copies: module -> the submodules reachable from it."""
+_SUBMODULES = {name: tuple(sorted(m.rpartition(".")[2] for m in ALLOWED_MODULES if m.rpartition(".")[0] == name))
+               for name in [*ALLOWED_MODULES, *ALLOWED_PACKAGES] if name != "math"}
+"""The modules reward code gets, as read-only copies: module -> the allowed submodules reachable from it."""
 _WITHHELD = frozenset({"save", "load", "from_file", "compile", "manual_seed", "seed", "initial_seed", "get_rng_state",
                        "use_deterministic_algorithms", "fork_rng", "cond", "while_loop", "vmap", "export"})
 
