@@ -21,10 +21,8 @@ def test_gate_seeds_are_stable_per_task_and_far_from_every_other_seed():
     assert min(a + b) >= GATE_SEED_BASE and not set(a) & set(b)
 
 
-def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path, repo_root):
-    """LiftApple asking for a 1.5 m lift, beyond the arm's reach (the executor now lifts as high as the task asks:
-    60 cm, the height this test used first, it reaches). The gate stops as soon as 80 % can no
-    longer be reached (3 failures of 10) and names the cause."""
+def _far_apple(tmp_path, repo_root):
+    """LiftApple-v0 asking for a 1.5 m lift, beyond the arm's reach: a task the solver cannot finish."""
     folder = tmp_path / "FarApple" / "v0"
     shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
     spec_path = TaskLayout(folder).spec
@@ -33,6 +31,14 @@ def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path
     spec["success"]["conditions"][0]["min_height_m"] = 1.5
     spec["max_episode_steps"] = 150
     spec_path.write_text(yaml.safe_dump(spec, sort_keys=False))
+    return folder
+
+
+def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path, repo_root):
+    """LiftApple asking for a 1.5 m lift, beyond the arm's reach (the executor now lifts as high as the task asks:
+    60 cm, the height this test used first, it reaches). The gate stops as soon as 80 % can no
+    longer be reached (3 failures of 10) and names the cause."""
+    folder = _far_apple(tmp_path, repo_root)
     r = measure(folder, attempts=10, min_rate=0.8)
     assert not r.passed and r.successes == 0 and r.attempts == 3 and r.planned_attempts == 10
     assert r.seeds == gate_seeds("FarApple")[:3]
@@ -123,14 +129,7 @@ def test_the_gate_on_two_worker_processes_gives_the_single_process_result(tmp_pa
     """`gendex generate --workers 2`: the gate's attempts run in two processes and are judged in seed order with
     the same early stop, so the record is the one a single process writes (the failing task stops after its 3rd
     failure either way; later attempts computed ahead are dropped)."""
-    folder = tmp_path / "FarApple" / "v0"
-    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
-    spec_path = TaskLayout(folder).spec
-    spec = yaml.safe_load(spec_path.read_text())
-    spec["name"] = "FarApple"
-    spec["success"]["conditions"][0]["min_height_m"] = 1.5
-    spec["max_episode_steps"] = 150
-    spec_path.write_text(yaml.safe_dump(spec, sort_keys=False))
+    folder = _far_apple(tmp_path, repo_root)
     one = measure(folder, attempts=5, min_rate=0.6)
     two = measure(folder, attempts=5, min_rate=0.6, workers=2)
     assert one.to_dict() == two.to_dict() and one.attempts == 3
