@@ -37,7 +37,7 @@ from types import ModuleType
 from gendex_envs import guard
 from gendex_envs.code_check import check_reward_file
 from gendex_envs.errors import RewardCodeError, RewardModuleError
-from gendex_envs.reward_view import copy_tensors, view_of
+from gendex_envs.reward_view import view_args, view_of
 
 log = logging.getLogger(__name__)
 
@@ -112,7 +112,7 @@ def _through_view(fn: Callable, copied: int) -> Callable:
     def call(env, *args):
         if len(args) != copied:
             raise TypeError(f"{fn.__name__} takes env and {copied} more arguments, got {len(args)}")
-        return fn(view_of(env), *(copy_tensors(a) for a in args))
+        return fn(view_of(env), *(view_args(a) for a in args))
     call.__name__ = call.__qualname__ = fn.__name__
     call.__wrapped__ = fn
     return call

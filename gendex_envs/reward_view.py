@@ -16,15 +16,15 @@ environment-API prompt (``prompts/env_api.txt``) documents, under the same names
   (:mod:`gendex_envs.code_check`, :mod:`gendex_envs.guard`). Views have no ``__dict__``: attributes cannot
   be added or replaced.
 
-``info``, ``obs`` and ``action`` passed to reward functions are copies as well (:func:`copy_tensors`), so writing
-into ``info["success"]`` cannot change what the env reports.
+``info``, ``obs`` and ``action`` passed to reward functions are copies as well (a read-only :class:`TensorsView`
+that copies each entry read, or :func:`copy_tensors`), so writing into ``info["success"]`` cannot change what the
+env reports.
 """
 
 from __future__ import annotations
 
 import weakref
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import torch
@@ -67,21 +67,75 @@ def copy_tensors(value: Any) -> Any:
     return value
 
 
-@dataclass(frozen=True, slots=True)
-class PoseView:
-    """A pose as reward code sees it: fresh ``p`` [N, 3] and ``q`` [N, 4] (wxyz)."""
+class TensorsView(Mapping):
+    """A read-only mapping over ``obs`` or ``info`` for reward code: reading an entry returns what
+    :func:`copy_tensors` would have copied for it (a fresh tensor, nested dicts as further views), made only for the
+    entries the code reads. Most reward modules read one or two entries of ``info`` and none of ``obs``; copying all
+    of them cost about 15 us a step."""
 
-    p: torch.Tensor
-    q: torch.Tensor
+    __slots__ = ("_data",)
+
+    def __init__(self, data: Mapping):
+        object.__setattr__(self, "_data", data)
+
+    def __setattr__(self, key, value):
+        raise AttributeError(f"reward views are read-only (cannot set {key!r})")
+
+    def __getitem__(self, key):
+        value = self._data[key]
+        if isinstance(value, torch.Tensor):
+            return value.clone()
+        if isinstance(value, Mapping):
+            return TensorsView(value)
+        return copy_tensors(value)
+
+    def __iter__(self):
+        return iter(list(self._data))
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __repr__(self) -> str:
+        return f"TensorsView({list(self._data)})"
+
+
+def view_args(value: Any) -> Any:
+    """What a reward function receives for an ``obs``, ``action`` or ``info`` argument: a :class:`TensorsView` over
+    a mapping, else a deep copy (:func:`copy_tensors`)."""
+    return TensorsView(value) if isinstance(value, Mapping) else copy_tensors(value)
+
+
+class PoseView:
+    """A pose as reward code sees it: ``p`` [N, 3], ``q`` [N, 4] (wxyz) and ``raw_pose`` [N, 7], each a fresh copy
+    made when it is read (reward code mostly reads ``p`` alone)."""
+
+    __slots__ = ("_raw",)
+
+    def __init__(self, raw_pose: torch.Tensor):
+        object.__setattr__(self, "_raw", raw_pose)
+
+    def __setattr__(self, key, value):
+        raise AttributeError(f"reward views are read-only (cannot set {key!r})")
+
+    @property
+    def p(self) -> torch.Tensor:
+        return self._raw[..., :3].clone()
+
+    @property
+    def q(self) -> torch.Tensor:
+        return self._raw[..., 3:].clone()
 
     @property
     def raw_pose(self) -> torch.Tensor:
         """[N, 7]: p then q."""
-        return torch.cat([self.p, self.q], dim=-1)
+        return self._raw.clone()
+
+    def __repr__(self) -> str:
+        return f"PoseView(p={self.p.tolist()}, q={self.q.tolist()})"
 
 
 def _pose(pose) -> PoseView:
-    return PoseView(_fresh(pose.p), _fresh(pose.q))
+    return PoseView(pose.raw_pose)
 
 
 class EntityView:

@@ -17,6 +17,7 @@ of the whole env and answers a Python ``True`` for a batch, so its flag is repla
 from __future__ import annotations
 
 import gymnasium as gym
+import numpy as np
 import torch
 from mani_skill.utils import common
 
@@ -54,25 +55,44 @@ class GymApi(gym.Wrapper, gym.utils.RecordConstructorArgs):
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
-        truncated = self._truncated(truncated)
         if not self.numpy:
-            return obs, reward, terminated, truncated, info
-        obs, reward, terminated, truncated, info = common.unbatch(
-            common.to_numpy(obs), common.to_numpy(reward), common.to_numpy(terminated), common.to_numpy(truncated),
-            common.to_numpy(info))
-        return obs, float(reward), bool(terminated), bool(truncated), info
+            return obs, reward, terminated, self._truncated(truncated), info
+        base = self.env.unwrapped  # one env: the flag as a Python bool, without building a batch of one
+        ended = isinstance(truncated, torch.Tensor) and bool(truncated.any())
+        if self.max_episode_steps is not None:
+            ended = ended or bool((base.elapsed_steps >= self.max_episode_steps).any())
+        return (unbatched_numpy(obs), float(unbatched_numpy(reward)), bool(unbatched_numpy(terminated)), ended,
+                unbatched_numpy(info))
 
     def reset(self, *, seed=None, options=None):
         obs, info = self.env.reset(seed=seed, options=options)
         if not self.numpy:
             return obs, info
-        return common.unbatch(common.to_numpy(obs), common.to_numpy(info))
+        return unbatched_numpy(obs), unbatched_numpy(info)
 
     def render(self):
         frames = self.env.render()
         if self.numpy and self.render_mode in ("rgb_array", "sensors", "all"):
             return common.unbatch(common.to_numpy(frames))
         return frames
+
+
+def unbatched_numpy(value):
+    """``common.unbatch(common.to_numpy(value))`` in one pass (the same values and types): tensors become numpy
+    arrays, a leading batch dimension of one is dropped and a one-element array becomes a Python scalar."""
+    if isinstance(value, dict):
+        return {k: unbatched_numpy(v) for k, v in value.items()}
+    if isinstance(value, torch.Tensor):
+        value = value.cpu().numpy()
+    elif isinstance(value, bool | str | float | int):
+        return value
+    elif not isinstance(value, np.ndarray):
+        value = np.array(value)
+    if value.shape == (1,):
+        return value.item()
+    if value.ndim > 0 and value.shape[0] == 1:
+        return value.squeeze(0)
+    return value
 
 
 def time_limit(env: gym.Env) -> int | None:

@@ -28,22 +28,32 @@ class ContactTable:
         self.scene = scene
         self._keys: dict[int, tuple[Actor | Link, int]] = {}  # id(wrapper) -> (wrapper, kept alive; entity id)
         self._ids = frozenset(self._id(b) for b in bodies)
+        # PhysX component -> entity id of the tracked bodies, looked up by the component object itself: SAPIEN's
+        # pybind11 bindings hand out the one live Python object of a component (ManiSkill's structs and this dict
+        # keep them alive), so a dict lookup replaces two attribute reads per body of every contact
+        self._tracked = {body: body.entity.per_scene_id for b in bodies for body in px_bodies(b)[:1]}
+        self._kept: list[tuple[int, int, np.ndarray]] | None = None  # (body 0, body 1, impulse on body 0)
         self._net: dict[int, np.ndarray] | None = None
         self._pair: dict[tuple[int, int], np.ndarray] = {}
 
     def invalidate(self) -> None:
         """Forget the cached contacts (call after every physics step or state change)."""
+        self._kept = None
         self._net = None
 
     def _refresh(self) -> None:
-        net: dict[int, np.ndarray] = {}
+        kept: list[tuple[int, int, np.ndarray]] = []
         pair: dict[tuple[int, int], np.ndarray] = {}
-        ids = self._ids
+        tracked = self._tracked
         for contact in self.scene.px.get_contacts():
             body0, body1 = contact.bodies
-            a, b = body0.entity.per_scene_id, body1.entity.per_scene_id
-            if a not in ids and b not in ids:
-                continue
+            a, b = tracked.get(body0), tracked.get(body1)
+            if a is None:
+                if b is None:  # neither body is tracked
+                    continue
+                a = body0.entity.per_scene_id
+            elif b is None:
+                b = body1.entity.per_scene_id
             points = contact.points
             if not points:
                 impulse = np.float64(0.0)  # what np.sum([], axis=0) gave
@@ -53,11 +63,22 @@ class ContactTable:
             for point in points[1:]:  # row by row, as np.sum(..., axis=0) adds them: the same float32 result
                 impulse = impulse + point.impulse
             # the impulse acts on body 0; body 1 receives the opposite (same convention as ManiSkill)
-            net[a] = net.get(a, 0.0) + impulse
-            net[b] = net.get(b, 0.0) - impulse
+            kept.append((a, b, impulse))
             pair[(a, b)] = pair.get((a, b), 0.0) + impulse
             pair[(b, a)] = pair.get((b, a), 0.0) - impulse
-        self._net, self._pair = net, pair
+        self._kept, self._pair = kept, pair
+
+    def _net_sums(self) -> dict[int, np.ndarray]:
+        """Net impulse per body, summed in contact order (only on request: most steps ask only pairwise)."""
+        if self._kept is None:
+            self._refresh()
+        if self._net is None:
+            net: dict[int, np.ndarray] = {}
+            for a, b, impulse in self._kept:
+                net[a] = net.get(a, 0.0) + impulse
+                net[b] = net.get(b, 0.0) - impulse
+            self._net = net
+        return self._net
 
     def _rows(self, values: list) -> torch.Tensor:
         """[1, len(values), 3] from cached impulses (0.0 where there was no contact)."""
@@ -87,9 +108,8 @@ class ContactTable:
         if self.scene.gpu_sim_enabled:
             return torch.stack([b.get_net_contact_impulses() for b in bodies], dim=1)
         ids = self._tracked_ids(bodies)
-        if self._net is None:
-            self._refresh()
-        return self._rows([self._net.get(i) for i in ids])
+        net = self._net_sums()
+        return self._rows([net.get(i) for i in ids])
 
     def pair_impulses(self, bodies: list[Actor | Link], others: list[Actor | Link]) -> torch.Tensor:
         """[N, B, 3] contact impulse on each body from all of ``others`` during the last physics step."""
@@ -97,7 +117,7 @@ class ContactTable:
             return torch.stack([sum(self.scene.get_pairwise_contact_impulses(b, o) for o in others)
                                 for b in bodies], dim=1)
         ids = self._tracked_ids(bodies)
-        if self._net is None:
+        if self._kept is None:
             self._refresh()
         pair = self._pair
         if not pair:  # nothing touches the tracked bodies (most steps of a reach)

@@ -45,6 +45,9 @@ class FreezingJointPosController(PDJointPosController):
         self.free_joint_names = tuple(free)
         self._qlimits = self.articulation.get_qlimits()[0, self.active_joint_indices].to(device)
         """[J, 2] limits of every driven joint."""
+        free_limits = self._qlimits[self.free_idx]
+        self._free_lo, self._free_hi = free_limits[:, 0].contiguous(), free_limits[:, 1].contiguous()
+        """[F] the free joints' limits, indexed once (an action moves them every step)."""
         self._px_joints = [px_objects(joint)[0] for joint in self.joints]
 
     def set_drive_targets(self, targets: torch.Tensor):
@@ -67,10 +70,21 @@ class FreezingJointPosController(PDJointPosController):
         limits = self._get_joint_limits()
         self.single_action_space = spaces.Box(limits[:, 0], limits[:, 1], dtype=np.float32)
 
+    def _clip_and_scale_action_space(self):
+        super()._clip_and_scale_action_space()
+        # ManiSkill scales an action by mid + half * clip(action) with both halves recomputed every step; they are
+        # constants, computed here once by the same float32 operations, so the scaled actions are the same values
+        self._action_mid = 0.5 * (self.action_space_high + self.action_space_low)
+        self._action_half = 0.5 * (self.action_space_high - self.action_space_low)
+
+    def _clip_and_scale_action(self, action):
+        return self._action_mid + self._action_half * torch.clip(action, -1, 1)
+
     def set_action(self, action: Array):
         action = self._preprocess_action(action)  # [N, F]
         self._step = 0
-        self._start_qpos = self.qpos
+        if self.config.interpolate:  # the measured start is needed only to interpolate towards the target
+            self._start_qpos = self.qpos
         if self.config.use_delta:
             target = self.moved_targets(self.free_idx, action, from_qpos=not self.config.use_target)
         else:
@@ -108,9 +122,12 @@ class FreezingJointPosController(PDJointPosController):
         policy's deltas run through the stage executor's absolute controller with it."""
         target = self._target_qpos.clone()
         base = (self.qpos if from_qpos else target)[:, idx]
-        lim = self._qlimits[idx]
-        target[:, idx] = torch.clamp(base + torch.as_tensor(delta, dtype=target.dtype, device=target.device),
-                                     lim[:, 0], lim[:, 1])
+        if idx is self.free_idx:
+            lo, hi = self._free_lo, self._free_hi
+        else:
+            lim = self._qlimits[idx]
+            lo, hi = lim[:, 0], lim[:, 1]
+        target[:, idx] = torch.clamp(base + torch.as_tensor(delta, dtype=target.dtype, device=target.device), lo, hi)
         self._mimic(target)
         return target
 

@@ -172,6 +172,15 @@ class UR10eShadowHand(BaseAgent):
         order = [j.name for j in self.robot.get_active_joints()]
         return np.array([by_name[n] for n in order], dtype=np.float32)
 
+    def set_action(self, action):
+        if isinstance(action, torch.Tensor) and not self.scene.gpu_sim_enabled:
+            # ManiSkill's NaN check goes through numpy's array protocol (about 5 us); the tensor's own is cheaper
+            if torch.isnan(action).any():
+                raise ValueError("Action cannot be NaN. Environment received:", action)
+            self.controller.set_action(action)
+            return
+        super().set_action(action)
+
     # ------------------------------------------------------------------ loading
     def _after_loading_articulation(self):
         for link in self.robot.get_links():
@@ -228,8 +237,10 @@ class UR10eShadowHand(BaseAgent):
             tips = poses[..., :3] + quat_rotate(poses[..., 3:], offsets)
             return torch.cat([tips, poses[..., 3:]], dim=-1).flatten(1)
         # CPU, one env: read the five link poses from PhysX and offset them along their z axes in numpy
-        rows = np.array([[*pose.p, *pose.q] for pose in (link.entity_pose for link in self._px_tip_links)],
-                        dtype=np.float32)  # [5, 7]
+        rows = np.empty((5, 7), dtype=np.float32)
+        for row, link in zip(rows, self._px_tip_links, strict=True):
+            pose = link.entity_pose
+            row[:3], row[3:] = pose.p, pose.q
         w, x, y, z = rows[:, 3], rows[:, 4], rows[:, 5], rows[:, 6]
         z_axis = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=1)
         rows[:, :3] += z_axis * self._tip_offsets_np[:, None]
