@@ -224,8 +224,19 @@ def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Ba
         import multiprocessing
 
         pool = multiprocessing.get_context("spawn").Pool(backend.workers, _process_init, (make_worker,))
-        try:
-            yield from pool.imap(_process_call, jobs)  # in order, computed ahead in parallel
+        try:  # in order, at most ``ahead`` submitted past the last result taken (jobs are pulled lazily)
+            pending: deque = deque()
+            it = iter(jobs)
+            exhausted = False
+            while True:
+                while not exhausted and len(pending) < ahead:
+                    try:
+                        pending.append(pool.apply_async(_process_call, (next(it),)))
+                    except StopIteration:
+                        exhausted = True
+                if not pending:
+                    return
+                yield pending.popleft().get()
         finally:
             pool.terminate()
     else:
