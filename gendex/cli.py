@@ -6,6 +6,7 @@ version, as ``gym.make`` resolves it) or a version folder."""
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from pathlib import Path
@@ -325,8 +326,11 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              gate_attempts: int = typer.Option(10, "--gate-attempts", min=0,
                                                help="Solver attempts (unseen seeds) a drafted task must pass at >= "
                                                     "80 % before it is committed; 0 skips the solvability gate."),
-             workers: int = typer.Option(1, "--workers", min=1, help="Processes running each task's gate attempts "
-                                                                    "(the same result as one)."),
+             workers: int = typer.Option(1, "--workers", min=1,
+                                         help="Workers: with --n above 1, tasks are generated in parallel (the "
+                                              "committed tasks equal one process's); with one task, its gate "
+                                              "attempts run in parallel."),
+             ray: bool = ray_option(), ray_address: str = ray_address_option(),
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a recorded transcript (or a task folder holding "
                                                         "one); repeat for several tasks.")) -> None:
@@ -361,6 +365,16 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
             return ReplayBackend(pending.pop(0))
         return make_backend(name, seed=seed, model=model)
 
+    # several tasks on several workers (or Ray): the offline author's tasks in parallel. A parallel batch guesses
+    # each task's proposal ahead of time, which needs an author that answers the same question the same way; a
+    # language model does not, and a replay reads its transcripts in order, so their tasks run one after another
+    # (each task's gate attempts still fan out)
+    fan_out = workers > 1 or ray or ray_address is not None
+    tasks_on = backend_of(workers, ray, ray_address) if n > 1 and fan_out and name == "offline" else None
+    picklable = functools.partial(make_backend, name, seed=seed, model=model)
+    if n > 1 and fan_out and tasks_on is None:
+        typer.secho(f"{name}: tasks are generated one after another (only the offline author's tasks run in "
+                    "parallel); --workers runs each task's gate attempts", fg=typer.colors.YELLOW, err=True)
     reading = None
     if instruction is not None:  # how the request was read, before anything runs: substitutions are never silent
         from generator.catalog_view import asset_dicts
@@ -382,9 +396,10 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                 rows.append(summary)
                 bar.update(1)
                 bar.set_postfix(last=summary.committed.name)
-            run_generate(factory, out, n=n, seed=seed, instruction=instruction, command=command, progress=progress,
-                         candidates=candidates, gate_attempts=gate_attempts, reading=reading, failed=failed,
-                         gate_workers=workers)
+            run_generate(factory if tasks_on is None else picklable, out, n=n, seed=seed, instruction=instruction,
+                         command=command, progress=progress, candidates=candidates, gate_attempts=gate_attempts,
+                         reading=reading, failed=failed, gate_workers=workers if tasks_on is None else 1,
+                         tasks_on=tasks_on)
     except GenDexError as exc:
         _die(exc)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")

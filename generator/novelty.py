@@ -16,6 +16,7 @@ the output folder and the repository):
 
 from __future__ import annotations
 
+import copy
 import logging
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -95,6 +96,14 @@ class Novelty:
             import numpy as np
 
             self._emb = np.vstack([self._emb, embed([task.instruction])[0]])
+
+    def extended(self, tasks: Iterable[ExistingTask]) -> Novelty:
+        """A copy with ``tasks`` added one by one, as :meth:`add` adds them (this one is unchanged)."""
+        out = copy.copy(self)
+        out.existing = list(self.existing)
+        for task in tasks:
+            out.add(task)
+        return out
 
     def near_duplicate(self, signature: Signature, instruction: str) -> str | None:
         """Why a task of ``signature`` worded ``instruction`` duplicates an existing one, or None."""
