@@ -53,6 +53,7 @@ from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_
 from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
+from gendex_envs.observation import flat_float_state
 from gendex_envs.physx import read_pose
 from gendex_envs.placement import Footprint, Item, place
 from gendex_envs.reward_module import RewardModule, load_reward_module
@@ -622,13 +623,8 @@ class TaskEnv(BaseEnv):
         return extra
 
     def _flatten_raw_obs(self, obs):
-        # ManiSkill hstacks every nested dict and then the whole (common.flatten_state_dict); when every leaf is a
-        # float32 tensor, one cat of the leaves in the same order is the same tensor at a third of the cost
-        if self._obs_mode == "state":
-            leaves: list[torch.Tensor] = []
-            if _float_leaves(obs, leaves) and leaves:
-                return torch.cat(leaves, dim=1)
-        return super()._flatten_raw_obs(obs)
+        flat = flat_float_state(obs) if self._obs_mode == "state" else None
+        return flat if flat is not None else super()._flatten_raw_obs(obs)
 
     def compute_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
         return self.reward.compute_dense_reward(self, obs, action, info)
@@ -643,17 +639,3 @@ class TaskEnv(BaseEnv):
         if unknown:
             raise TaskSpecError(f"unknown cameras {unknown}; cameras: {sorted(self.scene.human_render_cameras)}")
         return {n: self.render_rgb_array(camera_name=n).cpu().numpy() for n in names}
-
-
-def _float_leaves(tree: dict, out: list[torch.Tensor]) -> bool:
-    """Append the leaves of a state dict to ``out`` in ``flatten_state_dict``'s order, each [N, D] (a [N] leaf as
-    [N, 1]); False when a leaf is not a float32 tensor of one or two dimensions (that flatten handles it)."""
-    for value in tree.values():
-        if isinstance(value, dict):
-            if not _float_leaves(value, out):
-                return False
-        elif isinstance(value, torch.Tensor) and value.dtype == torch.float32 and value.dim() in (1, 2):
-            out.append(value[:, None] if value.dim() == 1 else value)
-        else:
-            return False
-    return True
