@@ -45,7 +45,21 @@ def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path
     assert sum(r.failures.values()) == 3, r.failures
 
 
-def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_committed(tmp_path, monkeypatch):
+@pytest.fixture
+def no_renders(monkeypatch):
+    """Renders stand-in for the tests whose gate verdicts are scripted: about half of a task's generation time is
+    rendering, which these tests do not look at (tests/sim/test_generate.py checks the real renders)."""
+    from generator.render import VIEWS
+
+    def views(spec, *, seed=0, resolution=None):
+        return {view: f"{spec.name}:{view}:{seed}".encode() for view in VIEWS}
+
+    monkeypatch.setattr("generator.pipeline.render_spec", views)
+    monkeypatch.setattr("generator.steps.refine.render_spec", views)
+
+
+def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_committed(tmp_path, monkeypatch,
+                                                                                        no_renders):
     """The gate's verdicts are scripted here (the real gate runs in tests/sim/test_generate.py's offline run): the
     first proposal fails, the second passes; only the second is committed, the first is reported with why."""
     verdicts = iter([GateResult(3, 0, 300, [1, 2, 3], {"reach_x/reach/no_ik": 3}, planned_attempts=10),
@@ -70,7 +84,8 @@ def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_comm
     assert json.loads(s.committed.files.record("proposal").read_text())["name"] == second
 
 
-def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reason_is_given(tmp_path, monkeypatch):
+def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reason_is_given(tmp_path, monkeypatch,
+                                                                                           no_renders):
     monkeypatch.setattr("generator.pipeline.run_gate",
                         lambda draft, name, attempts, workers=1: GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3}))
     with pytest.raises(GeneratorError, match="no proposal passed after 3 attempts.*solvability gate"):
@@ -78,7 +93,7 @@ def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reaso
     assert [p for p in tmp_path.iterdir() if not p.name.startswith(".")] == []
 
 
-def test_a_batch_goes_on_past_a_task_slot_without_a_task_and_reports_it(tmp_path, monkeypatch):
+def test_a_batch_goes_on_past_a_task_slot_without_a_task_and_reports_it(tmp_path, monkeypatch, no_renders):
     """Three proposals of the first slot fail the gate: with ``failed`` given, the reasons are recorded there and the
     second slot's task is still committed (a whole batch is not lost to one slot)."""
     verdicts = iter([GateResult(3, 0, 0, [1, 2, 3], {"a/b/timeout": 3})] * 3
