@@ -81,6 +81,7 @@ class Novelty:
 
     def __init__(self, existing: list[ExistingTask]):
         self.existing = list(existing)
+        self._extensions: dict[tuple[ExistingTask, ...], Novelty] = {}
         self._emb = None
         self.embedding = "not loaded"
         if self.existing:
@@ -92,18 +93,26 @@ class Novelty:
 
     def add(self, task: ExistingTask) -> None:
         self.existing.append(task)
+        self._extensions = {}  # made from the tasks before this one
         if self._emb is not None:
             import numpy as np
 
             self._emb = np.vstack([self._emb, embed([task.instruction])[0]])
 
     def extended(self, tasks: Iterable[ExistingTask]) -> Novelty:
-        """A copy with ``tasks`` added one by one, as :meth:`add` adds them (this one is unchanged)."""
-        out = copy.copy(self)
-        out.existing = list(self.existing)
-        for task in tasks:
-            out.add(task)
-        return out
+        """These tasks and ``tasks``, added one by one as :meth:`add` adds them; this one is unchanged. Extensions
+        are remembered, each made from the one a task shorter, so a batch asking for 1, 2, 3 ... added tasks embeds
+        each instruction once. The result may be shared: read it, do not add to it."""
+        tasks = tuple(tasks)
+        if not tasks:
+            return self
+        hit = self._extensions.get(tasks)
+        if hit is None:
+            hit = copy.copy(self.extended(tasks[:-1]))
+            hit.existing = list(hit.existing)
+            hit.add(tasks[-1])  # also gives the copy its own (empty) extensions
+            self._extensions[tasks] = hit
+        return hit
 
     def near_duplicate(self, signature: Signature, instruction: str) -> str | None:
         """Why a task of ``signature`` worded ``instruction`` duplicates an existing one, or None."""

@@ -275,8 +275,7 @@ def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, 
             continue
         existing = (*existing, summary.committed.name)
         if novelty is not None:
-            spec = summary.committed.spec
-            novelty.add(ExistingTask(summary.committed.env_id, spec_signature(spec), spec.instruction))
+            novelty.add(_library_entry(summary.committed))
         out.append(summary)
         if progress is not None:
             progress(summary)

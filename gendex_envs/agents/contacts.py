@@ -27,11 +27,11 @@ class ContactTable:
     def __init__(self, scene, bodies: list[Actor | Link]):
         self.scene = scene
         self._keys: dict[int, tuple[Actor | Link, int]] = {}  # id(wrapper) -> (wrapper, kept alive; entity id)
-        self._ids = frozenset(self._id(b) for b in bodies)
         # PhysX component -> entity id of the tracked bodies, looked up by the component object itself: SAPIEN's
         # pybind11 bindings hand out the one live Python object of a component (ManiSkill's structs and this dict
         # keep them alive), so a dict lookup replaces two attribute reads per body of every contact
-        self._tracked = {body: body.entity.per_scene_id for b in bodies for body in px_bodies(b)[:1]}
+        self._tracked = {px_bodies(b)[0]: self._id(b) for b in bodies}
+        self._ids = frozenset(self._tracked.values())
         self._kept: list[tuple[int, int, np.ndarray]] | None = None  # (body 0, body 1, impulse on body 0)
         self._net: dict[int, np.ndarray] | None = None
         self._pair: dict[tuple[int, int], np.ndarray] = {}

@@ -68,3 +68,21 @@ def test_the_offline_author_proposes_no_duplicate_of_the_library_or_of_its_own_b
         names += (p.name,)
         taken.add(sig)
         novelty.add(ExistingTask(f"GenDex/{p.name}-v0", sig, p.description))
+
+
+def test_an_extension_equals_adding_one_by_one_leaves_the_original_and_is_made_once(novelty):
+    import numpy as np
+
+    from generator.novelty import ExistingTask
+
+    added = [ExistingTask(f"GenDex/Extra{i}-v0", (("lift",), (f"kind{i}",)), text) for i, text in
+             enumerate(["Lift the purple teapot off the counter.", "Slide the sponge under the tap."])]
+    by_add = Novelty(novelty.existing)
+    for task in added:
+        by_add.add(task)
+    before = list(novelty.existing)
+    one, two = novelty.extended(added[:1]), novelty.extended(added)
+    assert two.existing == by_add.existing and np.array_equal(two._emb, by_add._emb)
+    assert one.existing == by_add.existing[:-1] and novelty.existing == before
+    assert novelty.extended(added) is two and novelty.extended(()) is novelty
+    assert two.near_duplicate(("x",), added[1].instruction) is not None  # the added instruction is known
