@@ -279,7 +279,15 @@ class StageExecutor:
 
     # ------------------------------------------------------------------ primitives
     def _approach(self, stage) -> Iterator[np.ndarray]:
-        yield from self.rigid.approach(stage.target, self._grip_conditions(stage.target))
+        yield from self.rigid.approach(stage.target, self._grip_conditions(stage.target),
+                                       upright=self._goes_inside(stage.target))
+
+    def _goes_inside(self, name: str) -> bool:
+        """Whether a later release sets ``name`` down inside a container (an ``inside`` condition wants it there)."""
+        spec = self._env.task_spec
+        conds = (*spec.success.conditions, *(c for s in spec.stages[self.stage_index + 1:] for c in s.success or ()))
+        return any(c.type == "inside" and c.object == name and not c.negate and c.target in self._env.objects
+                   and c.target not in self._env.articulations for c in conds)
 
     def _grip_conditions(self, name: str) -> tuple:
         """The ``grasped`` conditions the next grasp stage on ``name`` declares: a grasp is only chosen if its trial

@@ -24,10 +24,12 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+import sapien
 import torch
 
 from gendex.solve.grasp import GraspPlan
 from gendex.solve.motion import ArmHandMotion
+from gendex.solve.shape import ObjectShape
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import ConditionSpec
 from gendex_envs.success import conditions_hold
@@ -45,6 +47,10 @@ STILL_M_PER_S = 0.15
 """...and moves slower than this at the end of the hold."""
 FORCE_MARGIN = 0.6
 """Fraction of a required condition's force ceiling a trial must stay under (:func:`with_margin`)."""
+UPRIGHT_SPREAD = 1.25
+"""A held object whose footprint grew by more than this factor in the trial (:func:`spread`) swung over in the
+hand: it is a poor grasp when the object must go into a container next (:meth:`GraspTrials.trial`'s caller prefers
+a grasp that keeps it upright)."""
 
 
 @dataclass(frozen=True)
@@ -82,6 +88,20 @@ def with_margin(c: ConditionSpec) -> ConditionSpec:
     return replace(c, max_palm_force_n=FORCE_MARGIN * c.max_palm_force_n)
 
 
+def spread(shape: ObjectShape, before: np.ndarray, after: np.ndarray) -> float:
+    """How much wider the object's footprint seen from above is at rotation ``after`` [3, 3] than at ``before``
+    (ratio of the diagonals of the smallest enclosing rectangles; a turn about the vertical changes nothing). A tall
+    box swung 45 degrees in the hand spreads about 2x; a ball does not spread however it turns."""
+
+    def diagonal(rot: np.ndarray) -> float:
+        m = np.eye(4)
+        m[:3, :3] = rot
+        f = shape.posed(m).footprint()
+        return float(np.hypot(f.length, f.width))
+
+    return diagonal(after) / max(diagonal(before), 1e-6)
+
+
 @dataclass(frozen=True)
 class TrialResult:
     plan: GraspPlan
@@ -93,10 +113,18 @@ class TrialResult:
     speed_m_s: float
     steps: int
     why: str = ""
+    spread: float = 1.0
+    """How much the object's footprint grew by the end of the hold (:func:`spread`; 1.0 when not measured)."""
+
+    @property
+    def upright(self) -> bool:
+        """The object kept its footprint (within :data:`UPRIGHT_SPREAD`) while held."""
+        return self.spread <= UPRIGHT_SPREAD
 
     def __str__(self) -> str:
         verdict = "held" if self.held else f"failed ({self.why})"
-        return f"{self.plan}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps"
+        tilt = "" if self.upright else f", footprint spread {self.spread:.2f}x"
+        return f"{self.plan}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps{tilt}"
 
 
 class GraspTrials:
@@ -134,10 +162,11 @@ class GraspTrials:
     def close(self) -> None:
         self.sim.close()
 
-    def trial(self, plan: GraspPlan, q_pre: np.ndarray, name: str, require: tuple[ConditionSpec, ...] = ()
-              ) -> TrialResult:
+    def trial(self, plan: GraspPlan, q_pre: np.ndarray, name: str, require: tuple[ConditionSpec, ...] = (),
+              shape: ObjectShape | None = None) -> TrialResult:
         """Try ``plan`` on object ``name`` from the pre-grasp joint vector ``q_pre`` [J] (arm and opened hand);
-        ``require``: conditions (the task's own ``grasped`` ones) that must hold at the end as well."""
+        ``require``: conditions (the task's own ``grasped`` ones) that must hold at the end as well; ``shape``: the
+        object's geometry, to measure how far it swung over in the hand (:attr:`TrialResult.spread`)."""
         self._fresh_scene()
         sim, m, speed = self.sim, self.motion, self.speed
         sim.set_state(self.main.get_state())
@@ -148,6 +177,7 @@ class GraspTrials:
         obj = sim.obj(name)
         z0 = float(obj.pose.p[0, 2])
         xy0 = obj.pose.p[0, :2].cpu().numpy()
+        rot0 = _rotation(obj.pose.q[0])
         steps = 0
         why = ""
 
@@ -181,6 +211,12 @@ class GraspTrials:
                    "the grasp stage's own conditions do not hold")
             if pushed > 0.02:
                 why += f", pushed {pushed:.3f} m while closing"
-        result = TrialResult(plan, held, rise, touching, speed_now, steps, why)
+        grew = 1.0 if shape is None else spread(shape, rot0, _rotation(obj.pose.q[0]))
+        result = TrialResult(plan, held, rise, touching, speed_now, steps, why, grew)
         log.debug("grasp trial: %s", result)
         return result
+
+
+def _rotation(q: torch.Tensor) -> np.ndarray:
+    """3x3 rotation of a wxyz quaternion."""
+    return sapien.Pose([0.0, 0.0, 0.0], q.cpu().numpy().astype(np.float64)).to_transformation_matrix()[:3, :3]

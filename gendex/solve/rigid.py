@@ -149,6 +149,7 @@ class RigidPrimitives:
         self._trials: GraspTrials | None = None
         self._synth: GraspSynthesizer | None = None
         self._require: tuple[ConditionSpec, ...] = ()
+        self._upright = False
 
     def reset(self) -> None:
         """Start an episode: nothing held, and grasp trials in a rebuilt scene (:meth:`GraspTrials.renew`)."""
@@ -190,9 +191,12 @@ class RigidPrimitives:
         return np.concatenate([pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()])
 
     # ------------------------------------------------------------------ approach and grasp
-    def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = ()) -> tuple[GraspPlan, np.ndarray]:
+    def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = (), upright: bool = False
+                     ) -> tuple[GraspPlan, np.ndarray]:
         """The first reachable grasp of ``name`` that holds in a trial (meeting the ``grasped`` conditions
-        ``require`` as well), and its pre-grasp joint vector."""
+        ``require`` as well), and its pre-grasp joint vector. ``upright`` (the object goes into a container next):
+        a grasp that let the object swing over is kept only as a fallback while the trials last (the least swung
+        one), since a tilted object's footprint catches the container's rim."""
         m, c, env = self.m, self.config, self.env
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
@@ -202,6 +206,20 @@ class RigidPrimitives:
         m.avoid_objects(exclude=(name,))
         q0 = m.target()
         reachable, results, helped_trials = 0, [], 0
+        swung: list[tuple[TrialResult, np.ndarray]] = []
+        shape_now = self._shapes[name] if upright else None
+
+        def tried(plan: GraspPlan, q: np.ndarray) -> bool:
+            """Trial ``plan`` from ``q``; True when it is the grasp to take (held, and upright where asked)."""
+            result = self.trials.trial(plan, q, name, require, shape_now)
+            results.append(result)
+            self.trial_log.append(result)
+            if result.held and not result.upright and upright:
+                swung.append((result, q))
+            elif result.held:
+                log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
+            return result.held and (result.upright or not upright)
+
         for plan in synth.candidates():
             open_q = m.with_hand(q0, plan.open_hand)
             q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
@@ -210,28 +228,22 @@ class RigidPrimitives:
             if q_at is None or m.ik.solve(lifted, q_at, restarts=0) is None:
                 continue
             reachable += 1
-            if c.max_trials == 0:
-                return plan, q_pre
-            result = self.trials.trial(plan, q_pre, name, require)
-            results.append(result)
-            self.trial_log.append(result)
-            if result.held:
-                log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
+            if c.max_trials == 0 or tried(plan, q_pre):
                 return plan, q_pre
             # it held, but the grasp stage wants more fingers on the object: the middle finger joins the index (trials
             # of these come on top of max_trials, at most half as many)
-            helped = with_middle_finger(plan, require) if missed_only_conditions(result, c.motion.lift_m) else None
+            helped = with_middle_finger(plan, require) if missed_only_conditions(results[-1], c.motion.lift_m) else None
             if helped is not None and synth.hand_clear(helped) and 2 * helped_trials < c.max_trials:
                 helped_trials += 1
                 q_helped = m.with_hand(q_pre, helped.open_hand)
-                result = self.trials.trial(helped, q_helped, name, require)
-                results.append(result)
-                self.trial_log.append(result)
-                if result.held:
-                    log.info("grasp of %r: %s (trial %d)", name, helped, len(results))
+                if tried(helped, q_helped):
                     return helped, q_helped
             if len(results) - helped_trials >= c.max_trials:
                 break
+        if swung:
+            result, q = min(swung, key=lambda rq: rq[0].spread)
+            log.info("grasp of %r: %s (no trial kept it upright)", name, result)
+            return result.plan, q
         if not reachable:
             raise ExecutionError(f"no grasp of {name!r} that the arm reaches without collision (families "
                                  f"{synth.families()})", cause="no_ik")
@@ -239,12 +251,13 @@ class RigidPrimitives:
         raise ExecutionError(f"none of {len(results)} grasps of {name!r} held in a physics trial; best: {best}",
                              cause="grasp_failed")
 
-    def approach(self, name: str, require: tuple[ConditionSpec, ...] = ()) -> Iterator[np.ndarray]:
+    def approach(self, name: str, require: tuple[ConditionSpec, ...] = (), upright: bool = False
+                 ) -> Iterator[np.ndarray]:
         m = self.m
+        self._require, self._upright = require, upright
         for attempt in range(self.config.replans + 1):
             before = self._pose_now(name)
-            plan, q_pre = self.choose_grasp(name, require)
-            self._require = require
+            plan, q_pre = self.choose_grasp(name, require, upright)
             yield from self._bring_hand(name, plan, q_pre)
             moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
             if moved <= MOVED_M or attempt == self.config.replans:
@@ -329,7 +342,7 @@ class RigidPrimitives:
                                      f"{lift:.3f} m)", cause="slipped")
             log.info("%r slipped (rose %.3f m): opening and grasping again", name, risen)
             yield from self._let_go()
-            yield from self.approach(name, self._require)
+            yield from self.approach(name, self._require, self._upright)
 
     def _ease_grip(self) -> Iterator[np.ndarray]:
         """When the grasp stage's own conditions fail only by a force ceiling (fingers pulling the object into the

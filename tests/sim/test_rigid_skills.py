@@ -76,3 +76,22 @@ def test_push_slides_the_block_onto_the_goal_without_grasping_it(task_version):
     finally:
         executor.rigid.close()
         env.close()
+
+
+def test_a_tall_box_going_into_a_bowl_is_grasped_so_that_it_stays_upright():
+    """On this seed the first grasps of the sugar box that hold let it swing over (its footprint about doubles, and
+    a swung box catches the bowl's rim). The executor keeps trying and takes one that holds it upright."""
+    from gendex.solve.attempt import run_attempt
+    from gendex.solve.grasp_trial import UPRIGHT_SPREAD
+
+    env = gym.make("GenDex/PutSugarBoxInBowl-v0", control_mode="pd_joint_pos", control_joint="both")
+    executor = StageExecutor()
+    try:
+        out = run_attempt(env, executor, 1)
+        held = [r for r in executor.rigid.trial_log if r.held]
+        assert held[0].spread > 1.8  # the first grasp that held swung the box over
+        assert executor.grasp_plan is held[-1].plan and held[-1].spread <= UPRIGHT_SPREAD
+        assert all(r.spread > UPRIGHT_SPREAD for r in held[:-1])
+        assert out.succeeded, out.failure
+    finally:
+        env.close()
