@@ -76,6 +76,9 @@ HANDOVER_MARGIN_RAD = 0.15
 HANDOVER_TORQUE_FRACTION = 0.5
 """Gravity helps enough where its torque towards the goal is at least this part of its largest on the way (joint
 friction holds a lid that is just past upright: measured, a bin lid let go at 1.3 rad stays, at 1.0 rad falls)."""
+STAY_MARGIN_RAD = 0.08
+"""A lid that must stay open is pushed this far past its balance point (gravity and the push's momentum carry it on to
+its stop)."""
 RETREAT_M = 0.08
 """After a handover the palm backs off this far against the push direction and rises as much."""
 FALL_STEPS = 40
@@ -262,6 +265,8 @@ class PressPrimitives(HandlePrimitives):
 
     def __init__(self, motion, hand_cover: Callable[..., tuple[np.ndarray, np.ndarray]], config=None):
         super().__init__(motion, config, hand_cover)
+        self._goals: dict[tuple[str, float], float] = {}
+        """The goal each press pose was chosen for (part, direction)."""
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
         if prim not in ("approach_press", "press"):
@@ -281,9 +286,43 @@ class PressPrimitives(HandlePrimitives):
                  if c.type == "joint_open" and c.object == stage.target]
         return -1.0 if conds and all(c.negate for c in conds) else 1.0
 
-    def _press_goal(self, name: str, sign: float) -> float:
+    def _press_goal(self, stage, sign: float, stay: bool = True) -> float:
+        """Where the press takes the joint: the task's closed or open fraction (a margin past it). A lid opened for
+        later stages is pushed on past its balance point (:meth:`_stays_open`), or it falls shut behind the hand."""
+        u, name = self.motion.env, stage.target
+        if sign < 0:
+            return closing_goal(u, name, PRESS_CLOSE_FRACTION)
+        goal = opening_goal(u, name)
+        later = [s.target for s in u.task_spec.stages]
+        if stay and name in later and later[::-1].index(name) > 0:  # a later stage acts on something else
+            goal = self._stays_open(name, goal)
+        return goal
+
+    def _stays_open(self, name: str, goal: float) -> float:
+        """``goal``, or where gravity no longer pulls the part back towards closed (+ :data:`STAY_MARGIN_RAD`,
+        within the limits) when it does at ``goal`` (a bin's lid); ``goal`` when no such place is in range."""
         u = self.motion.env
-        return opening_goal(u, name) if sign > 0 else closing_goal(u, name, PRESS_CLOSE_FRACTION)
+        joint = read_joint(u, name)
+        way = float(np.sign(u.open_qpos(name) - u.closed_qpos(name))) or 1.0
+        if joint.prismatic or self._gravity(name, joint, np.array([goal]), way)[0] >= 0:
+            return goal
+        lo, hi = u.articulations[name].get_qlimits()[0, u.joint_index(name)].tolist()
+        end = (hi if way > 0 else lo) - way * 0.02
+        qs = np.arange(goal, end, way * ARC_CHECK_RAD)
+        holds = np.flatnonzero(self._gravity(name, joint, qs, way) >= 0) if len(qs) else []
+        if not len(holds):
+            log.info("the %r part falls back from %.2f and has no balance point before its limit", name, goal)
+            return goal
+        beyond = float(qs[holds[0]] + way * STAY_MARGIN_RAD)
+        return min(beyond, end) if way > 0 else max(beyond, end)
+
+    def _gravity(self, name: str, joint: JointFrame, qs: np.ndarray, sign: float) -> np.ndarray:
+        """[len(qs)] gravity's torque about the hinge on the moving part at joint positions ``qs``, positive
+        where it turns the part towards ``sign`` (per unit mass: the lever arm of its centre of mass)."""
+        body = px_bodies(self.motion.env.handle_link(name))[0]
+        com = np.asarray(body.cmass_local_pose.p, dtype=np.float64)
+        return np.array([sign * float(np.dot(joint.axis, np.cross(joint.point_at(com, q) - joint.point,
+                                                                  [0.0, 0.0, -1.0]))) for q in qs])
 
     def _beyond(self, name: str, goal: float, sign: float) -> float:
         """The furthest joint position the press commands: a little past ``goal`` (within the limits)."""
@@ -296,13 +335,48 @@ class PressPrimitives(HandlePrimitives):
         u = ex.env
         joint = read_joint(u, name)
         sign = self._sign(stage)
-        goal = self._press_goal(name, sign)
-        stop = self._handover(name, joint, sign, goal)
+        goal = self._press_goal(stage, sign)
         covers: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        chosen = self._find_press(stage, joint, sign, goal, covers)
+        plain = self._press_goal(stage, sign, stay=False)
+        if chosen is None and plain != goal:
+            log.info("%r: no press reaches %.2f, where it would stay open; pressing to %.2f", name, goal, plain)
+            goal = plain
+            chosen = self._find_press(stage, joint, sign, goal, covers)
+        if chosen is None:
+            raise ExecutionError(f"no press pose on {name!r}'s moving part that the arm can reach and follow along "
+                                 f"its path", cause="no_ik")
+        pose, q_pre, q0, pre = chosen
+        log.info("%r: %s", name, pose)
+        self.grasp, self.target, self.hooked = pose, name, False
+        self._goals[name, sign] = goal
+        ex.collision.set_obstacles(self._part_boxes(name))
+        ex.collision.cover_hand(*covers[pose.site])
+        try:
+            path = ex.plan_arm(q_pre, hand=q0)
+        except ExecutionError as exc:  # the hand starts too close to something: plan the arm alone
+            log.debug("no path with the hand covered (%s): planning the arm alone", exc)
+            path = None
+        finally:
+            ex.collision.cover_hand(None)
+        if path is None:
+            yield from ex.move_arm(q_pre, hand=q0)
+        else:
+            yield from path
+        back = joint.link[:3, :3] @ pose.normal_local
+        yield from ex.cartesian(-pre * back, self.config.insert_m_per_step)
+        yield from ex.settle()
+
+    def _find_press(self, stage, joint: JointFrame, sign: float, goal: float,
+                    covers: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple | None:
+        """The first press pose (with its pre-pose joints, hand joints and pre-distance) whose open hand clears the
+        part and the table, whose pre-pose the arm reaches, and whose path the arm follows to ``goal``'s stop."""
+        ex, name = self.motion, stage.target
+        u = ex.env
+        stop = self._handover(name, joint, sign, goal)
         fixed = self._fixed_shapes(name)
         moving = self._shape(name).posed(joint.link)
         around = self._part_boxes(name)
-        chosen = None
         for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign):
             touch = pose.palm_at(joint, joint.q)
             if pose.site not in covers:
@@ -338,30 +412,8 @@ class PressPrimitives(HandlePrimitives):
             if self._chain(self._arc(pose, joint, self._beyond(name, stop, sign)), q_in, CHAIN_RESTARTS) is None:
                 log.debug("%s: arm cannot follow the path", pose)
                 continue
-            chosen = (pose, q_pre, q0, pre)
-            break
-        if chosen is None:
-            raise ExecutionError(f"no press pose on {name!r}'s moving part that the arm can reach and follow along "
-                                 f"its path", cause="no_ik")
-        pose, q_pre, q0, pre = chosen
-        log.info("%r: %s", name, pose)
-        self.grasp, self.target, self.hooked = pose, name, False
-        ex.collision.set_obstacles(around)
-        ex.collision.cover_hand(*covers[pose.site])
-        try:
-            path = ex.plan_arm(q_pre, hand=q0)
-        except ExecutionError as exc:  # the hand starts too close to something: plan the arm alone
-            log.debug("no path with the hand covered (%s): planning the arm alone", exc)
-            path = None
-        finally:
-            ex.collision.cover_hand(None)
-        if path is None:
-            yield from ex.move_arm(q_pre, hand=q0)
-        else:
-            yield from path
-        back = joint.link[:3, :3] @ pose.normal_local
-        yield from ex.cartesian(-pre * back, self.config.insert_m_per_step)
-        yield from ex.settle()
+            return pose, q_pre, q0, pre
+        return None
 
     def press(self, stage) -> Iterator[np.ndarray]:
         """Push the part along its path to the stage's goal with the open hand."""
@@ -376,7 +428,8 @@ class PressPrimitives(HandlePrimitives):
             point = touch[:3, :3] @ self.grasp.contact + touch[:3, 3] - joint.point
             radius = float(np.linalg.norm(point - np.dot(point, joint.axis) * joint.axis))
             lead = max(self.config.lead_rad, PRESS_LEAD_M / max(radius, 1e-3))
-        goal = self._press_goal(name, sign)
+        goal = self._goals.get((name, sign))
+        goal = self._press_goal(stage, sign) if goal is None else goal
         stop = self._handover(name, joint, sign, goal)
         yield from self._move_joint(stage, stop, sign, hand=self.grasp.hand, lead=lead)
         if stop == goal:
@@ -403,14 +456,10 @@ class PressPrimitives(HandlePrimitives):
         a lever, a slide)."""
         if joint.prismatic:
             return goal
-        link = self.motion.env.handle_link(name)
-        body = px_bodies(link)[0]
-        com = np.asarray(body.cmass_local_pose.p, dtype=np.float64)
         qs = np.arange(joint.q, goal, sign * ARC_CHECK_RAD)
         if len(qs) == 0:
             return goal
-        torque = np.array([sign * float(np.dot(joint.axis, np.cross(joint.point_at(com, q) - joint.point,
-                                                                    [0.0, 0.0, -1.0]))) for q in qs])
+        torque = self._gravity(name, joint, qs, sign)
         helps = torque >= max(HANDOVER_TORQUE_FRACTION * float(torque.max()), 1e-6)
         start = len(helps)
         while start > 0 and helps[start - 1]:
