@@ -19,6 +19,10 @@ from gendex_envs.errors import GenDexError
 log = logging.getLogger(__name__)
 
 
+START_SLACK_M = 0.002
+"""A path from a start in collision may go this much deeper than the start (the check's own resolution)."""
+
+
 class PlanningError(GenDexError):
     """No collision-free arm motion was found (start or goal in collision, or the search ran out of time)."""
 
@@ -41,18 +45,24 @@ class ArmPlanner:
         self.seed = int(seed)
         self._searches = 0
 
-    def segment_free(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """True when every configuration on the straight joint-space segment a→b (arm entries) is free."""
+    def segment_free(self, a: np.ndarray, b: np.ndarray, floor: float = 0.0) -> bool:
+        """True when every configuration on the straight joint-space segment a→b (arm entries) is free (its
+        clearance at least ``floor``, which a start already in collision lowers to its own)."""
         n = max(2, int(np.ceil(np.max(np.abs(b - a)) / self.check_step_rad)) + 1)
-        return all(self.collision.is_free(a + (b - a) * t) for t in np.linspace(0.0, 1.0, n))
+        return all(self._ok(a + (b - a) * t, floor) for t in np.linspace(0.0, 1.0, n))
+
+    def _ok(self, q: np.ndarray, floor: float) -> bool:
+        return self.collision.is_free(q) if floor >= 0.0 else self.collision.clearance(q) >= floor
 
     def plan(self, q_start: np.ndarray, q_goal: np.ndarray, max_step_rad: float | None = None) -> np.ndarray:
         """Waypoints [T, dof] from ``q_start`` (excluded) to ``q_goal`` (included); hand entries copy ``q_goal``.
 
         ``max_step_rad``: the densification's step for this path (default: the planner's).
         Raises :class:`PlanningError` when the goal is in collision or no path is found within the time limit.
-        A start in collision (e.g. fingers already touching an object lifted a little into the margin) is allowed:
-        the search leaves it along the straight segment toward the goal when it can.
+        A start in collision (e.g. fingers already touching an object lifted a little into the margin, a hand that
+        just pressed a door shut) is allowed: the path may not go deeper into collision than the start is, so it
+        leaves along the straight segment toward the goal when that does not go deeper, else the search finds a way
+        out (a straight segment from a hand resting on a door's front had taken the hand through the cabinet).
         """
         q_start = np.asarray(q_start, dtype=np.float64)
         q_goal = np.asarray(q_goal, dtype=np.float64)
@@ -62,10 +72,11 @@ class ArmPlanner:
         if not self.collision.is_free(q_goal):
             raise PlanningError(f"goal configuration in collision (clearance "
                                 f"{self.collision.clearance(q_goal):+.3f} m)")
-        if self.segment_free(start, q_goal) or not self.collision.is_free(start):
+        floor = min(0.0, self.collision.clearance(start) - START_SLACK_M)
+        if self.segment_free(start, q_goal, floor):
             path = [start, q_goal]
         else:
-            path = self._rrt(start, q_goal)
+            path = self._rrt(start, q_goal, floor)
         return self._densify(path, max_step_rad or self.max_step_rad)
 
     def _densify(self, path: list[np.ndarray], max_step_rad: float) -> np.ndarray:
@@ -75,7 +86,7 @@ class ArmPlanner:
             out.extend(a + (b - a) * k / n for k in range(1, n + 1))
         return np.asarray(out)
 
-    def _rrt(self, start: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
+    def _rrt(self, start: np.ndarray, goal: np.ndarray, floor: float = 0.0) -> list[np.ndarray]:
         try:
             from ompl import base as ob
             from ompl import geometric as og
@@ -105,7 +116,7 @@ class ArmPlanner:
             q[arm] = [state[i] for i in range(len(arm))]
             return q
 
-        ss.setStateValidityChecker(lambda s: self.collision.is_free(full(s)))
+        ss.setStateValidityChecker(lambda s: self._ok(full(s), floor))
         si = ss.getSpaceInformation()
         span = float(np.max(hi - lo))
         si.setStateValidityCheckingResolution(self.check_step_rad / span)

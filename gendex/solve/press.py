@@ -293,10 +293,7 @@ class PressPrimitives(HandlePrimitives):
         if sign < 0:
             return closing_goal(u, name, PRESS_CLOSE_FRACTION)
         goal = opening_goal(u, name)
-        later = [s.target for s in u.task_spec.stages]
-        if stay and name in later and later[::-1].index(name) > 0:  # a later stage acts on something else
-            goal = self._stays_open(name, goal)
-        return goal
+        return self._stays_open(name, goal) if stay and self._hand_leaves(stage) else goal
 
     def _stays_open(self, name: str, goal: float) -> float:
         """``goal``, or where gravity no longer pulls the part back towards closed (+ :data:`STAY_MARGIN_RAD`,
@@ -433,21 +430,33 @@ class PressPrimitives(HandlePrimitives):
         stop = self._handover(name, joint, sign, goal)
         yield from self._move_joint(stage, stop, sign, hand=self.grasp.hand, lead=lead)
         if stop == goal:
+            if self._hand_leaves(stage):  # off the part first: an arm planned from a hand pressed on a door snags it
+                yield from self._retreat(name)
             return
+        yield from self._retreat(name)
         ex = self.motion
-        joint = read_joint(ex.env, name)  # out of the part's way: back against the push, and up
-        touch = self.grasp.palm_at(joint, joint.q).to_transformation_matrix()
-        away = -RETREAT_M * touch[:3, :3] @ np.array([0.0, -1.0, 0.0]) + np.array([0.0, 0.0, RETREAT_M])
-        try:
-            yield from ex.cartesian(away, self.config.insert_m_per_step)
-        except ExecutionError as exc:
-            log.debug("no retreat after the handover (%s)", exc)
         for _ in range(FALL_STEPS):  # gravity carries the part on; the hand stays where it let go
             if sign * (float(ex.env.joint_qpos(name)[0]) - goal) >= 0:
                 return
             yield ex.emit(ex.target())
         raise ExecutionError(f"the joint of {name!r} stopped at {float(ex.env.joint_qpos(name)[0]):.3f} after the "
                              f"hand let it go at {stop:.3f} (goal {goal:.3f})", cause="target_not_reached")
+
+    def _retreat(self, name: str) -> Iterator[np.ndarray]:
+        """Out of the part's way: :data:`RETREAT_M` back against the push, and as much up."""
+        ex = self.motion
+        joint = read_joint(ex.env, name)
+        touch = self.grasp.palm_at(joint, joint.q).to_transformation_matrix()
+        away = -RETREAT_M * touch[:3, :3] @ np.array([0.0, -1.0, 0.0]) + np.array([0.0, 0.0, RETREAT_M])
+        try:
+            yield from ex.cartesian(away, self.config.insert_m_per_step)
+        except ExecutionError as exc:
+            log.debug("no retreat from %r (%s)", name, exc)
+
+    def _hand_leaves(self, stage) -> bool:
+        """Whether a later stage acts on something other than ``stage``'s part (the hand leaves it)."""
+        later = [s.target for s in self.motion.env.task_spec.stages]
+        return stage.target in later and later[::-1].index(stage.target) > 0
 
     def _handover(self, name: str, joint: JointFrame, sign: float, goal: float) -> float:
         """Where the press may stop: the joint position :data:`HANDOVER_MARGIN_RAD` past the point after which

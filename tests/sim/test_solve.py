@@ -109,6 +109,38 @@ def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
         planner.plan(q0, mid)
 
 
+def test_a_start_in_collision_is_left_without_going_deeper(apple_env):
+    """A hand that just pressed a door shut rests inside the cabinet's margin. The path out may not cut through the
+    cabinet on the way to its goal, as the straight segment from such a start once did."""
+    env = apple_env.unwrapped
+    apple_env.reset(seed=0)
+    ik = ArmIK(env.agent)
+    model = ArmCollisionModel(ik)
+    planner = ArmPlanner(model, time_limit_s=5.0)
+    q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
+    q1 = q0.copy()
+    q1[ik.arm[0]] += 1.2  # pan the arm sideways
+    mid = q0.copy()
+    mid[ik.arm[0]] += 0.6
+    wrist = model.sphere_centres(mid)[0][-1]
+    start_wrist = model.sphere_centres(q0)[0][-1]
+    # a pillar across the straight sweep whose side comes to 5 cm of the start's wrist sphere centre: the wrist
+    # sphere (5.5 cm) is inside the box's 2 cm margin and 0.5 cm into the box, not deep
+    lo, hi = wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08]
+    side = int(np.argmax(np.abs(wrist - start_wrist)[:2]))
+    if start_wrist[side] < wrist[side]:
+        lo[side] = start_wrist[side] + 0.05
+    else:
+        hi[side] = start_wrist[side] - 0.05
+    model.set_obstacles([Box(lo, hi, "cabinet")])
+    depth = model.clearance(q0)
+    assert depth < 0 and model.is_free(q1)  # the start is in collision, the goal free
+    assert min(model.clearance(q0 + (q1 - q0) * t) for t in np.linspace(0, 1, 60)) < depth - 0.02  # straight: deeper
+    path = planner.plan(q0, q1)
+    assert np.allclose(path[-1][ik.arm], q1[ik.arm])
+    assert min(model.clearance(q) for q in path) >= depth - 0.0021
+
+
 @pytest.mark.parametrize("seed", [0, 7])
 def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed):
     env = apple_env.unwrapped
