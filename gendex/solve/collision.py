@@ -124,3 +124,21 @@ class ArmCollisionModel:
 
     def is_free(self, q: np.ndarray) -> bool:
         return self.clearance(q) >= 0.0
+
+
+def box_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01, cell_m: float = 0.02
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii.
+    Seen from above the box is cut into cells about as wide as it is tall (at least ``cell_m``), each covered by
+    a column of spheres as wide as the cell's diagonal: one column for an object at least as tall as it is wide; a
+    layer of small spheres for a flat one (one ball as wide as a tuna can's diagonal would hang 3 cm below it)."""
+    size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
+    n = np.maximum(1, np.ceil(size[:2] / max(float(size[2]), cell_m) - 1e-9)).astype(int)
+    cell = size[:2] / n
+    r_in = float(min(cell)) / 2
+    nz = max(1, int(np.ceil(size[2] / (2 * r_in))))
+    z = np.linspace(lo[2] + shrink_m + r_in, hi[2] - shrink_m - r_in, nz) if nz > 1 else \
+        np.array([(lo[2] + hi[2]) / 2])
+    xs, ys = (lo[k] + shrink_m + cell[k] * (np.arange(n[k]) + 0.5) for k in range(2))
+    pts = np.stack(np.meshgrid(xs, ys, z, indexing="ij"), axis=-1).reshape(-1, 3)
+    return pts, np.full(len(pts), float(np.linalg.norm(cell) / 2))

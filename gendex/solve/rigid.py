@@ -11,7 +11,7 @@ Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is 
   object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from where it
   is now. Then the straight approach.
 - ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m``. If the object did not come
-  up (it slipped), the hand opens, backs off and grasps once more from the object's new pose (``regrasps``).
+  up with the hand (it slipped), the hand opens, backs off and grasps once more from where it is (``regrasps``).
 - ``lift`` — raise the held object to the task's ``lifted`` height.
 - ``carry`` — the held object over the target: a level, eased palm path where the hand's orientation can be kept,
   else a planned arm motion, the held object attached to the palm in the collision model; an object that is no
@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sapien
 
+from gendex.solve.collision import box_spheres
 from gendex.solve.grasp import (
     PALM_THICKNESS_M,
     RELEASE_HAND,
@@ -333,14 +334,16 @@ class RigidPrimitives:
             self.held = name
             yield from m.cartesian(np.array([0.0, 0.0, lift]), c.motion.lift_m_per_step, guard=True, paced=True)
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
-            if risen >= 0.5 * lift:
+            # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
+            touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
+            if risen >= 0.5 * lift and touched >= 2:
                 yield from self._ease_grip()
                 return
             self.held = None
+            why = f"rose {risen:.3f} m of {lift:.3f} m, touched by {touched} part(s) of the hand"
             if attempt == c.regrasps:
-                raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting (rose {risen:.3f} m of "
-                                     f"{lift:.3f} m)", cause="slipped")
-            log.info("%r slipped (rose %.3f m): opening and grasping again", name, risen)
+                raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting ({why})", cause="slipped")
+            log.info("%r slipped (%s): opening and grasping again", name, why)
             yield from self._let_go()
             yield from self.approach(name, self._require, self._upright)
 
@@ -405,7 +408,7 @@ class RigidPrimitives:
         goal = sapien.Pose(palm.p + (goal_center - obj_p), palm.q)
         # the held object moves with the palm: plan with it attached, against every other object (the target too)
         m.avoid_objects(exclude=(held,))
-        m.collision.attach(*_object_spheres(held_lo, held_hi), q_now)
+        m.collision.attach(*box_spheres(held_lo, held_hi), q_now)
         try:
             # a straight line, the hand level; turning about the vertical along the way where it must (an object
             # carried past the robot's base)
@@ -631,20 +634,3 @@ class RigidPrimitives:
         back = -plan.approach + np.array([0.0, 0.0, 1.0])
         yield from m.cartesian(0.05 * back / np.linalg.norm(back), 0.01)
 
-
-def _object_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01, cell_m: float = 0.02
-                    ) -> tuple[np.ndarray, np.ndarray]:
-    """Spheres covering a held object's box (shrunk a little: the fingers wrap it): [k, 3] centres, [k] radii.
-    Seen from above the box is cut into cells about as wide as it is tall (at least ``cell_m``), each covered by
-    a column of spheres as wide as the cell's diagonal: one column for an object at least as tall as it is wide; a
-    layer of small spheres for a flat one (one ball as wide as a tuna can's diagonal would hang 3 cm below it)."""
-    size = np.maximum(hi - lo - 2 * shrink_m, 1e-3)
-    n = np.maximum(1, np.ceil(size[:2] / max(float(size[2]), cell_m) - 1e-9)).astype(int)
-    cell = size[:2] / n
-    r_in = float(min(cell)) / 2
-    nz = max(1, int(np.ceil(size[2] / (2 * r_in))))
-    z = np.linspace(lo[2] + shrink_m + r_in, hi[2] - shrink_m - r_in, nz) if nz > 1 else \
-        np.array([(lo[2] + hi[2]) / 2])
-    xs, ys = (lo[k] + shrink_m + cell[k] * (np.arange(n[k]) + 0.5) for k in range(2))
-    pts = np.stack(np.meshgrid(xs, ys, z, indexing="ij"), axis=-1).reshape(-1, 3)
-    return pts, np.full(len(pts), float(np.linalg.norm(cell) / 2))

@@ -95,3 +95,31 @@ def test_a_tall_box_going_into_a_bowl_is_grasped_so_that_it_stays_upright():
         assert out.succeeded, out.failure
     finally:
         env.close()
+
+
+def test_an_object_flung_onto_something_higher_is_grasped_again(caplog):
+    """On this seed the lemon squirts out of the pinch as the hand lifts and lands on the cutting board, 5 cm above
+    the table: it rose, but nothing of the hand touches it. That is a slip (grasped again), not a grasp that held
+    (which failed the carry that followed, generated batch 52817)."""
+    import logging
+    from pathlib import Path
+
+    import yaml
+
+    from gendex.solve.attempt import run_attempt
+    from gendex_envs.spec import parse_task_spec
+
+    path = Path(__file__).parents[1] / "data" / "tasks" / "SetLemonOnCuttingBoard.yaml"
+    spec = parse_task_spec(yaml.safe_load(path.read_text()), source=str(path))
+    env = TaskEnv(task_spec=spec, control_mode="pd_joint_pos", control_joint="both", obs_mode="none",
+                  reward_mode="none", render_backend="none")
+    try:
+        with caplog.at_level(logging.INFO, logger="gendex.solve.rigid"):
+            out = run_attempt(env, StageExecutor(), 800)
+        slips = [r.getMessage() for r in caplog.records if "slipped (" in r.getMessage()]
+        assert len(slips) == 1 and "touched by 0 part(s)" in slips[0], slips
+        rose = float(slips[0].split("rose ")[1].split(" m")[0])
+        assert rose > 0.04  # it did rise, onto the board
+        assert out.succeeded, out.failure
+    finally:
+        env.close()
