@@ -37,7 +37,11 @@ N_CANDIDATES = 3
 MAX_DISTRACTORS = 2
 """Clutter a scene may add beside the proposal's objects (``distractor: true``: no stage or condition names it)."""
 MAX_ARTICULATED_HEIGHT_M = 0.6
-"""Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach."""
+"""Articulated objects stand on the table: taller ones are scaled down so their handles stay in the hand's reach..."""
+MIN_ARTICULATED_SCALE = 0.75
+"""...but no further than this: a handle bar shrinks with its appliance, and at scale 0.71 the 2 cm behind a
+fridge's bar no longer takes the hooking fingers (OpenRefrigeratorLeftHinge, dev seeds: 3/6 opened at 0.706, 8/8
+at 0.75 and at 0.8; the bar is then 0.39 m high, within reach)."""
 CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
 LIFT_HOLD_FINGERS = 1
@@ -59,7 +63,7 @@ def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
         if role == "graspable" and hand_fit_scale(size[o.name][:2], s) != s:
             scales[o.name] = _clamp_scale(hand_fit_scale(size[o.name][:2], s))
         elif role == "articulated" and size[o.name][2] * s > MAX_ARTICULATED_HEIGHT_M:
-            scales[o.name] = _clamp_scale(MAX_ARTICULATED_HEIGHT_M / size[o.name][2])
+            scales[o.name] = _clamp_scale(max(MAX_ARTICULATED_HEIGHT_M / size[o.name][2], MIN_ARTICULATED_SCALE))
     held = [n for n, r in roles.items() if r == "graspable" and n in scales]
     for o in spec.objects:
         if roles.get(o.name) == "container" and held:

@@ -116,6 +116,29 @@ def test_the_size_step_fits_a_grasped_object_to_the_hand_as_the_grasp_benchmark_
     assert adjust_sizes(spec, proposal).objects[0].scale == fitted_scale("plate")
 
 
+def test_a_tall_appliance_is_scaled_down_but_keeps_a_handle_the_fingers_fit_behind():
+    from gendex_envs.spec import parse_task_spec
+    from generator.records import Proposal, ProposedObject, ProposedStep
+    from generator.steps.scene import MAX_ARTICULATED_HEIGHT_M, MIN_ARTICULATED_SCALE
+
+    def scaled(asset: str) -> float:
+        spec = parse_task_spec({
+            "name": "OpenIt", "instruction": "Open it.",
+            "objects": [{"name": "it", "asset": asset, "pos_m": [0.5, 0.0, 0.0], "fixed": True}],
+            "stages": [{"name": "open", "instruction": "Open it.", "skill": "open", "control_joint": "both",
+                        "method": "motion_planning", "target": "it"}],
+            "success": {"description": "It is open.",
+                        "conditions": [{"type": "joint_open", "object": "it", "min_fraction": 0.5}]}})
+        proposal = Proposal("OpenIt", "Open it.", (ProposedObject("it", asset, "articulated"),),
+                            (ProposedStep("open", "it", "both", "Open it."),), {}, "joint_open")
+        return adjust_sizes(spec, proposal).objects[0].scale
+
+    fridge = next(d for d in asset_dicts() if d["id"] == "refrigerator_left_hinge")["size_m"][2]
+    assert MAX_ARTICULATED_HEIGHT_M / fridge < MIN_ARTICULATED_SCALE  # the height rule alone would shrink it more
+    assert scaled("refrigerator_left_hinge") == MIN_ARTICULATED_SCALE
+    assert scaled("cabinet_left_hinge") == 1.0  # short enough: untouched
+
+
 def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
     """Stack, push and every measured articulated layout (close a door or drawer, open or close a lid, turn a lever):
     the scene parses with the task schema, starts the joint where the reference task measured it, and the composed
