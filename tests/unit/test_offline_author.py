@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 
+import numpy as np
 import pytest
 
 from gendex_envs.spec import spec_to_dict
@@ -178,6 +179,35 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
                 assert abs(obj["pos_m"][0] - layout["pos_m"][0]) <= 0.02 + 1e-9
                 laid_out += 1
     assert laid_out == len(ARTICULATED_LAYOUTS)
+
+
+def test_a_lid_opened_before_other_steps_is_laid_out_where_it_can_be_pushed_past_its_balance():
+    """A lid the hand leaves for other objects must stay open: the press follows it past its balance point, which
+    the hand reaches with the large box further out and the tall bin nearer in (``composed_pos_m``)."""
+    from generator.backends.offline import ARTICULATED_LAYOUTS
+    from generator.steps.propose import parse_proposal
+
+    b = OfflineBackend(seed=4)
+    options = b._task_options(list(asset_dicts()))
+    checked = set()
+    for asset in ("box_with_lid_large", "trash_can_tall"):
+        layout = ARTICULATED_LAYOUTS["open", asset]
+        single = next(o for k, o in options if k != "composed" and o["objects"][0]["asset"] == asset
+                      and o["name"].startswith("Open"))
+        composed = next(o for k, o in options if k == "composed" and o["objects"][0]["asset"] == asset
+                        and o["name"].startswith("Open"))
+        for raw, where in ((single, layout["pos_m"]), (composed, layout["composed_pos_m"])):
+            p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+            ids = {o.asset for o in p.objects}
+            context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+                       "candidate_index": 0, "index": 0, "attempt": 0}
+            spec = spec_to_dict(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p))
+            lid = next(o for o in spec["objects"] if o["asset"] == asset)
+            assert np.allclose(lid["pos_m"][:2], where, atol=0.02 + 1e-9), (raw["name"], lid["pos_m"])
+            checked.add(raw["name"])
+    assert len(checked) == 4
+    assert ARTICULATED_LAYOUTS["open", "box_with_lid_large"]["composed_pos_m"][0] > 0.5  # further out
+    assert ARTICULATED_LAYOUTS["open", "trash_can_tall"]["composed_pos_m"][0] < 0.55  # nearer in
 
 
 def test_scenes_may_carry_clutter_that_no_stage_or_condition_names():
