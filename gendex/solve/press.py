@@ -298,21 +298,19 @@ class PressPrimitives(HandlePrimitives):
 
     def _stays_open(self, name: str, goal: float) -> float:
         """``goal``, or where gravity no longer pulls the part back towards closed (+ :data:`STAY_MARGIN_RAD`,
-        within the limits) when it does at ``goal`` (a bin's lid); ``goal`` when no such place is in range."""
+        within the limits) when it does at ``goal`` (a bin's lid); ``goal`` when no such place is in range. Opening
+        turns the joint towards its upper limit, as everywhere in the press."""
         u = self.motion.env
         joint = read_joint(u, name)
-        way = float(np.sign(u.open_qpos(name) - u.closed_qpos(name))) or 1.0
-        if joint.prismatic or self._gravity(name, joint, np.array([goal]), way)[0] >= 0:
+        if joint.prismatic or self._gravity(name, joint, np.array([goal]), 1.0)[0] >= 0:
             return goal
-        lo, hi = u.articulations[name].get_qlimits()[0, u.joint_index(name)].tolist()
-        end = (hi if way > 0 else lo) - way * 0.02
-        qs = np.arange(goal, end, way * ARC_CHECK_RAD)
-        holds = np.flatnonzero(self._gravity(name, joint, qs, way) >= 0) if len(qs) else []
+        end = float(u.articulations[name].get_qlimits()[0, u.joint_index(name), 1]) - 0.02
+        qs = np.arange(goal, end, ARC_CHECK_RAD)
+        holds = np.flatnonzero(self._gravity(name, joint, qs, 1.0) >= 0) if len(qs) else []
         if not len(holds):
             log.info("the %r part falls back from %.2f and has no balance point before its limit", name, goal)
             return goal
-        beyond = float(qs[holds[0]] + way * STAY_MARGIN_RAD)
-        return min(beyond, end) if way > 0 else max(beyond, end)
+        return min(float(qs[holds[0]]) + STAY_MARGIN_RAD, end)
 
     def _gravity(self, name: str, joint: JointFrame, qs: np.ndarray, sign: float) -> np.ndarray:
         """[len(qs)] gravity's torque about the hinge on the moving part at joint positions ``qs``, positive

@@ -83,19 +83,23 @@ def test_attached_object_moves_with_the_palm_in_the_collision_model(apple_env):
     assert model.is_free(q)
 
 
-def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
+def _pan(apple_env):
+    """A planner at the rest pose q0, the goal q1 with the arm panned 1.2 rad sideways, and the half-way pose."""
     env = apple_env.unwrapped
     apple_env.reset(seed=0)
     ik = ArmIK(env.agent)
     model = ArmCollisionModel(ik)
     planner = ArmPlanner(model, time_limit_s=5.0)
     q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
-    q1 = q0.copy()
-    q1[ik.arm[0]] += 1.2  # pan the arm sideways
-    mid = q0.copy()
+    q1, mid = q0.copy(), q0.copy()
+    q1[ik.arm[0]] += 1.2
     mid[ik.arm[0]] += 0.6
-    centres, _ = model.sphere_centres(mid)
-    wrist = centres[-1]
+    return ik, model, planner, q0, q1, mid
+
+
+def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
+    ik, model, planner, q0, q1, mid = _pan(apple_env)
+    wrist = model.sphere_centres(mid)[0][-1]
     model.set_obstacles([Box(wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08], "pillar")])
     assert model.is_free(q0) and model.is_free(q1)
     assert not planner.segment_free(q0, q1)
@@ -112,16 +116,7 @@ def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
 def test_a_start_in_collision_is_left_without_going_deeper(apple_env):
     """A hand that just pressed a door shut rests inside the cabinet's margin. The path out may not cut through the
     cabinet on the way to its goal, as the straight segment from such a start once did."""
-    env = apple_env.unwrapped
-    apple_env.reset(seed=0)
-    ik = ArmIK(env.agent)
-    model = ArmCollisionModel(ik)
-    planner = ArmPlanner(model, time_limit_s=5.0)
-    q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
-    q1 = q0.copy()
-    q1[ik.arm[0]] += 1.2  # pan the arm sideways
-    mid = q0.copy()
-    mid[ik.arm[0]] += 0.6
+    ik, model, planner, q0, q1, mid = _pan(apple_env)
     wrist = model.sphere_centres(mid)[0][-1]
     start_wrist = model.sphere_centres(q0)[0][-1]
     # a pillar across the straight sweep whose side comes to 5 cm of the start's wrist sphere centre: the wrist
