@@ -58,7 +58,8 @@ def list_tasks() -> None:
         objects = ", ".join(f"{o.name}({o.asset})" for o in spec.objects)
         policies = ", ".join(version.artifacts.policy_stages()) or "none"
         origin = version.provenance()
-        made = ("promoted from " + origin["promotion"]["source"] if "promotion" in origin
+        made = ("reworded from " + origin["reword"]["source"] if "reword" in origin
+                else "promoted from " + origin["promotion"]["source"] if "promotion" in origin
                 else f"generated ({origin['generation']['backend']})" if "generation" in origin else "hand-written")
         gate = origin.get("solvability")
         solved = ("not measured by the solvability gate" if gate is None else
@@ -86,6 +87,30 @@ def stats(as_json: bool = typer.Option(False, "--json", help="Print the numbers 
 
     numbers = library_stats(registered_tasks(), all_versions=all_versions, diversity=diversity)
     typer.echo(json.dumps(numbers, indent=1) if as_json else format_stats(numbers))
+
+
+@app.command()
+def reword(keep: list[str] = typer.Option([], "--keep", help="Task names whose instruction stays (repeatable)."),
+           dry_run: bool = typer.Option(False, "--dry-run", help="Print the new wordings; publish nothing.")) -> None:
+    """Reword the library: each task's command framed by the situation and purpose least like the other tasks'
+    instructions (all-MiniLM-L6-v2, the 'stats' extra), each change published as the task's next version."""
+    from gendex_envs.registry import registered_tasks
+    from generator.reword import plan_rewording, publish_reworded
+
+    versions = registered_tasks()
+    unknown = sorted(set(keep) - {v.name for v in versions.values()})
+    if unknown:
+        raise typer.BadParameter(f"no registered task named {', '.join(unknown)}", param_hint="--keep")
+    changes, numbers = plan_rewording(versions, keep=keep)
+    for c in changes:
+        typer.echo(f"{c.env_id}\n    was: {c.old}\n    now: {c.new}")
+        if not dry_run:
+            record = {"reason": "gendex reword: the library's wording", "library": numbers}
+            published = publish_reworded(versions[c.env_id], c.new, record)
+            typer.echo(f"    published {published.env_id}")
+    typer.echo(f"{numbers['reworded']} of {numbers['tasks']} tasks reworded{' (dry run)' if dry_run else ''}; "
+               f"mean pairwise MiniLM cosine {numbers['mean_pairwise_cosine_before']:.3f} -> "
+               f"{numbers['mean_pairwise_cosine_after']:.3f}")
 
 
 @app.command()

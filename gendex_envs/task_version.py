@@ -53,8 +53,8 @@ DRAFTS = ".drafts"
 """Hidden folder of a task root where versions are assembled before they are published (never registered)."""
 VERSION_DIR = re.compile(r"^v(\d+)$")
 RECORDS = ("generation", "proposal", "scene_candidates", "critique", "reward_attempts", "solvability", "promotion",
-           "run")
-"""JSON records a folder may hold (how it was generated, promoted or trained)."""
+           "reword", "run")
+"""JSON records a folder may hold (how it was generated, promoted, reworded or trained)."""
 
 
 class TaskLayout:

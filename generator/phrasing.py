@@ -10,15 +10,19 @@ task from four seeded choices:
 - the **names** of its objects, drawn from the words a person would use for that catalog category (the same
   synonyms :mod:`generator.instruction` reads back: *cupboard*, *tap*, *bin*, *dresser*);
 - an optional **situation** before the command and an optional **purpose** after it, both from pools keyed by what
-  the main object is (fruit, packaged food, a ball, a toy, a tool, kitchenware, furniture, an appliance ...).
+  the main object is (fruit, packaged food, a ball, a toy, a tool, kitchenware, furniture, an appliance ...) and,
+  for a part that opens or closes something, by which (:data:`SITUATIONS_DIRECTED`, :data:`PURPOSES_DIRECTED`).
   They say why someone would want the task done; they never add a condition the task does not check.
 
-The choice is a pure function of the ``rng`` given, so a seeded author words the same task the same way.
+The choice is a pure function of the ``rng`` given, so a seeded author words the same task the same way; or, with a
+``choose`` function, the framing is picked from every one the command allows (:func:`framings`; the least like a
+library's instructions: :mod:`generator.reword`). :func:`split` takes a written instruction apart again.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +69,9 @@ MODEL_WORDS: dict[str, str] = {
 model): two tasks on sibling models must not read alike."""
 
 SURFACES = ("table", "tabletop", "counter", "worktop")
+
+Chooser = Callable[[list[str]], str]
+"""Picks one sentence of those the author could write for a task."""
 
 COMMANDS: dict[str, tuple[str, ...]] = {
     "lift": (
@@ -151,66 +158,138 @@ SITUATIONS: dict[str, tuple[str, ...]] = {
               "A guest who just ran a marathon asked for something fresh",
               "The fruit salad for the school fair is one piece short", "Market day left produce everywhere",
               "The nutritionist wants every snack weighed and logged", "A still-life painter is arranging a scene",
-              "The smoothie blender is already humming"),
+              "The smoothie blender is already humming", "Grandma is making jam this afternoon",
+              "The orchard tour ends with a tasting", "Harvest festival decorations go up at noon",
+              "A vegan cookery workshop starts shortly", "The greengrocer's van has just unloaded",
+              "Tomorrow's packed lunch needs something sweet"),
     "food": ("The pantry shelf is being restocked after the delivery", "Tonight's curry recipe is being gathered",
              "The food bank volunteers are sorting donations", "Lunch boxes are being packed for the school trip",
              "The camping trip leaves at dawn", "A stock-take of the corner shop is under way",
-             "The cooking show goes live in ten minutes"),
+             "The cooking show goes live in ten minutes", "The student flat's shelves are nearly empty",
+             "A charity bake sale needs ingredients counted", "The hiking club is packing provisions",
+             "Supper for the night shift is being prepared", "The shopping list has been ticked off twice"),
     "ball": ("Playtime in the garden has ended and it is getting dark", "The sports bag is being packed for Saturday",
              "Tennis practice at the club is over", "The puppy keeps chasing anything that rolls",
-             "The PE teacher is counting equipment after class", "A rainy afternoon moved the games indoors"),
+             "The PE teacher is counting equipment after class", "A rainy afternoon moved the games indoors",
+             "The juggling lesson has just finished", "Summer camp's equipment shed gets inspected today",
+             "The neighbours' children left their games behind", "A coach is setting up drills for the under-tens",
+             "The caretaker is locking the gym for the holidays"),
     "toy": ("The playroom floor must be clear by bedtime", "A toddler is learning shapes and colours",
             "The nursery is being tidied before the parents arrive", "Game night starts in five minutes",
-            "The kindergarten teacher is setting up a counting lesson", "A toy shop window display is being built"),
+            "The kindergarten teacher is setting up a counting lesson", "A toy shop window display is being built",
+            "Grandchildren are visiting this weekend", "The babysitter is tidying after a long afternoon",
+            "A birthday party for a four-year-old is winding down", "The charity shop is pricing donated games",
+            "The museum of childhood is rearranging an exhibit"),
     "tool": ("The workbench is being cleared after fixing the bicycle", "A carpenter needs a hand in the workshop",
-             "The toolbox is being sorted into trays", "The art class is packing up for the weekend",
-             "The garage sale opens in an hour", "The repair café has a queue of broken lamps"),
-    "kitchenware": ("The dishwasher has just finished its cycle", "Dinner guests are parking outside",
+             "The art class is packing up for the weekend",
+             "The garage sale opens in an hour", "The repair café has a queue of broken lamps",
+             "The shed roof is being patched before the storm", "A model railway is being rebuilt in the loft",
+             "The sculptor's studio gets swept on Fridays", "A volunteer is mending fences at the allotment"),
+    "kitchenware": ("Dinner guests are parking outside",
                     "The restaurant kitchen is being cleaned before closing", "The café counter needs clearing",
-                    "A baking class is about to start", "The holiday cottage must be spotless for check-in"),
+                    "A baking class is about to start", "The holiday cottage must be spotless for check-in",
+                    "The washing-up has been dried and stacked", "A food photographer is styling a shoot",
+                    "The canteen opens for breakfast at seven", "A wedding buffet is being laid out",
+                    "The caterers are packing their van"),
     "furniture": ("The bedroom is being tidied before the decorators come", "Moving day: every item is being checked",
                   "The hallway should look neat for the estate agent", "Spring cleaning has begun",
-                  "A burglar alarm test needs every cupboard checked", "The hotel room is being made up"),
-    "appliance": ("The kitchen is being shut down for the night", "Lunch needs heating up before the meeting",
-                  "The landlord is inspecting every appliance", "The leftovers from the party are waiting",
-                  "A power cut just ended", "The office kitchen is shared by thirty people"),
-    "fixture": ("The sink is full of dirty dishes", "The houseplants by the window are wilting",
-                "Someone has just come in from the muddy garden", "The kettle is empty and tea is overdue"),
+                  "The hotel room is being made up",
+                  "An antiques dealer is valuing the furniture", "The removal van is booked for Monday",
+                  "The guest room is being aired for visitors", "A carpenter is checking every hinge and runner",
+                  "The landlady is doing the yearly inventory"),
+    "appliance": ("Lunch needs heating up before the meeting", "The landlord is inspecting every appliance",
+                  "A power cut just ended", "The office kitchen is shared by thirty people",
+                  "The electrician is testing the sockets", "A student is cooking for the first time",
+                  "The home help comes round on Tuesdays", "The show kitchen is open to viewers today"),
+    "cold": ("The weekly shop has just been delivered", "A heatwave is forecast for the weekend",
+             "The picnic drinks need chilling", "Leftover soup has cooled down enough",
+             "The milk delivery has just arrived", "The freezer compartment is being defrosted"),
+    "fixture": ("The houseplants by the window are wilting",
+                "Someone has just come in from the muddy garden", "The kettle is empty and tea is overdue",
+                "The plumber wants to check the water pressure", "The paint brushes need rinsing",
+                "A hot summer day has left everyone thirsty", "The dog's water needs topping up"),
     "box": ("The craft supplies are being put away", "Parcels are being sorted in the mailroom",
-            "The attic is being reorganised after the flood", "A treasure hunt clue is hidden somewhere",
-            "The remote control needs new batteries"),
+            "The attic is being reorganised after the flood", "The study is being dusted for the week",
+            "A photographer is packing up after a shoot", "The office is closing for the holidays"),
     "waste": ("The floor is littered with scraps", "Rubbish collection is tomorrow morning",
-              "Peelings from the stew need throwing away", "The flies are getting in"),
+              "The recycling rota says it is your turn", "The office party has just wound down",
+              "A picnic has left wrappers everywhere", "The workshop bench is covered in offcuts"),
 }
-"""Situations a command may follow (``"<situation>: <command>."``), by what the main object is."""
+"""Situations a command may follow (``"<situation>: <command>."``), by what the main object is; ``{s}`` a word
+for the table. No situation names a catalog object, nor presumes the task opens or closes something (those are in
+:data:`SITUATIONS_DIRECTED`)."""
+
+SITUATIONS_DIRECTED: dict[tuple[str, str], tuple[str, ...]] = {
+    ("appliance", "open"): ("The leftovers from the party are waiting", "Breakfast porridge is ready to come out",
+                            "A cake has to be checked for doneness"),
+    ("appliance", "close"): ("The kitchen is being shut down for the night", "The timer has just been set"),
+    ("cold", "open"): ("The butter is needed for the toast", "Someone wants a cold drink"),
+    ("cold", "close"): ("The door alarm keeps beeping", "The ice cream is starting to melt"),
+    ("furniture", "open"): ("Someone is hunting for a spare key", "The winter coats have to come out",
+                            "A birthday present is hidden somewhere"),
+    ("furniture", "close"): ("The toddler keeps bumping into everything", "The cat likes to climb inside anything",
+                             "The room has to look finished for the photographs"),
+    ("box", "open"): ("The remote control needs new batteries", "A treasure hunt clue is hidden somewhere",
+                      "The birthday candles are packed away somewhere", "Someone needs the spare charger"),
+    ("box", "close"): ("The dust sheets are going on before the painting", "The sand from the beach gets everywhere",
+                       "The desk is being cleared for the night"),
+    ("waste", "open"): ("Peelings from the stew need throwing away", "The vegetables have just been trimmed",
+                        "The post came with a pile of junk mail"),
+    ("waste", "close"): ("The flies are getting in", "The fox raided the garden last night",
+                         "Guests are arriving and the kitchen should smell fresh"),
+}
+"""Situations that only suit a task that opens (or turns on) or one that closes something."""
 
 PURPOSES: dict[str, tuple[str, ...]] = {
     "fruit": ("so it can be washed", "before it bruises", "for a healthy snack", "to go with the yoghurt",
-              "ready for the juicer", "so the wasps leave it alone"),
+              "ready for the juicer", "so the wasps leave it alone", "for the children's afternoon break",
+              "so it can be peeled later", "to count the day's portions"),
     "food": ("so the recipe can start", "to check its best-before date", "ready for the picnic",
-             "for the pantry inventory", "before the ants find it"),
-    "ball": ("so nobody trips over it", "ready for the next match", "to show the coach", "before the dog steals it"),
+             "for the pantry inventory", "before the ants find it", "so the label can be read",
+             "ready for the hungry hikers", "for the weekly meal plan"),
+    "ball": ("so nobody trips over it", "ready for the next match", "to show the coach", "before the dog steals it",
+             "before it rolls under the sofa", "so it is not lost again", "for the team photograph"),
     "toy": ("so the child can see it", "before the toddler wakes up", "for the toy photo shoot",
-            "to finish the lesson"),
+            "to finish the lesson", "so nobody steps on it", "before the parents come to collect"),
     "tool": ("so the job can continue", "to hand it to the mechanic", "before it gets lost",
-             "so the bench can be swept"),
+             "so the bench can be swept", "before anyone cuts themselves", "so it can be oiled"),
     "kitchenware": ("so the table can be wiped", "before the guests sit down", "ready for dinner service",
-                    "to make space for the cake"),
-    "furniture": ("to air out the room", "so the hallway looks tidy", "to get at what is stored inside",
-                  "before the inspection"),
-    "appliance": ("to check on the food", "to save energy", "so the kitchen can be cleaned",
-                  "before anything spoils"),
-    "fixture": ("to fill the kettle", "to rinse the vegetables", "to water the basil"),
-    "box": ("to find the batteries", "to check what is inside", "so the dust stays out"),
-    "waste": ("so the scraps can go in", "to keep the smell in", "before the cat gets curious"),
+                    "to make space for the cake", "so the crumbs can be brushed off", "before the inspector arrives"),
+    "furniture": ("before the inspection", "before the viewing starts"),
+    "appliance": ("so the kitchen can be cleaned", "before the landlord arrives"),
+    "cold": ("before the shopping is unpacked",),
+    "fixture": ("to fill the kettle", "to rinse the vegetables", "to water the basil", "to wash the mud off",
+                "so the sink can be scrubbed"),
+    "box": ("before the visitors come",),
+    "waste": ("before the rubbish is collected",),
 }
-"""Reasons a command may end with (``"<command>, <purpose>."``), by what the main object is."""
+"""Reasons a command may end with (``"<command>, <purpose>."``), by what the main object is of the part done
+last; those that fit only an opening or a closing are in :data:`PURPOSES_DIRECTED`."""
+
+PURPOSES_DIRECTED: dict[tuple[str, str], tuple[str, ...]] = {
+    ("appliance", "open"): ("to check on the food", "to let the steam out", "to take out the warm leftovers"),
+    ("appliance", "close"): ("to save energy", "to keep the heat in"),
+    ("cold", "open"): ("to take out the milk", "to see what needs using up"),
+    ("cold", "close"): ("to keep the food cold", "before anything spoils", "to save energy"),
+    ("furniture", "open"): ("to air out the room", "to get at what is stored inside", "to find the spare towels"),
+    ("furniture", "close"): ("so the hallway looks tidy", "so nobody walks into it", "to keep the dust out"),
+    ("box", "open"): ("to find the batteries", "to check what is inside", "to take out the receipts"),
+    ("box", "close"): ("so the dust stays out", "to keep the contents dry", "before it gets knocked over"),
+    ("waste", "open"): ("so the scraps can go in", "to throw away the wrappers"),
+    ("waste", "close"): ("to keep the smell in", "before the cat gets curious", "to keep the flies off"),
+}
+"""Reasons that only suit a task that opens (or turns on) or one that closes something."""
+
+LEGACY_SITUATIONS = ("The sink is full of dirty dishes", "The dishwasher has just finished its cycle",
+                     "A burglar alarm test needs every cupboard checked", "The toolbox is being sorted into trays")
+"""Situations earlier versions of the author used and no longer do (they name catalog objects); kept so
+:func:`split` still takes them off instructions already written."""
 
 SHAPES = (0.4, 0.7, 0.9)
 """Cumulative shares of the sentence shapes: situation + command, command + purpose, all three, the bare command."""
 
-DOMAIN_OF_CATEGORY = {"trash_can": "waste", "box_with_lid": "box", "faucet": "fixture", "valve": "fixture",
-                      "laptop": "box", "knob": "appliance"}
+DOMAIN_OF_CATEGORY = {"refrigerator": "cold", "trash_can": "waste", "box_with_lid": "box", "faucet": "fixture",
+                      "valve": "fixture", "laptop": "box", "knob": "appliance"}
 DOMAIN_OF_TAG = (("fruit", "fruit"), ("food", "food"), ("ball", "ball"), ("toy", "toy"), ("tool", "tool"),
                  ("utensil", "kitchenware"), ("kitchenware", "kitchenware"), ("tableware", "kitchenware"),
                  ("appliance", "appliance"), ("furniture", "furniture"), ("fixture", "fixture"), ("box", "box"))
@@ -263,19 +342,70 @@ def command(part: Part, rng: np.random.Generator, surface: str) -> str:
 
 
 def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | None = None,
-           main_qualifier: str = "", other_qualifier: str = "") -> str:
-    """An instruction for one :class:`Part` (see there for the arguments)."""
-    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier)], rng)
+           main_qualifier: str = "", other_qualifier: str = "", choose: Chooser | None = None) -> str:
+    """An instruction for one :class:`Part` (see there and :func:`phrase_parts` for the arguments)."""
+    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier)], rng, choose=choose)
 
 
-def phrase_parts(parts: list[Part], rng: np.random.Generator) -> str:
+def direction(skill: str) -> str | None:
+    """``"open"`` for a skill that opens or turns something on, ``"close"`` for one that closes, else None."""
+    if skill.startswith("open_") or skill == "turn":
+        return "open"
+    if skill.startswith("close_"):
+        return "close"
+    return None
+
+
+@dataclass(frozen=True)
+class Frame:
+    """What the situation or purpose of a sentence is about: the domain of a part's main object and whether that
+    part opens or closes something (None: neither)."""
+
+    domain: str
+    direction: str | None = None
+
+    @classmethod
+    def of(cls, part: Part) -> Frame:
+        return cls(domain(part.main), direction(part.skill))
+
+
+def situations(frame: Frame) -> tuple[str, ...]:
+    """The situations that suit ``frame`` (``{s}`` still to fill in)."""
+    return SITUATIONS[frame.domain] + SITUATIONS_DIRECTED.get((frame.domain, frame.direction or ""), ())
+
+
+def purposes(frame: Frame) -> tuple[str, ...]:
+    """The purposes that suit ``frame``."""
+    return PURPOSES[frame.domain] + PURPOSES_DIRECTED.get((frame.domain, frame.direction or ""), ())
+
+
+def framings(text: str, first: Frame, last: Frame, surface: str) -> list[str]:
+    """Every sentence the author may make of the bare command ``text``: alone, after a situation about ``first``,
+    before a purpose about ``last``, or both (the bare command first)."""
+    sits = [x.format(s=surface) for x in situations(first)]
+    purps = purposes(last)
+    out = [_sentence(text)]
+    out += [_sentence(f"{x}: {text}") for x in sits]
+    out += [_sentence(f"{text}, {p}") for p in purps]
+    out += [_sentence(f"{x}: {text}, {p}") for x in sits for p in purps]
+    return out
+
+
+def phrase_parts(parts: list[Part], rng: np.random.Generator, choose: Chooser | None = None) -> str:
     """An instruction for a task of one or more parts done in turn (*..., then ...*), with a situation from the
-    first part's main object and a purpose from the last one's (or neither, or one of them)."""
+    first part's main object and a purpose from the last one's (or neither, or one of them).
+
+    Without ``choose`` the sentence's shape, situation and purpose are drawn from ``rng``; with it, ``choose`` picks
+    from every framing of the drawn command (:func:`framings`), e.g. the one least like the library's
+    instructions (:class:`generator.reword.LibraryWording`)."""
     surface = _pick(rng, SURFACES)
     text = ", then ".join(command(p, rng, surface) for p in parts)
+    first, last = Frame.of(parts[0]), Frame.of(parts[-1])
+    if choose is not None:
+        return choose(framings(text, first, last, surface))
     shape = rng.random()
-    situation = _pick(rng, SITUATIONS[domain(parts[0].main)]).format(s=surface)
-    purpose = _pick(rng, PURPOSES[domain(parts[-1].main)])
+    situation = _pick(rng, situations(first)).format(s=surface)
+    purpose = _pick(rng, purposes(last))
     if shape < SHAPES[0]:
         return _sentence(f"{situation}: {text}")
     if shape < SHAPES[1]:
@@ -285,5 +415,35 @@ def phrase_parts(parts: list[Part], rng: np.random.Generator) -> str:
     return _sentence(text)
 
 
-__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "SITUATIONS", "Part", "command", "domain", "names_for",
-           "phrase", "phrase_parts"]
+@functools.cache
+def _all_situations() -> tuple[str, ...]:
+    """Every situation the author writes or wrote, filled in with every surface word, longest first."""
+    found = set(LEGACY_SITUATIONS)
+    for pool in (*SITUATIONS.values(), *SITUATIONS_DIRECTED.values()):
+        for x in pool:
+            found |= {x.format(s=s) for s in SURFACES}
+    return tuple(sorted(found, key=len, reverse=True))
+
+
+@functools.cache
+def _all_purposes() -> tuple[str, ...]:
+    found = {p for pool in (*PURPOSES.values(), *PURPOSES_DIRECTED.values()) for p in pool}
+    return tuple(sorted(found, key=len, reverse=True))
+
+
+def split(instruction: str) -> tuple[str | None, str, str | None]:
+    """``(situation, command, purpose)`` of an instruction this author wrote (the command without capital or full
+    stop; None for a part it does not have). A sentence the author did not write is all command."""
+    text = instruction.strip().rstrip(".")
+    situation = next((x for x in _all_situations() if text.startswith(x + ": ")), None)
+    if situation is not None:
+        text = text[len(situation) + 2:]
+    purpose = next((p for p in _all_purposes() if text.endswith(", " + p)), None)
+    if purpose is not None:
+        text = text[: -len(purpose) - 2]
+    return situation, text[:1].lower() + text[1:] if situation is None else text, purpose
+
+
+__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS", "SITUATIONS_DIRECTED",
+           "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for", "phrase",
+           "phrase_parts", "purposes", "situations", "split"]

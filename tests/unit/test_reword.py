@@ -1,0 +1,201 @@
+"""Wording the library (generator.reword, generator.phrasing's framings): the command is kept, only the situation
+and purpose around it are chosen, so the library reads as varied as its tasks; each change is a new version."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import yaml
+
+from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
+from gendex_envs.task_version import TaskVersion
+from generator.catalog_view import asset_dicts
+from generator.instruction import SYNONYMS
+from generator.phrasing import (
+    LEGACY_SITUATIONS,
+    NAMES,
+    PURPOSES,
+    PURPOSES_DIRECTED,
+    SITUATIONS,
+    SITUATIONS_DIRECTED,
+    Frame,
+    Part,
+    framings,
+    phrase_parts,
+    purposes,
+    split,
+)
+from generator.reword import (
+    MAX_PAIR_COSINE,
+    MAX_REUSE,
+    LibraryWording,
+    ProposalWording,
+    RewordError,
+    candidates_for,
+    plan_rewording,
+    publish_reworded,
+    replace_instruction,
+    spec_frames,
+)
+from generator.stats import embed, latest_versions
+
+ASSETS = {a["id"]: a for a in asset_dicts()}
+
+
+def _mean_cos(texts: list[str]) -> float:
+    e = embed(texts)[0]
+    s = e @ e.T
+    return float((s.sum() - np.trace(s)) / (len(texts) * (len(texts) - 1)))
+
+
+def _without_instruction(text: str) -> list[str]:
+    """The spec's lines without its header comment and its top-level instruction entry (however many lines)."""
+    out, skipping = [], False
+    for line in text.splitlines():
+        if line.startswith("instruction:"):
+            skipping = True
+            continue
+        if skipping and line[:1] in (" ", ""):
+            continue
+        skipping = False
+        if not line.startswith("#"):
+            out.append(line)
+    return out
+
+
+def test_every_sentence_the_author_writes_splits_into_its_command_and_is_one_of_its_framings():
+    parts_list = [[Part("put_in", ASSETS["lemon"], ASSETS["pot"])], [Part("lift", ASSETS["tuna_can"])],
+                  [Part("close_door", ASSETS["refrigerator_left_hinge"])],
+                  [Part("close_lid", ASSETS["trash_can_small"]), Part("place_on", ASSETS["plum"], ASSETS["plate"])]]
+    for parts in parts_list:
+        for seed in range(25):
+            text = phrase_parts(parts, np.random.default_rng(seed))
+            situation, command, purpose = split(text)
+            assert command and command[0].islower() and not command.endswith("."), text
+            first, last = Frame.of(parts[0]), Frame.of(parts[-1])
+            surfaces = [w for w in ("tabletop", "table", "counter", "worktop") if w in text] or ["table"]
+            assert text in framings(command, first, last, surfaces[0]), text
+
+
+def test_a_closing_is_never_given_a_reason_to_open_and_no_frame_names_a_catalog_object():
+    fridge = Part("close_door", ASSETS["refrigerator_left_hinge"])
+    for seed in range(40):
+        _, _, purpose = split(phrase_parts([fridge], np.random.default_rng(seed)))
+        assert purpose is None or purpose not in PURPOSES_DIRECTED[("cold", "open")]
+    assert not set(purposes(Frame("box", "close"))) & set(PURPOSES_DIRECTED[("box", "open")])
+    words = set(SYNONYMS) | {w for ws in NAMES.values() for w in ws} | {a["category"].replace("_", " ")
+                                                                         for a in ASSETS.values()}
+    pools = [*SITUATIONS.values(), *SITUATIONS_DIRECTED.values(), *PURPOSES.values(), *PURPOSES_DIRECTED.values()]
+    for text in (t for pool in pools for t in pool):
+        plain = re.sub(r"\bcan (be|go|start|continue|see)\b", "", text.lower())  # the verb, not the tin
+        found = [w for w in words if re.search(rf"\b{re.escape(w)}s?\b", plain)]
+        assert not found, (text, found)  # the reader would take them for objects of the task
+    assert all(t not in pool for t in LEGACY_SITUATIONS for pool in SITUATIONS.values())
+
+
+def test_replacing_the_instruction_keeps_every_other_byte(task_version):
+    source = task_version("CloseCabinetRightHingeThenSetBlockMediumOnTray", 0)
+    text = source.files.spec.read_text()
+    new = "A new: wording, with 'quotes' and a colon."
+    out = replace_instruction(text, new)
+    assert yaml.safe_load(out) == dict(yaml.safe_load(text), instruction=new)
+    assert _without_instruction(out) == _without_instruction(text)
+    assert f"# {new}\n" in out  # the header comment that repeated the old instruction follows it
+    with pytest.raises(RewordError, match="no top-level 'instruction'"):
+        replace_instruction("name: X\n", new)
+
+
+def test_a_reworded_task_is_published_as_the_next_version_and_the_source_is_untouched(task_copy):
+    source = task_copy("LiftLemon", as_name="ScratchLemon")
+    digest = source.file_digest()
+    new = "Market day left produce everywhere: raise the lemon clear of the counter and keep hold of it."
+    published = publish_reworded(source, new, {"reason": "test"})
+    assert published.version == source.version + 1 and published.spec.instruction == new
+    assert source.file_digest() == digest and source.spec.instruction != new
+    record = published.provenance()["reword"]
+    assert record["source"] == source.env_id and record["old"] == source.spec.instruction and record["new"] == new
+    assert published.provenance()["solvability"] == source.provenance()["solvability"]  # the same scene
+    spec_a, spec_b = yaml.safe_load(source.files.spec.read_text()), yaml.safe_load(published.files.spec.read_text())
+    assert dict(spec_a, instruction=new) == spec_b
+    assert source.files.reward.read_bytes() == published.files.reward.read_bytes()
+    assert not list((source.tasks_root / ".drafts").glob("*"))  # nothing half-written left behind
+
+
+def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse():
+    # the library as it was before its rewording: the latest version of each task that is not a rewording
+    unworded = {k: v for k, v in discover_tasks([REPO_TASKS_DIR]).items() if "reword" not in v.provenance()}
+    versions = {k: v for k, v in latest_versions(unworded).items()
+                if v.name.startswith(("Lift", "Put", "SetFoam", "Close"))}
+    assert len(versions) >= 20
+    keep = {"PutAppleBowl"}
+    changes, numbers = plan_rewording(versions, keep=keep)
+    assert changes and numbers["mean_pairwise_cosine_after"] < numbers["mean_pairwise_cosine_before"] - 0.03
+    final = {k: v.spec.instruction for k, v in versions.items()} | {c.env_id: c.new for c in changes}
+    assert abs(_mean_cos(list(final.values())) - numbers["mean_pairwise_cosine_after"]) < 1e-4
+    for c in changes:
+        assert versions[c.env_id].name not in keep
+        assert split(c.new)[1].lower() == split(c.old)[1].lower()  # what the task asks for is unchanged
+    used: dict[str, int] = {}
+    for text in final.values():
+        sit, _, purp = split(text)
+        for x in (sit, purp):
+            if x is not None:
+                used[x] = used.get(x, 0) + 1
+    assert max(used.values()) <= MAX_REUSE
+    e = embed(list(final.values()))[0]
+    pairs = e @ e.T
+    np.fill_diagonal(pairs, 0.0)
+    assert pairs.max() < MAX_PAIR_COSINE  # no two tasks framed so that they read as one
+
+
+def test_the_offline_author_words_a_proposal_least_like_the_library(task_version):
+    library = [v.spec.instruction for v in latest_versions(discover_tasks([REPO_TASKS_DIR])).values()]
+    spec = task_version("PutPlumInPot").spec
+    proposal = {"name": "PutPlumInPot", "description": spec.instruction,
+                "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
+                "steps": [], "success": {"type": "inside", "object": "plum", "target": "pot"}}
+    worded = ProposalWording()(proposal, library)
+    options = candidates_for("PutPlumInPot", spec.instruction, spec_frames(spec))
+    sims = embed(options)[0] @ embed(library)[0].T
+    apart = [k for k in range(len(options)) if sims[k].max() < MAX_PAIR_COSINE]
+    assert apart  # some framing reads like no task of the library
+    assert worded["description"] == options[min(apart, key=lambda k: sims[k].mean())]
+    assert worded["description"] == LibraryWording(library)(options)
+    assert sims[options.index(spec.instruction)].mean() > sims[options.index(worded["description"])].mean()
+    assert ProposalWording()(proposal, []) is proposal
+
+
+def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
+    """The left-hinged fridge's task proposed next to the right-hinged one's: the least-alike framing by the mean
+    alone took the very frame the sibling had (cosine 0.99, and the proposal was dropped as a near-duplicate)."""
+    right = "The butter is needed for the toast: pull the right-hinged fridge's door open by its handle."
+    library = [right, "Put the apple into the bowl.", "Close the drawer.", "Lift the golf ball off the table."]
+    command = "pull the left-hinged fridge's door open by its handle"
+    options = framings(command, Frame("cold", "open"), Frame("cold", "open"), "table")
+    assert any(o.startswith("The butter is needed") for o in options)
+    chosen = LibraryWording(library)(options)
+    e = embed([chosen, right])[0]
+    assert float(e[0] @ e[1]) < MAX_PAIR_COSINE, chosen
+
+
+def test_reword_rejects_an_unknown_task_name():
+    from typer.testing import CliRunner
+
+    from gendex.cli import app
+
+    result = CliRunner().invoke(app, ["reword", "--keep", "NoSuchTask", "--dry-run"])
+    assert result.exit_code != 0 and "NoSuchTask" in result.output
+
+
+def test_a_version_that_is_not_a_folder_of_the_library_is_not_touched_by_a_failed_publish(task_copy, monkeypatch):
+    source = task_copy("LiftLemon", as_name="ScratchLemonTwo")
+    import generator.reword as rw
+
+    monkeypatch.setattr(rw, "replace_instruction", lambda text, new: text)  # the rewrite silently fails
+    with pytest.raises(RewordError, match="the rewritten spec reads"):
+        publish_reworded(source, "Something else entirely.", {})
+    assert [v.version for v in map(TaskVersion.at, source.root.parent.iterdir())] == [source.version]
+    assert not list((source.tasks_root / ".drafts").glob("*"))
+
