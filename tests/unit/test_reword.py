@@ -13,6 +13,7 @@ from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dicts
 from generator.instruction import SYNONYMS
+from generator.novelty import NEAR_DUPLICATE_COSINE
 from generator.phrasing import (
     LEGACY_SITUATIONS,
     NAMES,
@@ -180,6 +181,17 @@ def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     assert float(e[0] @ e[1]) < MAX_PAIR_COSINE, chosen
 
 
+def test_the_committed_library_reads_as_varied_as_the_issue_asks():
+    """The library's instruction diversity (mean pairwise MiniLM cosine of the latest versions) meets the task
+    library issue's goal of <= 0.19 (RoboGen 0.191; before the rewording 0.299)."""
+    texts = [v.spec.instruction for v in latest_versions(discover_tasks([REPO_TASKS_DIR])).values()]
+    assert len(texts) >= 60 and _mean_cos(texts) <= 0.19
+    e = embed(texts)[0]
+    pairs = e @ e.T
+    np.fill_diagonal(pairs, 0.0)
+    assert pairs.max() < NEAR_DUPLICATE_COSINE  # and no two of them read as the same task
+
+
 def test_reword_rejects_an_unknown_task_name():
     from typer.testing import CliRunner
 
@@ -199,3 +211,22 @@ def test_a_version_that_is_not_a_folder_of_the_library_is_not_touched_by_a_faile
     assert [v.version for v in map(TaskVersion.at, source.root.parent.iterdir())] == [source.version]
     assert not list((source.tasks_root / ".drafts").glob("*"))
 
+
+def test_a_reworded_version_differs_from_its_source_only_in_its_instruction():
+    """What lets the environment checks test a reworded version through its source: every committed rewording
+    is its source's folder byte for byte, but for the spec's instruction (and its reword record)."""
+    found = discover_tasks([REPO_TASKS_DIR])
+    reworded = {e: v for e, v in found.items() if "reword" in v.provenance()}
+    assert len(reworded) >= 70
+    for env_id, v in reworded.items():
+        source = found[v.provenance()["reword"]["source"]]
+        assert source.name == v.name and source.version < v.version, env_id
+        files = {p.relative_to(v.root) for p in v.root.rglob("*") if p.is_file() and "__pycache__" not in p.parts}
+        src = {p.relative_to(source.root) for p in source.root.rglob("*")
+               if p.is_file() and "__pycache__" not in p.parts}
+        assert files - src == {v.files.record("reword").relative_to(v.root)}, env_id
+        assert src <= files, env_id
+        for rel in src - {v.files.spec.relative_to(v.root)}:
+            assert (v.root / rel).read_bytes() == (source.root / rel).read_bytes(), (env_id, rel)
+        a, b = yaml.safe_load(source.files.spec.read_text()), yaml.safe_load(v.files.spec.read_text())
+        assert dict(a, instruction=b["instruction"]) == b and v.provenance()["reword"]["new"] == b["instruction"]

@@ -7,6 +7,7 @@ from typer.testing import CliRunner
 
 from gendex.cli import app
 from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
+from generator.phrasing import split
 from generator.stats import TASK_SKILLS, instruction_diversity, jaccard, library_stats, task_skills
 
 EXPECTED = {
@@ -61,3 +62,16 @@ def test_cli_stats_json():
     assert r.exit_code == 0, r.output
     s = json.loads(r.output[r.output.index("{"):])
     assert s["skills_covered"] == 13 and s["instruction_diversity"]["published"]["GenDexHand"] == 0.288
+
+
+def test_the_commands_alone_are_measured_beside_the_framed_instructions(task_version):
+    """The framing (situation, purpose) lowers the figure; the stats show how much by measuring the commands
+    alone: for a framed library the commands read more alike than the instructions."""
+    names = ("LiftLemon", "PutPlumInPot", "CloseCabinet", "OpenMicrowaveStandard", "SetRacquetballOnPlate")
+    versions = {task_version(n).env_id: task_version(n) for n in names}
+    s = library_stats(versions)["instruction_diversity"]
+    assert s["commands_only"] is not None and s["commands_only"] > s["mean_pairwise_cosine"]
+    bare = [split(v.spec.instruction)[1] for v in versions.values()]
+    assert s["commands_only"] == pytest.approx(instruction_diversity(bare)[0])
+    assert all(b and b[0].islower() for b in bare)
+    assert library_stats(versions, diversity=False)["instruction_diversity"]["commands_only"] is None
