@@ -71,6 +71,10 @@ SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
+SET_DOWN_CONDITIONS = ("inside", "over", "near")
+"""Success conditions that set their object down in, on or next to a target object: a grasp of that object that
+lets it swing over too far to fit the target is taken only when no trial does better
+(:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp`)."""
 CARRY_EXTRA_STEPS = 15
 """A level carry takes its length over :data:`~gendex.solve.rigid.CARRY_M_PER_STEP` plus about this many steps
 (easing in and out, rising to the carry height)."""
@@ -280,14 +284,16 @@ class StageExecutor:
     # ------------------------------------------------------------------ primitives
     def _approach(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.approach(stage.target, self._grip_conditions(stage.target),
-                                       upright=self._goes_inside(stage.target))
+                                       set_on=self._set_on(stage.target))
 
-    def _goes_inside(self, name: str) -> bool:
-        """Whether a later release sets ``name`` down inside a container (an ``inside`` condition wants it there)."""
+    def _set_on(self, name: str) -> str | None:
+        """The object a later release sets ``name`` down in, on or next to (the target of an ``inside``, ``over`` or
+        ``near`` condition on ``name``), if any: a tall object that swung over in the hand catches a container's rim,
+        or lands on its side and topples off a board."""
         spec = self._env.task_spec
         conds = (*spec.success.conditions, *(c for s in spec.stages[self.stage_index + 1:] for c in s.success or ()))
-        return any(c.type == "inside" and c.object == name and not c.negate and c.target in self._env.objects
-                   and c.target not in self._env.articulations for c in conds)
+        return next((c.target for c in conds if c.type in SET_DOWN_CONDITIONS and c.object == name and not c.negate
+                     and c.target in self._env.objects and c.target not in self._env.articulations), None)
 
     def _grip_conditions(self, name: str) -> tuple:
         """The ``grasped`` conditions the next grasp stage on ``name`` declares: a grasp is only chosen if its trial

@@ -19,7 +19,7 @@ trials depend only on that episode.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -29,7 +29,7 @@ import torch
 
 from gendex.solve.grasp import GraspPlan
 from gendex.solve.motion import ArmHandMotion
-from gendex.solve.shape import ObjectShape
+from gendex.solve.shape import ObjectShape, PosedShape
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import ConditionSpec
 from gendex_envs.success import conditions_hold
@@ -49,8 +49,12 @@ FORCE_MARGIN = 0.6
 """Fraction of a required condition's force ceiling a trial must stay under (:func:`with_margin`)."""
 UPRIGHT_SPREAD = 1.25
 """A held object whose footprint grew by more than this factor in the trial (:func:`spread`) swung over in the
-hand: it is a poor grasp when the object must go into a container next (:meth:`GraspTrials.trial`'s caller prefers
-a grasp that keeps it upright)."""
+hand: unless it still fits what it is set down in or on next (:func:`fits_on`), a poor grasp for that
+(:meth:`GraspTrials.trial`'s caller prefers one that keeps it upright)."""
+
+FIT_FRACTION = 0.8
+"""A held object fits what it is set down in or on when its footprint's diagonal is at most this fraction of that
+object's narrower side (:func:`fits_on`; the rest is the container's wall and the carry's aim)."""
 
 
 @dataclass(frozen=True)
@@ -100,6 +104,15 @@ def spread(shape: ObjectShape, before: np.ndarray, after: np.ndarray) -> float:
         return float(np.hypot(f.length, f.width))
 
     return diagonal(after) / max(diagonal(before), 1e-6)
+
+
+def fits_on(held: PosedShape, target: PosedShape) -> Callable[[float], bool]:
+    """A test of a trial's footprint :func:`spread`: True when ``held``, swung that much, still fits ``target`` seen
+    from above (its footprint's diagonal within :data:`FIT_FRACTION` of ``target``'s narrower side). A bottle caged
+    25 degrees over still fits a large bowl; a sugar box swung 45 degrees does not fit a small one."""
+    f, t = held.footprint(), target.footprint()
+    diagonal, room = float(np.hypot(f.length, f.width)), FIT_FRACTION * min(t.length, t.width)
+    return lambda s: s * diagonal <= room
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,8 @@ its nominal speed); with room to spare every motion keeps its nominal speed.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import logging
+from collections.abc import Generator, Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,6 +29,8 @@ from gendex_envs.errors import ExecutionError
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
+
+log = logging.getLogger(__name__)
 
 MAX_PACE = 1.6
 """Largest speed-up of a paced motion over its nominal speed (a short budget): planned arm paths at up to 0.1
@@ -156,9 +159,11 @@ class ArmHandMotion:
             yield self.emit(q)
 
     def cartesian(self, offset: np.ndarray, m_per_step: float, guard: bool = False, paced: bool = False,
-                  after: int = 0) -> Iterator[np.ndarray]:
+                  after: int = 0, partial: bool = False) -> Generator[np.ndarray, None, float]:
         """Straight palm translation by ``offset`` (world, m), orientation kept, IK per step; ``paced``: faster by
-        the :meth:`pace` the budget asks for (``after``: steps of the same primitive that follow)."""
+        the :meth:`pace` the budget asks for (``after``: steps of the same primitive that follow). Returns the
+        fraction of ``offset`` done: 1, or with ``partial`` where the arm's reach ends (no IK further on) the
+        fraction reached so far instead of an ``ExecutionError``."""
         target = self.target()
         palm = self.ik.fk(target)
         n = max(1, int(np.ceil(np.linalg.norm(offset) / m_per_step)))
@@ -168,12 +173,16 @@ class ArmHandMotion:
         for k in range(1, n + 1):
             goal = sapien.Pose(palm.p + offset * k / n, palm.q)
             nq = self.ik.solve(goal, q, restarts=0)
+            if nq is None and partial:
+                log.info("straight palm motion stopped at step %d/%d: the arm reaches no further", k - 1, n)
+                return (k - 1) / n
             if nq is None:
                 raise ExecutionError(f"no IK along the straight palm motion at step {k}/{n}", cause="no_ik")
             q = nq
             t = self.target()
             t[self.arm] = q[self.arm]
             yield self.emit(t, guard)
+        return 1.0
 
     def rise_clear(self, q: np.ndarray, max_m: float, step_m: float = 0.03) -> tuple[float, np.ndarray]:
         """How far the palm must rise from joint vector ``q`` (0 to ``max_m``, in ``step_m`` steps) before the arm

@@ -44,7 +44,7 @@ from gendex.solve.grasp import (
     palm_rotation,
     pose_of,
 )
-from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand
+from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand, fits_on
 from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
@@ -150,7 +150,7 @@ class RigidPrimitives:
         self._trials: GraspTrials | None = None
         self._synth: GraspSynthesizer | None = None
         self._require: tuple[ConditionSpec, ...] = ()
-        self._upright = False
+        self._set_on: str | None = None
 
     def reset(self) -> None:
         """Start an episode: nothing held, and grasp trials in a rebuilt scene (:meth:`GraspTrials.renew`)."""
@@ -192,12 +192,13 @@ class RigidPrimitives:
         return np.concatenate([pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy()])
 
     # ------------------------------------------------------------------ approach and grasp
-    def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = (), upright: bool = False
+    def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = (), set_on: str | None = None
                      ) -> tuple[GraspPlan, np.ndarray]:
         """The first reachable grasp of ``name`` that holds in a trial (meeting the ``grasped`` conditions
-        ``require`` as well), and its pre-grasp joint vector. ``upright`` (the object goes into a container next):
-        a grasp that let the object swing over is kept only as a fallback while the trials last (the least swung
-        one), since a tilted object's footprint catches the container's rim."""
+        ``require`` as well), and its pre-grasp joint vector. ``set_on``: the object ``name`` is set down in or on
+        next; a grasp that let ``name`` swing over so far that its footprint no longer fits ``set_on``'s
+        (:func:`~gendex.solve.grasp_trial.fits_on`) is kept only as a fallback while the trials last (the least
+        swung one): a tilted object catches a container's rim, or lands on its side and topples off a board."""
         m, c, env = self.m, self.config, self.env
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
@@ -208,18 +209,20 @@ class RigidPrimitives:
         q0 = m.target()
         reachable, results, helped_trials = 0, [], 0
         swung: list[tuple[TrialResult, np.ndarray]] = []
-        shape_now = self._shapes[name] if upright else None
+        shape_now = self._shapes[name] if set_on is not None else None
+        fits = fits_on(self.shape(name), self.shape(set_on)) if set_on is not None else None
 
         def tried(plan: GraspPlan, q: np.ndarray) -> bool:
-            """Trial ``plan`` from ``q``; True when it is the grasp to take (held, and upright where asked)."""
+            """Trial ``plan`` from ``q``; True when it is the grasp to take (held, and fitting where asked)."""
             result = self.trials.trial(plan, q, name, require, shape_now)
             results.append(result)
             self.trial_log.append(result)
-            if result.held and not result.upright and upright:
+            fitting = fits is None or result.upright or fits(result.spread)
+            if result.held and not fitting:
                 swung.append((result, q))
             elif result.held:
                 log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
-            return result.held and (result.upright or not upright)
+            return result.held and fitting
 
         for plan in synth.candidates():
             open_q = m.with_hand(q0, plan.open_hand)
@@ -243,7 +246,7 @@ class RigidPrimitives:
                 break
         if swung:
             result, q = min(swung, key=lambda rq: rq[0].spread)
-            log.info("grasp of %r: %s (no trial kept it upright)", name, result)
+            log.info("grasp of %r: %s (no trial kept it upright enough to fit %r)", name, result, set_on)
             return result.plan, q
         if not reachable:
             raise ExecutionError(f"no grasp of {name!r} that the arm reaches without collision (families "
@@ -252,13 +255,13 @@ class RigidPrimitives:
         raise ExecutionError(f"none of {len(results)} grasps of {name!r} held in a physics trial; best: {best}",
                              cause="grasp_failed")
 
-    def approach(self, name: str, require: tuple[ConditionSpec, ...] = (), upright: bool = False
+    def approach(self, name: str, require: tuple[ConditionSpec, ...] = (), set_on: str | None = None
                  ) -> Iterator[np.ndarray]:
         m = self.m
-        self._require, self._upright = require, upright
+        self._require, self._set_on = require, set_on
         for attempt in range(self.config.replans + 1):
             before = self._pose_now(name)
-            plan, q_pre = self.choose_grasp(name, require, upright)
+            plan, q_pre = self.choose_grasp(name, require, set_on)
             yield from self._bring_hand(name, plan, q_pre)
             moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
             if moved <= MOVED_M or attempt == self.config.replans:
@@ -345,7 +348,7 @@ class RigidPrimitives:
                 raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting ({why})", cause="slipped")
             log.info("%r slipped (%s): opening and grasping again", name, why)
             yield from self._let_go()
-            yield from self.approach(name, self._require, self._upright)
+            yield from self.approach(name, self._require, self._set_on)
 
     def _ease_grip(self) -> Iterator[np.ndarray]:
         """When the grasp stage's own conditions fail only by a force ceiling (fingers pulling the object into the
@@ -391,12 +394,14 @@ class RigidPrimitives:
         if held_lo[2] < self.env.table_height + 0.5 * c.motion.lift_m:
             # still at the table (a trained grasp policy closes the hand but does not lift, unlike the scripted
             # grasp): lift straight up first, so the planned carry never drags the object across the table
+            # (as far as the arm reaches: a tall object held high leaves little; the carry plans from there)
             z0 = float(self.env.obj(held).pose.p[0, 2])
-            yield from m.cartesian(np.array([0.0, 0.0, c.motion.lift_m]), c.motion.lift_m_per_step, guard=True)
+            done = yield from m.cartesian(np.array([0.0, 0.0, c.motion.lift_m]), c.motion.lift_m_per_step,
+                                          guard=True, partial=True)
             risen = float(self.env.obj(held).pose.p[0, 2]) - z0
-            if risen < 0.5 * c.motion.lift_m:
+            if risen < 0.5 * done * c.motion.lift_m:
                 raise ExecutionError(f"{held!r} slipped when lifted for the carry (rose {risen:.3f} m of "
-                                     f"{c.motion.lift_m:.3f} m)", cause="slipped")
+                                     f"{done * c.motion.lift_m:.3f} m)", cause="slipped")
             held_lo, held_hi = m.world_aabb(held)
         t_center = m.object_geometry(target)[0]
         t_hi = m.world_aabb(target)[1]

@@ -123,3 +123,58 @@ def test_an_object_flung_onto_something_higher_is_grasped_again(caplog):
         assert out.succeeded, out.failure
     finally:
         env.close()
+
+
+def _data_task_env(name: str) -> TaskEnv:
+    from pathlib import Path
+
+    import yaml
+
+    path = Path(__file__).parents[1] / "data" / "tasks" / f"{name}.yaml"
+    spec = parse_task_spec(yaml.safe_load(path.read_text()), source=str(path))
+    return TaskEnv(task_spec=spec, control_mode="pd_joint_pos", control_joint="both", obs_mode="none",
+                   reward_mode="none", render_backend="none")
+
+
+def test_a_bottle_caged_a_little_over_still_goes_into_a_large_bowl():
+    """The side cage holds the bottle tilted 25 degrees (its footprint spreads about 1.5x). It still fits the
+    22 cm bowl, so it is taken; passed over as 'not upright', a pinch was taken instead and the bottle slipped out
+    of it in the carry (this seed, before fits_on)."""
+    from gendex.solve.attempt import run_attempt
+    from gendex.solve.grasp_trial import UPRIGHT_SPREAD
+
+    env = _data_task_env("PutBottleInBowlLarge")
+    executor = StageExecutor()
+    try:
+        out = run_attempt(env, executor, 779002)
+        first = executor.rigid.trial_log[0]
+        assert first.held and first.plan.kind == "side" and first.spread > UPRIGHT_SPREAD
+        assert executor.grasp_plan is first.plan
+        assert out.succeeded, out.failure
+    finally:
+        executor.rigid.close()
+        env.close()
+
+
+def test_a_tall_box_held_high_is_carried_from_as_high_as_the_arm_reaches(caplog):
+    """On this seed the first grasp that holds the sugar box is a side grasp that swings it over too far to fit the
+    20 cm board (taken before fits_on: the box toppled off the board). The pinch taken instead holds the box low in
+    the hand, so the carry first lifts it off the table, and the arm reaches only part of the 10 cm (the attempt
+    stopped there with no_ik). It lifts as far as it reaches and the carry plans from there."""
+    import logging
+
+    from gendex.solve.attempt import run_attempt
+
+    env = _data_task_env("SetSugarBoxOnCuttingBoard")
+    executor = StageExecutor()
+    try:
+        with caplog.at_level(logging.INFO, logger="gendex.solve.motion"):
+            out = run_attempt(env, executor, 779001)
+        assert any("reaches no further" in r.getMessage() for r in caplog.records)
+        held = [r for r in executor.rigid.trial_log if r.held]
+        assert held[0].plan.kind == "side" and held[0].spread > 2.0  # swung: does not fit the 20 cm board
+        assert executor.grasp_plan is held[-1].plan and held[-1].plan.kind == "pinch"
+        assert out.succeeded, out.failure
+    finally:
+        executor.rigid.close()
+        env.close()

@@ -40,3 +40,32 @@ def test_a_ball_does_not_spread_however_it_turns_and_a_cube_only_when_tipped_far
         assert spread(ball, np.eye(3), turn) == pytest.approx(1.0, abs=0.03)
     cube = box(0.05, 0.05, 0.05)
     assert spread(cube, np.eye(3), rot("x", 12)) <= UPRIGHT_SPREAD < spread(cube, np.eye(3), rot("xy", [35, 35]))
+
+
+def test_a_swung_object_fits_what_it_is_set_on_when_its_footprint_does():
+    """fits_on: a bottle caged 25 degrees over still fits a 22 cm bowl (the side grasp that holds it is taken, where
+    the upright rule alone passed it over for pinches that slipped in the carry); a sugar box swung 45 degrees fits
+    neither a 16 cm bowl nor a 20 cm board."""
+    from gendex.solve.grasp_trial import FIT_FRACTION, fits_on
+
+    def posed(shape: ObjectShape, r: np.ndarray | None = None):
+        m = np.eye(4)
+        m[:3, :3] = np.eye(3) if r is None else r
+        return shape.posed(m)
+
+    cylinder = ObjectShape([ConvexPart.of_points(np.array(
+        [[0.033 * np.cos(a), 0.033 * np.sin(a), z] for a in np.linspace(0, 2 * np.pi, 24, endpoint=False)
+         for z in (-0.1, 0.1)]))])
+    bottle_swung = spread(cylinder, np.eye(3), rot("x", 25))
+    assert bottle_swung > UPRIGHT_SPREAD  # the upright rule alone would pass the cage over
+    large_bowl, bowl, board = box(0.22, 0.22, 0.07), box(0.16, 0.16, 0.06), box(0.3, 0.2, 0.02)
+    assert fits_on(posed(cylinder), posed(large_bowl))(bottle_swung)
+    assert not fits_on(posed(cylinder), posed(bowl))(bottle_swung)  # 0.8 x 16 cm = 12.8 cm < its 15.9 cm
+    sugar = box(0.04, 0.09, 0.175)
+    swung = spread(sugar, np.eye(3), rot("x", 45))
+    for target in (bowl, board):
+        assert not fits_on(posed(sugar), posed(target))(swung)
+        assert fits_on(posed(sugar), posed(target))(1.0)  # upright, it fits both
+    # the room is the target's narrower side, whatever its yaw
+    assert fits_on(posed(sugar), posed(board, rot("z", 40)))(1.5) == (1.5 * np.hypot(0.09, 0.04)
+                                                                       <= FIT_FRACTION * 0.2 + 1e-9)
