@@ -223,7 +223,7 @@ def replace_instruction(text: str, instruction: str) -> str:
 
 def publish_reworded(source: TaskVersion, instruction: str, record: dict) -> TaskVersion:
     """Publish ``v<N+1>`` of ``source``'s task: ``source`` with the spec's instruction replaced and ``record``
-    (plus the source and both wordings) saved as ``reword.json``. ``source`` is left untouched."""
+    (plus the source and both wordings) saved as its ``reword`` record. ``source`` is left untouched."""
     from gendex_envs.atomic_io import write_json
 
     root = source.tasks_root
