@@ -122,7 +122,7 @@ PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a genera
                                  "rubiks_cube": None, "foam_brick": None, "tuna_can": None, "sponge": None}
 """Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
 COMPOSE_STRIDE = 12
-"""Each articulated first part is composed with every 12th rigid task (a different slice for each): a few hundred."""
+"""Each articulated first part is composed with every COMPOSE_STRIDE-th rigid task (a different slice for each)."""
 COMPOSED_SIDE_M = 0.1
 """Articulated object this far off the middle (|y|): a composed task's movables on the other side, else in front."""
 COMPOSED_WEIGHT = 2.0
