@@ -14,10 +14,12 @@ A task version is data: its spec, the reward modules that shape it, and what was
     generation.json, proposal.json, scene_candidates.json, critique.json, reward_attempts.json, transcript.jsonl
                                    how the generator made it (replaying the transcript reproduces the files)
     promotion.json                 which version and training runs it was derived from (``gendex promote``)
+    reword.json                    which version it rewords, and both wordings (``gendex reword``)
 
 A published version never changes behaviour: a new policy, reward or set of start states is a new version
-(:func:`derive_version`). Folders are published atomically (:func:`publish`): a draft is assembled in the hidden
-``<root>/.drafts/`` folder and renamed into place, so a killed run never leaves a half-written version.
+(:func:`derive_version`; any copy of a version with a change and a record: :func:`publish_derived`). Folders are
+published atomically (:func:`publish`): a draft is assembled in the hidden ``<root>/.drafts/`` folder and renamed
+into place, so a killed run never leaves a half-written version.
 
 A training run folder (``gendex train --out RUN``) uses the same layout for what it produces (``policies/``,
 ``start_states/``) plus ``run.json``; :class:`Artifacts` reads policies and start states from either kind of folder.
@@ -31,7 +33,7 @@ import os
 import re
 import shutil
 import uuid
-from collections.abc import Collection, Iterable
+from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -419,17 +421,31 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
     raise PublishError(f"could not find a free version folder for {name!r} in {root}")
 
 
-def derive_version(source: TaskVersion, overlays: Collection[Artifacts], record: dict) -> TaskVersion:
-    """Publish ``v<N+1>`` of ``source``'s task: a copy of ``source`` with the policies and start states of
-    ``overlays`` (later overlays win) and ``record`` saved as ``promotion.json``. ``source`` is left untouched."""
+def publish_derived(source: TaskVersion, kind: str, edit: Callable[[TaskLayout], dict],
+                    skip: tuple[str, ...] = ("__pycache__",)) -> TaskVersion:
+    """Publish ``v<N+1>`` of ``source``'s task: a copy of ``source`` (without files matching ``skip``) that
+    ``edit`` changes in the draft, with the record ``edit`` returns (and the source's id) saved as ``kind``. Nothing
+    is published when ``edit`` raises; ``source`` is left untouched."""
     from gendex_envs.atomic_io import write_json
 
     root = source.tasks_root
     draft = new_draft(root)
     try:
-        shutil.copytree(source.root, draft, dirs_exist_ok=True,
-                        ignore=shutil.ignore_patterns("checkpoints", "__pycache__"))
+        shutil.copytree(source.root, draft, dirs_exist_ok=True, ignore=shutil.ignore_patterns(*skip))
         out = TaskLayout(draft)
+        record = edit(out)
+        write_json(out.record(kind), dict(record, source=source.env_id), indent=2, sort_keys=True)
+        return publish(root, source.name, draft, required=(out.spec, out.reward))
+    finally:
+        if draft.exists():
+            shutil.rmtree(draft, ignore_errors=True)
+
+
+def derive_version(source: TaskVersion, overlays: Collection[Artifacts], record: dict) -> TaskVersion:
+    """Publish ``v<N+1>`` of ``source``'s task: a copy of ``source`` with the policies and start states of
+    ``overlays`` (later overlays win) and ``record`` saved as ``promotion.json``. ``source`` is left untouched."""
+
+    def overlay(out: TaskLayout) -> dict:
         copied: dict[str, list[str]] = {"policies": [], "start_states": []}
         for art in overlays:
             for stage in art.policy_stages():
@@ -449,8 +465,6 @@ def derive_version(source: TaskVersion, overlays: Collection[Artifacts], record:
         if not any(copied.values()):
             raise StageError(f"nothing to promote: {', '.join(str(a.layout.root) for a in overlays)} hold no "
                              "trained policy or start states")
-        write_json(out.record("promotion"), dict(record, source=source.env_id, **copied), indent=2, sort_keys=True)
-        return publish(root, source.name, draft, required=(out.spec, out.reward))
-    finally:
-        if draft.exists():
-            shutil.rmtree(draft, ignore_errors=True)
+        return dict(record, **copied)
+
+    return publish_derived(source, "promotion", overlay, skip=("checkpoints", "__pycache__"))

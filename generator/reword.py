@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import logging
 import re
-import shutil
 from collections import Counter
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -28,7 +27,7 @@ import numpy as np
 import yaml
 
 from gendex_envs.spec import TaskSpec
-from gendex_envs.task_version import TaskLayout, TaskVersion, new_draft, publish
+from gendex_envs.task_version import TaskLayout, TaskVersion, publish_derived
 from generator.catalog_view import asset_dict
 from generator.phrasing import SURFACES, Frame, direction, domain, framings, split
 from generator.stats import embed, latest_versions, task_skills
@@ -224,23 +223,15 @@ def replace_instruction(text: str, instruction: str) -> str:
 def publish_reworded(source: TaskVersion, instruction: str, record: dict) -> TaskVersion:
     """Publish ``v<N+1>`` of ``source``'s task: ``source`` with the spec's instruction replaced and ``record``
     (plus the source and both wordings) saved as its ``reword`` record. ``source`` is left untouched."""
-    from gendex_envs.atomic_io import write_json
 
-    root = source.tasks_root
-    draft = new_draft(root)
-    try:
-        shutil.copytree(source.root, draft, dirs_exist_ok=True, ignore=shutil.ignore_patterns("__pycache__"))
-        out = TaskLayout(draft)
+    def reword(out: TaskLayout) -> dict:
         out.spec.write_text(replace_instruction(out.spec.read_text(), instruction))
         written = yaml.safe_load(out.spec.read_text())["instruction"]
         if written != instruction:
             raise RewordError(f"{source.env_id}: the rewritten spec reads {written!r}")
-        write_json(out.record("reword"), dict(record, source=source.env_id, old=source.spec.instruction,
-                                              new=instruction), indent=2, sort_keys=True)
-        return publish(root, source.name, draft, required=(out.spec, out.reward))
-    finally:
-        if draft.exists():
-            shutil.rmtree(draft, ignore_errors=True)
+        return dict(record, old=source.spec.instruction, new=instruction)
+
+    return publish_derived(source, "reword", reword)
 
 
 __all__ = ["LibraryWording", "ProposalWording", "RewordError", "Rewording", "candidates_for", "plan_rewording",

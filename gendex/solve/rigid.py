@@ -210,7 +210,7 @@ class RigidPrimitives:
         reachable, results, helped_trials = 0, [], 0
         swung: list[tuple[TrialResult, np.ndarray]] = []
         shape_now = self._shapes[name] if set_on is not None else None
-        fits = fits_on(self.shape(name), self.shape(set_on)) if set_on is not None else None
+        fits = fits_on(shape, self.shape(set_on)) if set_on is not None else None
 
         def tried(plan: GraspPlan, q: np.ndarray) -> bool:
             """Trial ``plan`` from ``q``; True when it is the grasp to take (held, and fitting where asked)."""

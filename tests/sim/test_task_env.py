@@ -28,8 +28,7 @@ HISTORY_DEPENDENT = {"GenDex/OpenOvenCompact-v0": _HISTORY.format(what=", next t
                                                                         "touching it", rate="8/8")}
 
 
-REWORDED = {e: v.provenance()["reword"]["source"] for e, v in registered_tasks().items()
-            if "reword" in v.provenance()}
+REWORDED = {e: p["reword"]["source"] for e, v in registered_tasks().items() if "reword" in (p := v.provenance())}
 """Versions that only reword their source (``gendex reword``): the same scene, stages and rewards byte for byte
 (checked by test_a_reworded_version_differs_from_its_source_only_in_its_instruction), so checked through it."""
 
