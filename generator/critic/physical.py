@@ -22,9 +22,11 @@ How each check is measured (the thresholds are the module constants below):
     link is a penetration (contacts inside one articulation, robot-robot and robot-table are ignored). PhysX
     reports the depth along the contact normal per convex-hull pair, which for deep overlaps understates the true
     overlap, so the fix is computed from the bodies' collision-shape AABBs instead: the smaller movable object is
-    moved in xy along the line between the two AABB centres until the AABBs no longer overlap in x or y
-    (+ PENETRATION_FIX_MARGIN_M + both objects' randomization half-ranges); a penetration of the table is fixed by
-    raising the object. Static: the same on the catalog bounding boxes placed by the spec; an object whose footprint
+    moved in xy until the AABBs no longer overlap in x or y (+ PENETRATION_FIX_MARGIN_M + both objects'
+    randomization half-ranges), along the line between the two AABB centres or, where that ends off the table, out
+    of reach, on a third object or in front of an articulated object a stage works, along the shortest table axis
+    that does not (:mod:`generator.critic.layout`); a penetration of the table is fixed by raising the object.
+    Static: the same on the catalog bounding boxes placed by the spec; an object whose footprint
     lies inside a container's footprint and that is above the table is *not* counted (it may rest on the
     container's floor; only the simulator can tell). Randomization is off for the measurement (nominal poses).
 ``unsupported`` (static)
@@ -84,6 +86,7 @@ from gendex_envs.spec import (
     spec_to_dict,
 )
 from generator.critic.directives import Directive
+from generator.critic.layout import Room, choose_move, front_zone
 from generator.errors import DirectiveError
 
 log = logging.getLogger(__name__)
@@ -96,8 +99,6 @@ CHECKS: tuple[str, ...] = ("penetration", "floating", "unsupported", "out_of_rea
 PENETRATION_TOL_M = 0.003
 """Deepest tolerated interpenetration at reset (m). Objects placed by the spec rest at separation ~0 (measured
 0.0 on the reference tasks); an apple placed at the centre of the bowl sits 6 mm into its floor."""
-PENETRATION_FIX_MARGIN_M = 0.01
-"""Gap left between two bounding boxes moved apart by a penetration fix (m)."""
 SUPPORT_TOL_M = 0.005
 """An object's lowest point may be this far above the table, or above / below the top of what it stands on (m)."""
 CONTAINER_FLOOR_M = 0.01
@@ -274,12 +275,17 @@ class Placed:
         return "container" in self.record.tags
 
 
-def _place(obj: ObjectSpec) -> Placed:
+def _frame(obj: ObjectSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(scaled local box lo, hi, world origin) of an object as the spec places it."""
     rec = get_asset(obj.asset)
     lo, hi = np.asarray(rec.bbox_min_m) * obj.scale, np.asarray(rec.bbox_max_m) * obj.scale
+    return lo, hi, np.array([obj.pos_m[0], obj.pos_m[1], obj.pos_m[2] - lowest_point_z(rec, obj.scale, obj.quat_wxyz)])
+
+
+def _place(obj: ObjectSpec) -> Placed:
+    lo, hi, origin = _frame(obj)
     local = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    origin = np.array([obj.pos_m[0], obj.pos_m[1], obj.pos_m[2] - lowest_point_z(rec, obj.scale, obj.quat_wxyz)])
-    return Placed(obj, rec, local @ _rotation(obj.quat_wxyz).T + origin)
+    return Placed(obj, get_asset(obj.asset), local @ _rotation(obj.quat_wxyz).T + origin)
 
 
 def _min_width_xy(points: np.ndarray) -> float:
@@ -292,31 +298,6 @@ def _min_width_xy(points: np.ndarray) -> float:
 
 def _footprint_inside(inner_lo, inner_hi, outer_lo, outer_hi) -> bool:
     return bool(np.all(inner_lo[:2] >= outer_lo[:2] - 1e-9) and np.all(inner_hi[:2] <= outer_hi[:2] + 1e-9))
-
-
-def separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
-                     jitter_xy: Iterable[float] = (0.0, 0.0)) -> np.ndarray:
-    """xy translation of ``mover`` along the line between the box centres that separates the boxes in x or y.
-
-    The gap left is PENETRATION_FIX_MARGIN_M plus ``jitter_xy`` (both objects' randomization half-ranges, per axis),
-    so the objects stay apart at every reset.
-    """
-    jitter = list(jitter_xy)
-    c_m, c_o = (mover_lo[:2] + mover_hi[:2]) / 2, (other_lo[:2] + other_hi[:2]) / 2
-    u = c_m - c_o
-    n = float(np.linalg.norm(u))
-    if n < 1e-3:  # centres on one vertical line: move towards the table's centre line y = 0
-        u = np.array([0.0, -1.0 if fallback_y > 0 else 1.0])
-    else:
-        u = u / n
-    need = []
-    for i in range(2):
-        if abs(u[i]) < 1e-6:
-            continue
-        overlap = other_hi[i] - mover_lo[i] if u[i] > 0 else mover_hi[i] - other_lo[i]
-        need.append((max(overlap, 0.0) + PENETRATION_FIX_MARGIN_M + jitter[i]) / abs(u[i]))
-    t = min(need) if need else PENETRATION_FIX_MARGIN_M
-    return u * t
 
 
 def moves(obj: str, dxy: Iterable[float]) -> tuple[Directive, ...]:
@@ -452,7 +433,7 @@ def _unsupported(placed: dict[str, Placed], meas: dict, violations: list[Violati
     return fixes
 
 
-def _overlaps(placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+def _overlaps(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
     names = list(placed)
     meas["_method"] = "catalog bounding boxes placed by the spec"
     for i, a in enumerate(names):
@@ -467,12 +448,40 @@ def _overlaps(placed: dict[str, Placed], meas: dict, violations: list[Violation]
                 meas.setdefault(inside[0][0].spec.name, {})["inside_container"] = inside[0][1].spec.name
                 continue
             mover, other = pick_mover(pa, pb)
-            fix = moves(mover.spec.name, separating_move(mover.lo, mover.hi, other.lo, other.hi,
-                                                           float(other.centre_xy[1]), randomization_xy(pa, pb)))
+            fix = penetration_fix(spec, placed, mover, other, (mover.lo, mover.hi), (other.lo, other.hi))
             meas.setdefault(a, {})[b] = rounded(depth)
             violations.append(Violation(
                 "penetration", mover.spec.name, f"{a!r} and {b!r} overlap by {depth:.3f} m (bounding boxes as placed)",
                 measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=other.spec.name))
+
+
+def room_for(spec: TaskSpec, placed: dict[str, Placed], skip: Iterable[str]) -> Room:
+    """Where a penetration fix may put an object (:class:`~generator.critic.layout.Room`): the table, the reach
+    limits with REACH_MARGIN_M to spare, the objects not in ``skip``, and the front zones of the articulated objects
+    that a stage targets."""
+    worked = {s.target for s in spec.stages if s.target}
+    obstacles, zones = [], []
+    for name, p in placed.items():
+        if name in skip:
+            continue
+        j = np.asarray(p.spec.randomize.xy_m, dtype=float)
+        obstacles.append((np.r_[p.lo[:2] - j, p.lo[2]], np.r_[p.hi[:2] + j, p.hi[2]]))
+        if p.record.articulated and name in worked:
+            lo, hi, origin = _frame(p.spec)
+            zones.append(front_zone(lo, hi, _rotation(p.spec.quat_wxyz), origin, j, p.spec.randomize.yaw_deg))
+    return Room((spec.table.size_m[0] / 2, spec.table.size_m[1] / 2), tuple(spec.robot.base_pos_m[:2]),
+                (REACH_MIN_M + REACH_MARGIN_M, REACH_MAX_M - REACH_MARGIN_M), tuple(obstacles), tuple(zones))
+
+
+def penetration_fix(spec: TaskSpec, placed: dict[str, Placed], mover: Placed, other: Placed, mover_box: tuple,
+                    other_box: tuple) -> tuple[Directive, ...]:
+    """Directives moving ``mover`` (its 3-D box ``mover_box``) out of ``other`` (``other_box``), as measured by the
+    caller (catalog boxes or the simulator's), into a spot :func:`room_for` admits where one is near."""
+    room = room_for(spec, placed, (mover.spec.name, other.spec.name))
+    (mlo, mhi), (olo, ohi) = mover_box, other_box
+    d = choose_move(mlo, mhi, olo, ohi, room, float((olo[1] + ohi[1]) / 2), randomization_xy(mover, other),
+                    mover.spec.randomize.xy_m)
+    return moves(mover.spec.name, d)
 
 
 def randomization_xy(*placed: Placed) -> np.ndarray:
@@ -556,7 +565,7 @@ def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dic
     violations: list[Violation] = []
     meas: dict[str, dict] = {c: {} for c in CHECKS}
     if overlap:
-        _overlaps(placed, meas["penetration"], violations)
+        _overlaps(spec, placed, meas["penetration"], violations)
     unsupported = _unsupported(placed, meas["unsupported"], violations)
     _position_fixes(spec, placed, meas["out_of_reach"], meas["off_table"], violations)
     _scale_checks(spec, placed, meas["scale"], violations)

@@ -19,10 +19,10 @@ import numpy as np
 from gendex_envs.physx import px_objects
 from gendex_envs.spec import RandomizeSpec, TaskSpec
 from generator.critic.directives import Directive
+from generator.critic.layout import PENETRATION_FIX_MARGIN_M, separating_move
 from generator.critic.physical import (
     FALL_TOL_M,
     MOVING_TOL_MPS,
-    PENETRATION_FIX_MARGIN_M,
     PENETRATION_TOL_M,
     SETTLE_STEPS,
     PhysicalReport,
@@ -31,10 +31,10 @@ from generator.critic.physical import (
     log,
     moves,
     ordered,
+    penetration_fix,
     pick_mover,
     randomization_xy,
     rounded,
-    separating_move,
     static_findings,
 )
 
@@ -52,8 +52,8 @@ def _entity_ids(entity) -> list[int]:
     return [obj.per_scene_id for obj in px_objects(entity)]
 
 
-def _contact_penetrations(env, placed: dict[str, Placed], boxes: dict[str, tuple], start: dict[str, np.ndarray],
-                          meas: dict) -> list[Violation]:
+def _contact_penetrations(env, spec: TaskSpec, placed: dict[str, Placed], boxes: dict[str, tuple],
+                          start: dict[str, np.ndarray], meas: dict) -> list[Violation]:
     """Penetrations in PhysX's contact list (one per object pair; one per object for the table and the robot)."""
     from gendex_envs.assets.bounds import body_points
 
@@ -92,9 +92,7 @@ def _contact_penetrations(env, placed: dict[str, Placed], boxes: dict[str, tuple
                 other="table"))
             continue
         pm, po = pick_mover(placed[a], placed[b])
-        (mlo, mhi), (olo, ohi) = boxes[pm.spec.name], boxes[po.spec.name]
-        fix = moves(pm.spec.name, separating_move(mlo, mhi, olo, ohi, float((olo[1] + ohi[1]) / 2),
-                                                    randomization_xy(pm, po)))
+        fix = penetration_fix(spec, placed, pm, po, boxes[pm.spec.name], boxes[po.spec.name])
         violations.append(Violation(
             "penetration", pm.spec.name, f"{a!r} and {b!r} interpenetrate by {depth:.3f} m at reset",
             measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=po.spec.name))
@@ -133,7 +131,7 @@ def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, 
         boxes = {n: entity_aabb(e) for n, e in env.objects.items()}
 
         env.scene.step()  # one physics step: PhysX lists the contacts of the reset state
-        violations = _contact_penetrations(env, placed, boxes, start, meas["penetration"])
+        violations = _contact_penetrations(env, spec, placed, boxes, start, meas["penetration"])
 
         zero = np.zeros(env.action_space.shape, dtype=np.float32)
         for _ in range(max(settle_steps - 1, 0)):

@@ -114,3 +114,25 @@ def test_cabinet_starting_open_with_an_open_stage():
     assert ("joint_state", "cabinet") in checks(report), report.summary()
     assert report.joint_fixes() == [{"object": "cabinet", "joint": "door_hinge", "value": 0.0}]
     assert_fixed(spec, report)
+
+
+def test_overlap_fix_keeps_a_moved_object_out_of_the_front_of_a_door_a_stage_shuts():
+    """Batch 58117: PhysX finds the can in the pot; the fix moves it clear of the pot, and not in front of the
+    microwave whose door the first stage presses shut (there, the pressing hand met the can on 4 of 8 dev seeds)."""
+    from pathlib import Path
+
+    import numpy as np
+    import yaml
+
+    from generator.critic.physical import _place, room_for
+
+    path = Path(__file__).parents[1] / "data" / "tasks" / "CloseMicrowaveThenPutCanInPot.yaml"
+    spec = parse_task_spec(yaml.safe_load(path.read_text()), source=str(path))
+    report = check_scene(spec)
+    assert {(v.check, v.object, v.other) for v in report.violations} == {("penetration", "can", "pot")}
+    fixed = apply_directives(spec, report.directives())
+    placed = {o.name: _place(o) for o in fixed.objects}
+    (zone,) = room_for(fixed, placed, ()).zones
+    can, j = placed["can"], np.asarray(fixed.object("can").randomize.xy_m)
+    assert np.any(can.hi[:2] + j <= zone[0]) or np.any(can.lo[:2] - j >= zone[1])
+    assert_fixed(spec, report)
