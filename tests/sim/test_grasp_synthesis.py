@@ -191,3 +191,95 @@ def test_a_pinch_raised_off_the_table_passes_its_own_clearance_check():
         assert pointing_away
     finally:
         s.env.close()
+
+
+def test_distances_beside_a_thin_tilted_part_are_not_mistaken_for_contact():
+    """Beside the edges of a fork handle's thin tilted segments, face planes alone put points at half their distance
+    from the part (16 mm where it is 33 mm); the supporting planes along many directions keep the bound at 74-100 %
+    of the exact distance (a small QP per part), and it stays a lower bound."""
+    from scipy.optimize import minimize
+
+    def exact(part, p):
+        """Distance from p to the convex part: the nearest point inside all its face planes (a small QP)."""
+        inside = {"type": "ineq", "fun": lambda x: -(part.normals @ x + part.offsets), "jac": lambda x: -part.normals}
+        sol = minimize(lambda x: float((x - p) @ (x - p)), part.vertices.mean(axis=0), jac=lambda x: 2 * (x - p),
+                       constraints=[inside], method="SLSQP", options={"ftol": 1e-14, "maxiter": 200})
+        return float(np.linalg.norm(sol.x - p))
+
+    s = Scene("fork", seed=1000)
+    try:
+        fp = s.shape.footprint()
+        axis = np.array([fp.axis[0], fp.axis[1], 0.0])
+        across = np.cross([0.0, 0.0, 1.0], axis)
+        pts = np.array([fp.center[0], fp.center[1], 0.01]) + np.outer(np.linspace(0.02, 0.04, 5), across)
+        pts = np.concatenate([pts + 0.03 * axis, pts - 0.03 * axis])
+        d = s.shape.signed_distance(pts)
+        truth = np.array([min(exact(part, p) for part in s.shape.parts) for p in pts])
+        assert np.all(d <= truth + 1e-6) and np.all(d >= 0.7 * truth)  # measured: 0.74-1.0 of the truth
+        faces_only = np.min([np.max(pts @ p.normals.T + p.offsets, axis=1) for p in s.shape.parts], axis=0)
+        assert np.min(faces_only / truth) < 0.6  # what the faces alone said: down to 0.52
+    finally:
+        s.env.close()
+
+
+def test_thin_objects_get_tip_pinches_only_where_the_pads_do_not_press_them_into_the_table():
+    """A knife's handle is lower than a fingertip pad is wide: every pad at the table meets it above its widest
+    point and would press it down, so it gets no tip pinch. A fork's handle arches off the table: its tip pinches are
+    near its centroid, and their hands stay above the table and leave its top alone between the fingertips."""
+    from gendex.solve import tip_pinch
+
+    knife = Scene("knife", seed=1000)
+    try:
+        assert knife.synth.families() == ["pinch", "tip"]
+        away = np.array([np.cos(knife.synth.prefer), np.sin(knife.synth.prefer), 0.0])
+        assert tip_pinch.table_lines(knife.shape, 0.0, away) == []
+    finally:
+        knife.env.close()
+    fork = Scene("fork", seed=1000)
+    try:
+        away = np.array([np.cos(fork.synth.prefer), np.sin(fork.synth.prefer), 0.0])
+        lines = tip_pinch.table_lines(fork.shape, 0.0, away)
+        assert lines and all(line.press <= tip_pinch.MAX_PRESS for line in lines)
+        fp = fork.shape.footprint()
+        along = float(abs((lines[0].thumb[:2] + lines[0].finger[:2]) / 2 - fork.shape.centroid()[:2]) @ fp.axis)
+        assert along < 0.02
+        plan = next(iter(fork.synth._tip()))[0]
+        m = plan.palm.to_transformation_matrix()
+        shapes = (plan.open_hand, *[targets for targets, _ in plan.closing])
+        # every shape the hand passes through stays above the table; the last target is only the squeeze's lead
+        # (SQUEEZE_GAIN times past the last shape: the guard stops the fingers on the fork long before it)
+        for hand in shapes[:-1]:
+            cover = fork.hand.spheres(hand)
+            assert float(np.min(cover.centers @ m[2, :3] + m[2, 3] - cover.radii)) > 0.0
+        assert fork.synth.hand_clear(plan)
+    finally:
+        fork.env.close()
+
+
+@pytest.mark.parametrize("asset,seed", [("fork", 1000), ("spoon", 1000)])
+def test_a_utensil_lying_flat_is_lifted_by_a_fingertip_pinch_at_the_table(asset, seed):
+    """Fork and spoon handles (1-2 mm strips arching off the table) held 0/20 before the tip pinch. The spoon's tip
+    pinches often lift it between the index and the curled middle finger with the thumb off it, which does not count
+    as held (seed 1001: 4 of its 16 trials lifted it so, none with the thumb on it); on this seed the 12th trial
+    holds it with thumb and index."""
+    checker = LiftChecker(asset)
+    try:
+        result = checker(seed)
+    finally:
+        checker.close()
+    assert result.held and result.rise_m >= 0.10, result.failure
+    assert result.grasp.startswith("tip")
+
+
+def test_an_elongated_object_is_pinched_across_its_centroid_first():
+    """The hammer's centre of mass lies 20 mm from its box's centre, towards the head; pinched there it twisted out
+    of the pads (4/20). Its first pinch lines now cross its centroid."""
+    s = Scene("hammer", seed=1000)
+    try:
+        fp = s.shape.footprint()
+        s_com = float((s.shape.centroid()[:2] - fp.center) @ fp.axis)
+        assert abs(s_com) > 0.015
+        first = s.synth.pinch_lines()[0]
+        assert abs(float((first.center[:2] - fp.center) @ fp.axis) - s_com) < 0.002
+    finally:
+        s.env.close()
