@@ -40,9 +40,10 @@ DIFF_STEP = 1e-4
 Forward kinematics comes in float32 poses: at scipy's default step (~1e-8) a derivative is rounding noise, solves
 stall where they start and their answers change with the last bits of any computation before them.
 :func:`gendex.solve.grasp.pinch_shape` and :meth:`HandModel.finger_ik` still take scipy's step, so their answers are
-those the published tasks were measured with. With this step there, the knife held 12/20 instead of 0/20 and the
-hammer 13/20 instead of 3/20 (seeds 9500.., 9300..), but every other pinch moved too and three seeded scenario tests
-of the rigid skills changed outcome: that change waits for a library-wide re-measure."""
+those the published tasks were measured with. With this step there too, the knife held 12/20 and the hammer 13/20
+on seeds 9500.. (without it, on seeds 9300..: 0/20 and 3/20), but every other pinch moved as well and three seeded
+scenario tests of the rigid skills changed outcome: that change waits for a library-wide re-measure (the variant is
+on branch wip/pinch-diff-step)."""
 
 
 def actuated(finger: str) -> tuple[str, ...]:
