@@ -30,6 +30,13 @@ FRONT_ZONE_MAX_M = 0.30
 """Deepest front zone (m): the travel of the catalog's drawers; a 42 cm side door open 45 degrees reaches 0.3 m out."""
 
 
+def _clearance(mover_lo, mover_hi, other_lo, other_hi, axis: int, sign: float, jitter: float) -> float:
+    """How far ``mover`` must go along ``sign`` x axis ``axis`` to clear ``other`` by PENETRATION_FIX_MARGIN_M plus
+    ``jitter``."""
+    overlap = other_hi[axis] - mover_lo[axis] if sign > 0 else mover_hi[axis] - other_lo[axis]
+    return max(float(overlap), 0.0) + PENETRATION_FIX_MARGIN_M + jitter
+
+
 def separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
                     jitter_xy: Iterable[float] = (0.0, 0.0)) -> np.ndarray:
     """xy translation of ``mover`` along the line between the box centres that separates the boxes in x or y.
@@ -49,8 +56,7 @@ def separating_move(mover_lo, mover_hi, other_lo, other_hi, fallback_y: float,
     for i in range(2):
         if abs(u[i]) < 1e-6:
             continue
-        overlap = other_hi[i] - mover_lo[i] if u[i] > 0 else mover_hi[i] - other_lo[i]
-        need.append((max(overlap, 0.0) + PENETRATION_FIX_MARGIN_M + jitter[i]) / abs(u[i]))
+        need.append(_clearance(mover_lo, mover_hi, other_lo, other_hi, i, u[i], jitter[i]) / abs(u[i]))
     t = min(need) if need else PENETRATION_FIX_MARGIN_M
     return u * t
 
@@ -61,9 +67,8 @@ def axis_moves(mover_lo, mover_hi, other_lo, other_hi, jitter_xy: Iterable[float
     out = []
     for i in range(2):
         for sign in (1.0, -1.0):
-            overlap = other_hi[i] - mover_lo[i] if sign > 0 else mover_hi[i] - other_lo[i]
             d = np.zeros(2)
-            d[i] = sign * (max(float(overlap), 0.0) + PENETRATION_FIX_MARGIN_M + jitter[i])
+            d[i] = sign * _clearance(mover_lo, mover_hi, other_lo, other_hi, i, sign, jitter[i])
             out.append(d)
     return sorted(out, key=lambda d: float(np.abs(d).sum()))
 
