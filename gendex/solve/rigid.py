@@ -124,11 +124,14 @@ class RigidConfig:
     release_steps: int = 8
     max_trials: int = 10
     """Physics trials per grasp before giving up (0: no trials, the first reachable candidate is used)."""
-    thin_trials: int = 16
+    thin_trials: int = 48
     """Physics trials per grasp of an object low enough for fingertip pinches at the table (the ``tip`` family):
-    side pinches and tip pinches share the budget there, and most of either are near misses. The spoon on dev seeds
-    1000-1003 held 2 times in 4 with 10 trials; with 16, 10 in 10 on 1000-1009, the grasp that held being the 5th to
-    13th tried."""
+    side pinches and tip pinches share the budget there, and most of either are near misses. Trying every tip hand
+    (palm direction, roll, solve start) of a line on dev seeds showed one hand of 10-14 holding and the rest 0, which
+    one depending on the object (knife 14/25 trials, spoon 9/12, fork 4/6), not on a feature of the hand that could
+    rank them; so the trials rank them, and need the budget to reach that hand on a few lines. Dev seeds 1000-1009:
+    knife 6, spoon 7, fork 10 of 10 with 16 trials; 9, 9 and 10 with 48 (a failed attempt then costs about 20 s of
+    trials)."""
     regrasps: int = 1
     """Further grasps after one whose object slipped out while lifting."""
     replans: int = 2

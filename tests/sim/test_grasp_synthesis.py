@@ -268,7 +268,7 @@ def test_thin_objects_get_tip_pinches_only_where_friction_can_hold_them_off_the_
 def test_a_utensil_lying_flat_is_lifted_by_a_fingertip_pinch_at_the_table(asset, seed):
     """Fork and spoon handles (1-2 mm strips arching off the table) and the knife's low handle held 0/20 before
     the tip pinch. The spoon's tip pinches often lift it between the index and the curled middle finger with the
-    thumb off it, which does not count as held (seed 1001: 4 of its 16 trials lifted it so, none with the thumb on
+    thumb off it, which does not count as held (seed 1001, 16 trials: 4 of them lifted it so, none with the thumb on
     it); on this seed the 12th trial holds it with thumb and index."""
     checker = LiftChecker(asset)
     try:
