@@ -41,6 +41,21 @@ def transform_points(p: torch.Tensor, q_wxyz: torch.Tensor, local: torch.Tensor)
     return p + quat_rotate(q_wxyz, local.expand_as(p))
 
 
+def box_rest_point(p: torch.Tensor, q_wxyz: torch.Tensor, lo: torch.Tensor, hi: torch.Tensor) -> torch.Tensor:
+    """[N, 3] where an object with the box ``[lo, hi]`` (its frame, [3] each) posed at ``p`` [N, 3], ``q_wxyz``
+    [N, 4] rests: below the box's centre, at the lowest point of the ellipsoid inscribed in the box. That point is
+    the object's bottom for a box on any face, a ball turned any way and a can standing or on its side, so an object
+    standing as built (its frame's origin at the centre of its bottom face) rests at its origin, however it is
+    turned about the vertical; a bottle lying on its side rests at its middle, not at its base. (The box's own
+    lowest corner would put a rolled ball up to 0.7 of its radius below the table.)"""
+    center = transform_points(p, q_wxyz, (lo + hi) / 2)
+    half = (hi - lo) / 2
+    axes = torch.eye(3, dtype=p.dtype, device=p.device)
+    # the world z of each of the box's half axes: the ellipsoid reaches sqrt(sum of their squares) below its centre
+    down = torch.stack([quat_rotate(q_wxyz, axes[j].expand_as(p))[:, 2] * half[j] for j in range(3)], dim=-1)
+    return torch.cat([center[:, :2], (center[:, 2] - torch.linalg.norm(down, dim=-1))[:, None]], dim=-1)
+
+
 def xy_distance(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
     """Horizontal distance between positions a, b [N, 3] -> [N], metres."""
     return torch.linalg.norm(a[..., :2] - b[..., :2], dim=-1)

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 import torch
 
 from gendex_envs.errors import RewardModuleError, TaskSpecError
-from gendex_envs.geometry import xy_distance, z_twist
+from gendex_envs.geometry import box_rest_point, xy_distance, z_twist
 from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, TaskSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -49,6 +49,22 @@ def _anchor(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     return env.handle_pos(c.object, c.joint) if c.part == "handle" else env.obj_pose(c.object).p
 
 
+def rest_point(env: TaskEnv, name: str) -> torch.Tensor:
+    """[N, 3] where object ``name`` rests, as ``near``, ``over`` and ``inside`` measure it: below the centre of its
+    box, at the box's inscribed ellipsoid's lowest point (:func:`~gendex_envs.geometry.box_rest_point`). A catalog
+    object's origin is the bottom centre of its box, so an object standing as it was spawned is measured at its
+    origin; one that lies on its side is measured at its middle, not at its base. An articulated object is measured
+    at its root's origin."""
+    pose = env.obj_pose(name)
+    if name in env.articulations:
+        return pose.p
+    record = env.asset_record(name)
+    scale = env.task_spec.object(name).scale
+    lo, hi = (torch.tensor(b, dtype=pose.p.dtype, device=pose.p.device) * scale
+              for b in (record.bbox_min_m, record.bbox_max_m))
+    return box_rest_point(pose.p, pose.q, lo, hi)
+
+
 def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     t = c.type
     if t == "lifted":
@@ -57,10 +73,10 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
         return env.joint_open_fraction(c.object, c.joint) >= c.min_fraction
     if t == "near":
         target = env.goal_pos if c.target == GOAL_TARGET else env.obj_pose(c.target).p
-        return torch.linalg.norm(env.obj_pose(c.object).p - target, dim=-1) <= c.max_dist_m
+        return torch.linalg.norm(rest_point(env, c.object) - target, dim=-1) <= c.max_dist_m
     if t == "inside":
         inner_r, top = env.container_extent(c.target)
-        box, p = env.obj_pose(c.target).p, env.obj_pose(c.object).p
+        box, p = env.obj_pose(c.target).p, rest_point(env, c.object)
         dz = p[:, 2] - box[:, 2]
         return (xy_distance(p, box) <= inner_r) & (dz >= -INSIDE_FLOOR_TOL_M) & (dz <= top)
     if t == "rotated":
@@ -68,7 +84,7 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
         goal = math.radians(c.min_deg)
         return twist >= goal if goal > 0 else twist <= goal
     if t == "over":
-        p, q = env.obj_pose(c.object).p, env.obj_pose(c.target).p
+        p, q = rest_point(env, c.object), env.obj_pose(c.target).p
         dz = p[:, 2] - q[:, 2]
         return (xy_distance(p, q) <= c.max_xy_m) & (dz >= c.min_dz_m) & (dz <= c.max_dz_m)
     if t in ("grasped", "released"):

@@ -158,3 +158,24 @@ def test_success_must_hold_for_hold_steps(task_version):
         assert seen == [False, False, True, True], seen
     finally:
         env.close()
+
+
+def test_a_bottle_lying_on_the_plate_is_on_it(make_env):
+    """``near`` measures where an object rests, not its origin: a bottle laid on its side with its middle over the
+    plate is on the plate, though its origin (the centre of its base) is half its length away."""
+    env = make_env("GenDex/SetBottleOnPlate-v2", gym_api=False)
+    u = env.unwrapped
+    env.reset(seed=0)
+    bottle, plate = u.obj("bottle"), u.obj("plate")
+    record = u.asset_record("bottle")
+    half_length, radius = record.size_m[2] / 2, record.size_m[0] / 2
+    p = plate.pose.p.clone()
+    p[:, 0] -= half_length  # laid along world +x (base -> cap), its middle over the plate's centre
+    p[:, 2] += 0.03 + radius
+    lying = torch.tensor([[np.cos(np.pi / 4), 0.0, np.sin(np.pi / 4), 0.0]]).expand_as(bottle.pose.q)
+    bottle.set_pose(type(bottle.pose).create_from_pq(p, lying))
+    for _ in range(120):  # 1 s of physics, no control
+        u.scene.step()
+    limit = u.task_spec.success.conditions[0].max_dist_m
+    assert (torch.linalg.norm(bottle.pose.p - plate.pose.p, dim=-1) > limit).all(), "the origin alone is off it"
+    assert u.evaluate()["success"].all(), f"bottle at {bottle.pose.p} {bottle.pose.q}, plate at {plate.pose.p}"
