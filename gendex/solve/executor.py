@@ -339,14 +339,15 @@ class StageExecutor:
         yield from self.rigid.push(stage.target, goal[0, :2].cpu().numpy().astype(np.float64), c.max_dist_m)
 
     def _set_down_on(self, stage, held: str | None) -> str | None:
-        """The object an ``inside`` or ``over`` condition (the stage's, else the task's) wants ``held`` in or on."""
+        """The object an ``inside``, ``over`` or ``near`` condition (the stage's, else the task's) wants ``held`` in, on
+        or by (a ``near`` on the goal point sets nothing down: pushes use it)."""
         conds = (*(stage.success or ()), *self._env.task_spec.success.conditions)
-        return next((c.target for c in conds if c.type in ("inside", "over") and c.object == held and not c.negate
+        return next((c.target for c in conds if c.type in SET_DOWN_CONDITIONS and c.object == held and not c.negate
                      and c.target in self._env.objects and c.target not in self._env.articulations), None)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
-        """Let go; an object held over what a condition wants it in or on is first set down there (a dropped tall
-        object topples out of a bowl)."""
+        """Let go; an object held over what a condition wants it in, on or by is first set down there (a dropped tall
+        object topples out of a bowl; a dropped ball bounces off a flat board)."""
         held = self.rigid.held
         onto = self._set_down_on(stage, held)
         if held is not None and onto is not None and self.rigid.placed_on != onto:

@@ -3,6 +3,7 @@ rests there) and ``push`` (an object slid across the table with the flat hand, c
 
 import gymnasium as gym
 import numpy as np
+import pytest
 import torch
 
 from gendex.solve.executor import StageExecutor
@@ -175,6 +176,26 @@ def test_a_tall_box_held_high_is_carried_from_as_high_as_the_arm_reaches(caplog)
         assert held[0].plan.kind == "side" and held[0].spread > 2.0  # swung: does not fit the 20 cm board
         assert executor.grasp_plan is held[-1].plan and held[-1].plan.kind == "pinch"
         assert out.succeeded, out.failure
+    finally:
+        executor.rigid.close()
+        env.close()
+
+
+@pytest.mark.parametrize("seed", [779603, 779604])
+def test_a_ball_to_lie_on_a_board_is_set_down_on_it_not_dropped(seed):
+    """A release whose ``near`` names a board first lowers the ball onto it. Dropped from the carry's height, a
+    tennis ball bounced off the cutting board on these seeds; set down, it rests on the board, let go, and stays."""
+    from gendex.solve.attempt import run_attempt
+    from gendex_envs.success import rest_point
+
+    env = _data_task_env("SetTennisBallOnCuttingBoard")
+    executor = StageExecutor()
+    try:
+        out = run_attempt(env, executor, seed)
+        assert out.succeeded, out.failure
+        assert executor.rigid.placed_on == "cutting_board"
+        board_top = float(env.obj("cutting_board").pose.p[0, 2]) + env.asset_record("cutting_board").size_m[2]
+        assert abs(float(rest_point(env, "tennis_ball")[0, 2]) - board_top) < 0.02  # on it, not in the air
     finally:
         executor.rigid.close()
         env.close()
