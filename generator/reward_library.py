@@ -60,8 +60,10 @@ def _header(title: str) -> str:
 
 def _parts(spec: dict) -> list[dict]:
     """The task's success conditions, one per part, without the ``grasped`` that the scene step adds beside a
-    ``lifted`` (:func:`generator.steps.scene.hold_lifted`): the lift's reward terms already reward the contact."""
-    return [c for c in spec["success"]["conditions"] if c["type"] != "grasped"]
+    ``lifted`` (:func:`generator.steps.scene.hold_lifted`) nor the ``released`` it adds beside a set-down
+    (:func:`generator.steps.scene.let_go`): the lift's terms already reward the contact, and letting go is rewarded
+    by the success itself."""
+    return [c for c in spec["success"]["conditions"] if c["type"] not in ("grasped", "released")]
 
 
 def _success_condition(spec: dict, obj: str | None = None) -> dict:

@@ -15,6 +15,7 @@ import logging
 from gendex.solve.grasp import HAND_SPAN_M, hand_fit_scale
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.spec import (
+    GOAL_TARGET,
     SCALE_RANGE,
     ConditionSpec,
     RobotSpec,
@@ -46,6 +47,11 @@ CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
 LIFT_HOLD_FINGERS = 1
 """Fingers besides the thumb that must touch an object a task's success needs lifted (:func:`hold_lifted`)."""
+SET_DOWN_TYPES = ("inside", "near", "over")
+"""Success conditions that set an object down in, on or by another object (:func:`let_go`)."""
+SETTLED_STEPS = 10
+"""Consecutive control steps (0.5 s at 20 Hz) a set-down success must hold (:func:`let_go`): a dropped ball passes
+through a board's ``near`` in two or three."""
 
 
 def _clamp_scale(s: float) -> float:
@@ -89,6 +95,24 @@ def hold_lifted(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=extra + conds))
 
 
+def let_go(spec: TaskSpec) -> TaskSpec:
+    """Give every object the task's success sets down on, in or by another object a ``released`` condition, and the
+    success :data:`SETTLED_STEPS` to hold: without them a ball still in the hand over a cutting board, or one falling
+    past it, was within the board's ``near`` and counted as set down (the offline author's set-on-board tasks,
+    dev seeds). A ``near`` on the ``goal`` point (a push) is left alone, as is an object the success itself holds."""
+    conds = spec.success.conditions
+    kept = {c.object for c in conds if c.type in ("released", "grasped") and not c.negate}
+    add = [c.object for c in conds if c.type in SET_DOWN_TYPES and not c.negate and c.target != GOAL_TARGET
+           and c.object not in kept]
+    if not add:
+        return spec
+    log.info("success of %s: %s must also be let go and stay %d steps", spec.name, ", ".join(add), SETTLED_STEPS)
+    extra = tuple(ConditionSpec(type="released", object=o) for o in dict.fromkeys(add))
+    success = dataclasses.replace(spec.success, conditions=conds + extra,
+                                  hold_steps=max(spec.success.hold_steps, SETTLED_STEPS))
+    return dataclasses.replace(spec, success=success)
+
+
 def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     """Parse a scene answer into a TaskSpec using exactly the proposal's objects; :class:`SceneError` otherwise."""
     raw = parse_yaml_block(text, "scene file", SceneError)
@@ -108,7 +132,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
     if spec.name != proposal.name:
         spec = dataclasses.replace(spec, name=proposal.name)
-    return hold_lifted(spec)
+    return let_go(hold_lifted(spec))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

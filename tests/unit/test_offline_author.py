@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from gendex_envs.spec import spec_to_dict
+from gendex_envs.spec import parse_task_spec, spec_to_dict
 from generator.backends.base import ModelRequest
 from generator.backends.offline import OfflineBackend
 from generator.catalog_view import asset_dicts
@@ -276,7 +276,7 @@ def test_composed_tasks_do_two_parts_in_turn_and_check_both():
                    "candidate_index": 0, "index": i, "attempt": 0}
         spec = spec_to_dict(adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="",
                                                                               context=context)).text, p), p))
-        assert len([c for c in spec["success"]["conditions"] if c["type"] != "grasped"]) == 2
+        assert len([c for c in spec["success"]["conditions"] if c["type"] not in ("grasped", "released")]) == 2
         roles = roles_of(dataclasses.asdict(p))
         src = compose_task_module(spec, roles)
         check_reward_source(src)
@@ -309,4 +309,29 @@ def test_a_lift_success_is_written_with_a_grasp_so_a_knocked_object_does_not_cou
     context["proposal"] = dataclasses.asdict(put)
     context["assets"] = [a for a in asset_dicts() if a["id"] in {o.asset for o in put.objects}]
     other = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, put)
-    assert [c.type for c in other.success.conditions] == ["inside"]
+    assert [c.type for c in other.success.conditions] == ["inside", "released"]  # and no grasp: see below
+
+
+def test_a_set_down_success_is_written_with_a_release_held_while_it_settles():
+    """A ball still in the hand over a cutting board, or one falling past it, met the board's ``near``: the scene
+    step adds ``released`` for each object set in, on or by another, and makes the success hold for
+    :data:`SETTLED_STEPS`; a push to the goal point and a success that holds its object are left alone."""
+    from generator.steps.scene import SETTLED_STEPS, let_go
+
+    proposals = _proposals(3, 40)
+    b = OfflineBackend(seed=3)
+    for kind in ("inside", "near"):
+        p = next(p for p in proposals if p.success.get("type") == kind and p.success.get("target") != "goal")
+        context = {"proposal": dataclasses.asdict(p), "candidate_index": 0, "index": 0, "attempt": 0,
+                   "assets": [a for a in asset_dicts() if a["id"] in {o.asset for o in p.objects}]}
+        spec = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p)
+        conds = [(c.type, c.object, c.negate) for c in spec.success.conditions]
+        assert conds == [(kind, p.success["object"], False), ("released", p.success["object"], False)], conds
+        assert spec.success.hold_steps == SETTLED_STEPS
+        assert let_go(spec) == spec  # nothing added twice
+    raw = spec_to_dict(spec)
+    raw["success"] = {"description": "pushed", "conditions": [{"type": "near", "object": p.success["object"],
+                                                               "target": "goal", "max_dist_m": 0.04}]}
+    raw["goal"] = {"pos_m": [0.1, 0.0, 0.0]}
+    pushed = parse_task_spec(raw)
+    assert let_go(pushed) == pushed
