@@ -32,7 +32,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 import sapien
@@ -48,6 +48,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 DOOR_FRONT_LOCAL = np.array([-1.0, 0.0, 0.0])
 """Outward normal of a door's front in its link frame (catalog convention: fronts face -x)."""
@@ -295,6 +296,8 @@ class HandlePrimitives:
         self.hooked = False
         self.target: str | None = None
         self._shapes: dict[tuple[str, str], ObjectShape | None] = {}
+        self._others: list[Box] = []
+        """Boxes of the scene's other objects, obstacles beside the part's own (:meth:`_clear_of_others`)."""
 
     def run(self, prim: str, stage) -> Iterator[np.ndarray]:
         """The actions of primitive ``prim`` (``approach_handle``, ``hook``, ``pull`` or ``shut``) for ``stage``."""
@@ -302,6 +305,24 @@ class HandlePrimitives:
             raise ExecutionError(f"no articulated primitive {prim!r}; primitives: approach_handle, hook, pull, shut",
                                  cause="unsupported")
         return getattr(self, prim)(stage)
+
+    def _obstacles(self, boxes: list[Box]) -> None:
+        """Plan among ``boxes`` (the part's) and the other objects' boxes, if :meth:`_clear_of_others` set them."""
+        self.motion.collision.set_obstacles(boxes + self._others)
+
+    def _clear_of_others(self, name: str, search: Callable[[], T | None]) -> T | None:
+        """``search()`` (for a grasp or press pose of ``name``'s part, and the arm motions it needs) run with every
+        other object an obstacle too, and again without them only if that finds nothing. Without them the forearm,
+        swung along a microwave door's arc, knocked a standing bottle over (a fresh batch's close-the-door-then-set-
+        the-bottle-down task, dev seeds 779401-779403: the bottle was then too low to grasp)."""
+        for avoid in (True, False):
+            self._others = self.motion.object_boxes(exclude=(name,)) if avoid else []
+            found = search()
+            if found is not None:
+                return found
+            if avoid and self._others:
+                log.info("%r: no pose of the hand and arm clear of the other objects; trying without them", name)
+        return None
 
     def _goal(self, name: str) -> float:
         """Where this task moves ``name``'s joint: towards closed if a stage closes it, else open."""
@@ -391,32 +412,7 @@ class HandlePrimitives:
         joint = read_joint(u, name)
         handle = handle_local(u, name)
         goal = self._goal(name)
-        chosen = None
-        # the links' boxes inflated 1 cm first; where no grasp clears them (a low drawer: the forearm housing
-        # passes 1.5 cm from the chest's front), the links' own boxes (the model's 2 cm margin still applies)
-        for inflate in INFLATES_M:
-            for grasp in hook_grasps(joint, handle):
-                q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
-                ex.collision.set_obstacles(self._boxes(name, moving=False, inflate_m=inflate))
-                q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20,
-                                    valid=ex.collision.is_free)
-                if q_pre is None:
-                    log.debug("%s: pre-pose unreachable", grasp)
-                    continue
-                n = INSERT_CHECKS
-                q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)],
-                                   q_pre)
-                if q_in is None:
-                    log.debug("%s: no straight motion in", grasp)
-                    continue
-                ex.collision.set_obstacles(self._boxes(name, moving=True, inflate_m=inflate))
-                if self._chain(self._arc(grasp, joint, goal), q_in) is None:
-                    log.debug("%s: arm cannot follow the arc", grasp)
-                    continue
-                chosen = (grasp, q_pre, q0, inflate)
-                break
-            if chosen is not None:
-                break
+        chosen = self._clear_of_others(name, lambda: self._find_hook(name, joint, handle, goal))
         if chosen is None:
             raise ExecutionError(f"no hook grasp of {name!r}'s handle that the arm can reach and pull along the "
                                  f"door's arc", cause="no_ik")
@@ -428,6 +424,34 @@ class HandlePrimitives:
         yield from ex.cartesian(-PRE_M * normal, self.config.insert_m_per_step)
         yield from ex.settle()
 
+    def _find_hook(self, name: str, joint: JointFrame, handle: np.ndarray, goal: float) -> tuple | None:
+        """The first hook grasp (with its pre-pose joints, hand joints and inflation) whose pre-pose the arm
+        reaches, that it moves straight in from, and whose arc to ``goal`` it follows, all clear of the obstacles."""
+        ex = self.motion
+        # the links' boxes inflated 1 cm first; where no grasp clears them (a low drawer: the forearm housing
+        # passes 1.5 cm from the chest's front), the links' own boxes (the model's 2 cm margin still applies)
+        for inflate in INFLATES_M:
+            for grasp in hook_grasps(joint, handle):
+                q0 = ex.with_hand(ex.target(), HOOK_OPEN | grasp.wrist)
+                self._obstacles(self._boxes(name, moving=False, inflate_m=inflate))
+                q_pre = ex.ik.solve(grasp.palm_at(joint, joint.q, PRE_M), q0, restarts=20,
+                                    valid=ex.collision.is_free)
+                if q_pre is None:
+                    log.debug("%s: pre-pose unreachable", grasp)
+                    continue
+                n = INSERT_CHECKS
+                q_in = self._chain([grasp.palm_at(joint, joint.q, PRE_M * (1 - k / n)) for k in range(1, n + 1)],
+                                   q_pre)
+                if q_in is None:
+                    log.debug("%s: no straight motion in", grasp)
+                    continue
+                self._obstacles(self._boxes(name, moving=True, inflate_m=inflate))
+                if self._chain(self._arc(grasp, joint, goal), q_in) is None:
+                    log.debug("%s: arm cannot follow the arc", grasp)
+                    continue
+                return grasp, q_pre, q0, inflate
+        return None
+
     def _bring_open_hand(self, name: str, q_pre: np.ndarray, q0: np.ndarray, inflate_m: float = 0.01
                          ) -> Iterator[np.ndarray]:
         """Planned arm motion to the pre-pose ``q_pre`` with the open hand (targets ``q0``) in the collision model
@@ -437,7 +461,7 @@ class HandlePrimitives:
         ex = self.motion
         path, rise = None, 0.0
         if self.hand_cover is not None:
-            ex.collision.set_obstacles(self._part_boxes(name))
+            self._obstacles(self._part_boxes(name))
             ex.collision.cover_hand(*self.hand_cover())
             try:
                 rise, start = ex.rise_clear(q0, ESCAPE_M)
@@ -447,7 +471,7 @@ class HandlePrimitives:
                 path, rise = None, 0.0
             finally:
                 ex.collision.cover_hand(None)
-        ex.collision.set_obstacles(self._boxes(name, moving=False, inflate_m=inflate_m))
+        self._obstacles(self._boxes(name, moving=False, inflate_m=inflate_m))
         if path is None:
             yield from ex.move_arm(q_pre, hand=q0)
             return

@@ -220,15 +220,19 @@ class ArmHandMotion:
         radius = float(np.max(size[:2]) / 2)
         return (lo[:2] + hi[:2]) / 2, float(lo[2]), float(hi[2] - lo[2]), radius
 
-    def avoid_objects(self, exclude: tuple[str, ...] = ()) -> None:
-        """Make every object but ``exclude`` an obstacle of planned motions (boxes inflated 1 cm)."""
+    def object_boxes(self, exclude: tuple[str, ...] = ()) -> list[Box]:
+        """World boxes of every object but ``exclude``, inflated 1 cm."""
         boxes = []
         for name in self.env.objects:
             if name in exclude:
                 continue
             lo, hi = self.world_aabb(name)
             boxes.append(Box(lo - 0.01, hi + 0.01, name))
-        self.collision.set_obstacles(boxes)
+        return boxes
+
+    def avoid_objects(self, exclude: tuple[str, ...] = ()) -> None:
+        """Make every object but ``exclude`` an obstacle of planned motions (boxes inflated 1 cm)."""
+        self.collision.set_obstacles(self.object_boxes(exclude))
 
 
 def resample(path: np.ndarray, pace: float) -> np.ndarray:

@@ -331,22 +331,27 @@ class PressPrimitives(HandlePrimitives):
         u = ex.env
         joint = read_joint(u, name)
         sign = self._sign(stage)
-        goal = self._press_goal(stage, sign)
         covers: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        chosen = self._find_press(stage, joint, sign, goal, covers)
-        plain = self._press_goal(stage, sign, stay=False)
-        if chosen is None and plain != goal:
-            log.info("%r: no press reaches %.2f, where it would stay open; pressing to %.2f", name, goal, plain)
-            goal = plain
+
+        def search() -> tuple | None:
+            goal = self._press_goal(stage, sign)
             chosen = self._find_press(stage, joint, sign, goal, covers)
-        if chosen is None:
+            plain = self._press_goal(stage, sign, stay=False)
+            if chosen is None and plain != goal:
+                log.info("%r: no press reaches %.2f, where it would stay open; pressing to %.2f", name, goal, plain)
+                goal = plain
+                chosen = self._find_press(stage, joint, sign, goal, covers)
+            return None if chosen is None else (*chosen, goal)
+
+        found = self._clear_of_others(name, search)
+        if found is None:
             raise ExecutionError(f"no press pose on {name!r}'s moving part that the arm can reach and follow along "
                                  f"its path", cause="no_ik")
-        pose, q_pre, q0, pre = chosen
+        pose, q_pre, q0, pre, goal = found
         log.info("%r: %s", name, pose)
         self.grasp, self.target, self.hooked = pose, name, False
         self._goals[name, sign] = goal
-        ex.collision.set_obstacles(self._part_boxes(name))
+        self._obstacles(self._part_boxes(name))
         ex.collision.cover_hand(*covers[pose.site])
         try:
             path = ex.plan_arm(q_pre, hand=q0)
@@ -387,7 +392,7 @@ class PressPrimitives(HandlePrimitives):
             q0 = ex.with_hand(ex.target(), pose.hand)
             q_pre = q_in = None
             for pre in PRE_M:  # a pre-pose the arm reaches with the open hand clear, and moves straight in from
-                ex.collision.set_obstacles(around)  # the pre-pose: the open hand clear of the whole part
+                self._obstacles(around)  # the pre-pose: the open hand clear of the whole part
                 ex.collision.cover_hand(centres, radii)
                 try:
                     q_pre = ex.ik.solve(pose.palm_at(joint, joint.q, pre), q0, restarts=20, valid=ex.collision.is_free)
@@ -395,7 +400,7 @@ class PressPrimitives(HandlePrimitives):
                     ex.collision.cover_hand(None)
                 if q_pre is None:
                     continue
-                ex.collision.set_obstacles(self._boxes(name, moving=True, inflate_m=0.0))  # then the arm alone
+                self._obstacles(self._boxes(name, moving=True, inflate_m=0.0))  # then the arm alone
                 n = int(np.ceil(pre / INSERT_STEP_M))
                 q_in = self._chain([pose.palm_at(joint, joint.q, pre * (1 - k / n)) for k in range(1, n + 1)], q_pre,
                                    CHAIN_RESTARTS)
