@@ -161,7 +161,7 @@ def test_success_must_hold_for_hold_steps(task_version):
 
 
 def test_a_bottle_lying_on_the_plate_is_on_it(make_env):
-    """``near`` measures where an object rests, not its origin: a bottle laid on its side with its middle over the
+    """``near`` measures where an object lies, not its origin: a bottle laid on its side with its middle over the
     plate is on the plate, though its origin (the centre of its base) is half its length away."""
     env = make_env("GenDex/SetBottleOnPlate-v2", gym_api=False)
     u = env.unwrapped

@@ -44,9 +44,9 @@ def test_transform_points_and_xy_distance():
 
 
 def test_box_rest_point_is_the_origin_of_a_standing_box_and_the_middle_of_a_lying_one():
-    """A 0.22 m bottle-like box, origin at its bottom centre: standing (turned about z, anywhere) it rests at its
-    origin; laid on its side, at the middle of its length, on the table, not at its base. A ball turned any way
-    rests one radius below its centre."""
+    """A 0.22 m bottle-like box, origin at its bottom centre: standing (turned about z, anywhere) it lies at its
+    origin; laid on its side, at the middle of its length seen from above, at its origin's height. A ball turned
+    any way lies under its centre."""
     lo, hi = torch.tensor([-0.03, -0.03, 0.0]), torch.tensor([0.03, 0.03, 0.22])
     p = torch.tensor([[0.1, -0.2, 0.76], [0.1, -0.2, 0.76]])
     standing = yaw_quat(torch.tensor([0.0, 1.1]))
@@ -54,11 +54,10 @@ def test_box_rest_point_is_the_origin_of_a_standing_box_and_the_middle_of_a_lyin
     # about world y by +90 deg: the body's +z (base -> cap) points along world +x; its side lies on the table
     lying = torch.tensor([[math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0]]).expand(2, 4)
     p_lying = torch.tensor([[0.1, -0.2, 0.79], [0.0, 0.0, 0.79]])  # the origin 3 cm up: the radius
-    rest = box_rest_point(p_lying, lying, lo, hi)
-    torch.testing.assert_close(rest, p_lying + torch.tensor([0.11, 0.0, -0.03]))
+    torch.testing.assert_close(box_rest_point(p_lying, lying, lo, hi), p_lying + torch.tensor([0.11, 0.0, 0.0]))
     ball_lo, ball_hi = torch.tensor([-0.033, -0.033, 0.0]), torch.tensor([0.033, 0.033, 0.066])
     turned = torch.tensor(Rotation.random(8, random_state=4).as_quat()[:, [3, 0, 1, 2]], dtype=torch.float32)
-    origin = torch.zeros(8, 3)
-    centre = quat_rotate(turned, torch.tensor([[0.0, 0.0, 0.033]]).expand(8, 3))
-    expected = torch.cat([centre[:, :2], (centre[:, 2] - 0.033)[:, None]], dim=-1)
+    origin = torch.rand(8, 3)
+    centre = origin + quat_rotate(turned, torch.tensor([[0.0, 0.0, 0.033]]).expand(8, 3))
+    expected = torch.cat([centre[:, :2], origin[:, 2:]], dim=-1)
     torch.testing.assert_close(box_rest_point(origin, turned, ball_lo, ball_hi), expected)
