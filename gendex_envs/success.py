@@ -35,6 +35,9 @@ if TYPE_CHECKING:  # pragma: no cover
 INSIDE_FLOOR_TOL_M = 0.01
 """An object counts as inside a container from this far below the container's origin (a seated object may sink
 into a thin floor) up to the container's height."""
+SET_DOWN_CONDITIONS = ("inside", "over", "near")
+"""Conditions that set their object down in, on or by a target: they measure it where it lies (:func:`rest_point`);
+the solver sets it down before letting go, and the generator's scene step has it let go and settled."""
 THUMB, PALM = 0, 5
 """Rows of the hand's contact-force groups (thumb, index, middle, ring, little, palm)."""
 

@@ -315,12 +315,13 @@ class HandlePrimitives:
         other object an obstacle too, and again without them only if that finds nothing. Without them the forearm,
         swung along a microwave door's arc, knocked a standing bottle over (a fresh batch's close-the-door-then-set-
         the-bottle-down task, dev seeds 779401-779403: the bottle was then too low to grasp)."""
-        for avoid in (True, False):
-            self._others = self.motion.object_boxes(exclude=(name,)) if avoid else []
+        others = self.motion.object_boxes(exclude=(name,))
+        for boxes in ((others, []) if others else ([],)):  # without others the second pass would repeat the first
+            self._others = boxes
             found = search()
             if found is not None:
                 return found
-            if avoid and self._others:
+            if self._others:
                 log.info("%r: no pose of the hand and arm clear of the other objects; trying without them", name)
         return None
 

@@ -54,6 +54,7 @@ from gendex.solve.press import PressPrimitives
 from gendex.solve.rigid import CARRY_M_PER_STEP, RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
+from gendex_envs.success import SET_DOWN_CONDITIONS
 from gendex_envs.task_version import Artifacts, PolicyFiles
 from gendex_envs.wrappers import time_limit
 
@@ -71,10 +72,6 @@ SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
-SET_DOWN_CONDITIONS = ("inside", "over", "near")
-"""Success conditions that set their object down in, on or next to a target object: a grasp of that object that
-lets it swing over too far to fit the target is taken only when no trial does better
-(:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp`)."""
 CARRY_EXTRA_STEPS = 15
 """A level carry takes its length over :data:`~gendex.solve.rigid.CARRY_M_PER_STEP` plus about this many steps
 (easing in and out, rising to the carry height)."""
@@ -289,7 +286,8 @@ class StageExecutor:
     def _set_on(self, name: str) -> str | None:
         """The object a later release sets ``name`` down in, on or next to (the target of an ``inside``, ``over`` or
         ``near`` condition on ``name``), if any: a tall object that swung over in the hand catches a container's rim,
-        or lands on its side and topples off a board."""
+        or lands on its side and topples off a board, so a grasp that lets it swing over too far to fit the target is
+        taken only when no trial does better (:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp`)."""
         spec = self._env.task_spec
         conds = (*spec.success.conditions, *(c for s in spec.stages[self.stage_index + 1:] for c in s.success or ()))
         return next((c.target for c in conds if c.type in SET_DOWN_CONDITIONS and c.object == name and not c.negate

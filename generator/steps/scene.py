@@ -24,6 +24,7 @@ from gendex_envs.spec import (
     dump_task_spec,
     parse_task_spec,
 )
+from gendex_envs.success import SET_DOWN_CONDITIONS
 from generator.backends.base import Backend
 from generator.catalog_view import asset_dict, asset_dicts, guidance
 from generator.critic.physical import REACH_MAX_M
@@ -47,8 +48,6 @@ CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
 LIFT_HOLD_FINGERS = 1
 """Fingers besides the thumb that must touch an object a task's success needs lifted (:func:`hold_lifted`)."""
-SET_DOWN_TYPES = ("inside", "near", "over")
-"""Success conditions that set an object down in, on or by another object (:func:`let_go`)."""
 SETTLED_STEPS = 10
 """Consecutive control steps (0.5 s at 20 Hz) a set-down success must hold (:func:`let_go`): a dropped ball passes
 through a board's ``near`` in two or three."""
@@ -102,7 +101,7 @@ def let_go(spec: TaskSpec) -> TaskSpec:
     dev seeds). A ``near`` on the ``goal`` point (a push) is left alone, as is an object the success itself holds."""
     conds = spec.success.conditions
     kept = {c.object for c in conds if c.type in ("released", "grasped") and not c.negate}
-    add = [c.object for c in conds if c.type in SET_DOWN_TYPES and not c.negate and c.target != GOAL_TARGET
+    add = [c.object for c in conds if c.type in SET_DOWN_CONDITIONS and not c.negate and c.target != GOAL_TARGET
            and c.object not in kept]
     if not add:
         return spec
