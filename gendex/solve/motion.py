@@ -184,6 +184,64 @@ class ArmHandMotion:
             yield self.emit(t, guard)
         return 1.0
 
+    def level_path(self, start: sapien.Pose, goal: sapien.Pose, q: np.ndarray, m_per_step: float, step_rad: float,
+                   ramp_steps: int, pace: float = 1.0, turn: float = 0.0, pivot: np.ndarray | None = None
+                   ) -> list[np.ndarray] | None:
+        """Joint vectors moving the palm straight from ``start`` to ``goal`` at a constant orientation (or turning
+        steadily by ``turn`` rad about the vertical through ``pivot``, which moves with the palm: a held object's
+        centre), at most ``m_per_step`` a step and ``step_rad`` per joint (both times ``pace``), the speed ramping
+        up and down over ``ramp_steps`` (a held ball flies out of a sudden 0.4 m/s start); None if a step has no IK,
+        jumps branches (an arm joint moving more than 8 ``step_rad``) or collides."""
+        speed, paced_rad = m_per_step * pace, step_rad * pace
+        length = float(np.linalg.norm(goal.p - start.p))
+        ramp = np.minimum(1.0, np.arange(1, 4 * ramp_steps + int(length / speed) + 2) / ramp_steps) * speed
+        travelled, profile = 0.0, []
+        for v in ramp:
+            if travelled >= length:
+                break
+            slow = min(1.0, (length - travelled) / (ramp_steps * speed) + 0.2)
+            travelled = min(length, travelled + v * slow)
+            profile.append(travelled / max(length, 1e-9))
+        out = []
+        for f in profile:
+            pose = sapien.Pose(start.p + (goal.p - start.p) * f, start.q)
+            if turn:
+                at = sapien.Pose((start.p if pivot is None else pivot) + (goal.p - start.p) * f)
+                yaw = turn * f
+                pose = at * sapien.Pose(q=[np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]) * at.inv() * pose
+            nq = self.ik.solve(pose, q, restarts=0)
+            if nq is None or not self.collision.is_free(nq):
+                return None
+            jump = float(np.max(np.abs(nq[self.arm] - q[self.arm])))
+            if jump > 8 * step_rad:  # an IK branch jump, not a fast stretch of the straight line
+                return None
+            steps = max(1, int(np.ceil(jump / paced_rad)))
+            out += [q + (nq - q) * j / steps for j in range(1, steps + 1)]
+            q = nq
+        return out
+
+    def turn_about(self, pivot: np.ndarray, rotvec: np.ndarray, rad_per_step: float, guard: bool = False
+                   ) -> Generator[np.ndarray, None, float]:
+        """Turn the palm by the rotation vector ``rotvec`` (a world axis times an angle, rad) about the world point
+        ``pivot`` (a held object's centre, which then stays where it is), IK per step. Returns the fraction of the
+        turn done: 1, or less where the arm reaches no further."""
+        angle = float(np.linalg.norm(rotvec))
+        n = max(1, int(np.ceil(angle / rad_per_step)))
+        palm, at = self.ik.fk(self.target()), sapien.Pose(np.asarray(pivot, dtype=np.float64))
+        q = self.target()
+        for k in range(1, n + 1):
+            half = angle * k / n / 2
+            turn = sapien.Pose(q=np.r_[np.cos(half), np.sin(half) * np.asarray(rotvec) / max(angle, 1e-12)])
+            nq = self.ik.solve(at * turn * at.inv() * palm, q, restarts=0)
+            if nq is None:
+                log.info("turn of the palm stopped at step %d/%d: the arm reaches no further", k - 1, n)
+                return (k - 1) / n
+            q = nq
+            t = self.target()
+            t[self.arm] = q[self.arm]
+            yield self.emit(t, guard)
+        return 1.0
+
     def rise_clear(self, q: np.ndarray, max_m: float, step_m: float = 0.03) -> tuple[float, np.ndarray]:
         """How far the palm must rise from joint vector ``q`` (0 to ``max_m``, in ``step_m`` steps) before the arm
         and whatever the collision model carries (an opened hand) are clear, and the joint vector there (``q``

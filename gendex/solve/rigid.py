@@ -69,6 +69,18 @@ EASE_FRACTION = 0.85
 the measured angles kept each step."""
 ESCAPE_M = 0.15
 """Highest rise of the opened hand out of the collision model's margins before a staged approach is planned."""
+UNTILT_MAX_RAD = 0.8
+UNTILT_RAD_PER_STEP = 0.03
+UNTILT_TOPPLE_RAD = 0.6
+"""Before a set-down the hand turns the object back to its tilt at reset (this many rad a step) if it is taller than
+wide (topples at under ``UNTILT_TOPPLE_RAD``; a ball's tilt means nothing) and the grasp tilted it by more than half
+its toppling angle, but at most ``UNTILT_MAX_RAD`` (more is a grasp that turned it on purpose)."""
+RETREATS = 8
+RETREAT_M = 0.03
+RETREAT_WAIT_STEPS = 5
+RETREAT_FORCE_N = 0.05
+"""After letting go the hand backs off ``RETREAT_M`` more at a time (at most ``RETREATS`` times, each time waiting
+for the object to settle) while a group of it presses on the object with more than ``RETREAT_FORCE_N``."""
 PLACE_CORRECTIONS = 3
 PLACE_TOLERANCE_M = 0.005
 """Before a place lowers the object, it is moved over the target's centre (at most this many corrections, until
@@ -427,13 +439,14 @@ class RigidPrimitives:
             # a straight line, the hand level; turning about the vertical along the way where it must (an object
             # carried past the robot's base)
             straight, turn = None, 0.0
+            level = (CARRY_M_PER_STEP, c.carry_step_rad, CARRY_RAMP_STEPS)
             for turn in CARRY_YAWS_RAD:
-                straight = self._level_path(palm, goal, q_now, turn=turn, pivot=obj_p)
+                straight = m.level_path(palm, goal, q_now, *level, turn=turn, pivot=obj_p)
                 if straight is not None:
                     break
             pace = 1.0 if straight is None else m.pace(len(straight))
             if pace > 1.0:  # a short budget: the same line, faster
-                straight = self._level_path(palm, goal, q_now, pace, turn, obj_p) or straight
+                straight = m.level_path(palm, goal, q_now, *level, pace, turn, obj_p) or straight
             if straight is not None:  # the hand stays level: nothing held is tipped out on the way
                 log.info("carrying %r to %r on a straight line, turning %+.1f rad: %d steps (pace %.2f)", held,
                          target, turn, len(straight), pace)
@@ -473,6 +486,7 @@ class RigidPrimitives:
         if held is None:
             raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing",
                                  cause="slipped")
+        yield from self._stand_as_before(held)
         goal_xy = self.shape(target).footprint().center
         for _ in range(PLACE_CORRECTIONS):  # the carry ends within a few cm: centre the object over the target
             lo, hi = m.world_aabb(held)
@@ -506,6 +520,26 @@ class RigidPrimitives:
         if lag > 0.002:  # take the press off: the object rests on its support under its own weight
             yield from m.cartesian(np.array([0.0, 0.0, min(lag, PLACE_PRESS_M)]), c.motion.lift_m_per_step,
                                    guard=True)
+
+    def _stand_as_before(self, held: str) -> Iterator[np.ndarray]:
+        """Turn the hand about the held object's centre back to the object's tilt at reset (when: see
+        :data:`UNTILT_TOPPLE_RAD`): a bottle a side grasp lifted 24° askew falls when let go, on thumb or tray."""
+        q_now = self.env.obj(held).pose.q[0].cpu().numpy()
+        q_init = self.env.init_obj_quat(held)[0].cpu().numpy()
+        up_now = sapien.Pose(q=q_now).to_transformation_matrix()[:3, 2]
+        up_then = sapien.Pose(q=q_init).to_transformation_matrix()[:3, 2]
+        angle = float(np.arccos(np.clip(up_now @ up_then, -1.0, 1.0)))
+        self.shape(held)  # reads the collision shape once
+        standing = self._shapes[held].posed(sapien.Pose(q=q_init).to_transformation_matrix())
+        base = standing.footprint()
+        topple = float(np.arctan2(base.width / 2, standing.centroid()[2] - base.bottom))
+        if topple > UNTILT_TOPPLE_RAD or not topple / 2 < angle <= UNTILT_MAX_RAD:
+            return
+        axis, (lo, hi) = np.cross(up_now, up_then), self.m.world_aabb(held)
+        done = yield from self.m.turn_about((lo + hi) / 2, axis / np.linalg.norm(axis) * angle, UNTILT_RAD_PER_STEP,
+                                            guard=True)
+        log.info("stood %r back up before setting it down: %.0f%% of a %.0f° tilt (it topples at %.0f°)", held,
+                 100 * done, np.degrees(angle), np.degrees(topple))
 
     # ------------------------------------------------------------------ pushing
     def push(self, name: str, goal_xy: np.ndarray, tolerance_m: float) -> Iterator[np.ndarray]:
@@ -596,55 +630,21 @@ class RigidPrimitives:
         raise ExecutionError(f"no flat-hand pose behind {name!r} that clears the table and the objects and that the "
                              "arm reaches", cause="no_ik")
 
-    def _level_path(self, start: sapien.Pose, goal: sapien.Pose, q: np.ndarray, pace: float = 1.0,
-                    turn: float = 0.0, pivot: np.ndarray | None = None) -> list[np.ndarray] | None:
-        """Joint vectors moving the palm straight from ``start`` to ``goal`` at a constant orientation (or turning
-        steadily by ``turn`` rad about the vertical through ``pivot``, which moves with the palm: the held object's
-        centre), at most :data:`CARRY_M_PER_STEP` a step and ``carry_step_rad`` per joint (both times ``pace``);
-        None if a step has no IK, jumps branches or collides (the planner's path is used then)."""
-        m = self.m
-        speed, step_rad = CARRY_M_PER_STEP * pace, self.config.carry_step_rad * pace
-        length = float(np.linalg.norm(goal.p - start.p))
-        # speed ramps up and down over CARRY_RAMP_STEPS (a held ball flies out of a sudden 0.4 m/s start)
-        ramp = np.minimum(1.0, np.arange(1, 4 * CARRY_RAMP_STEPS + int(length / speed) + 2) / CARRY_RAMP_STEPS) * speed
-        travelled, profile = 0.0, []
-        for v in ramp:
-            if travelled >= length:
-                break
-            left = length - travelled
-            slow = min(1.0, left / (CARRY_RAMP_STEPS * speed) + 0.2)
-            travelled = min(length, travelled + v * slow)
-            profile.append(travelled / max(length, 1e-9))
-        out = []
-        for f in profile:
-            pose = sapien.Pose(start.p + (goal.p - start.p) * f, start.q)
-            if turn:
-                at = sapien.Pose((start.p if pivot is None else pivot) + (goal.p - start.p) * f)
-                yaw = turn * f
-                pose = at * sapien.Pose(q=[np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]) * at.inv() * pose
-            nq = m.ik.solve(pose, q, restarts=0)
-            if nq is None or not m.collision.is_free(nq):
-                return None
-            jump = float(np.max(np.abs(nq[m.arm] - q[m.arm])))
-            if jump > 8 * self.config.carry_step_rad:  # an IK branch jump, not a fast stretch of the straight line
-                return None
-            steps = int(np.ceil(jump / step_rad))
-            out += [q + (nq - q) * j / max(steps, 1) for j in range(1, max(steps, 1) + 1)]
-            q = nq
-        return out
-
     def release(self) -> Iterator[np.ndarray]:
         """Let go: the fingers go back to the grasp's own pre-shape (the least motion that frees the object, no
-        sweeping thumb), and the hand backs off 5 cm, up and the way it came in."""
-        m, plan = self.m, self.plan
-        if plan is None:
-            yield from m.ramp(m.with_hand(m.target(), RELEASE_HAND), self.config.release_steps)
-            self.held = None
-            yield from m.cartesian(np.array([0.0, 0.0, 0.05]), 0.01)
-            return
+        sweeping thumb), and the hand backs off 5 cm, up and the way it came in; then on, a little at a time, while
+        the object still touches it (a tall object set down tilted leans on the thumb and follows it)."""
+        m, plan, held = self.m, self.plan, self.held
         # every joint the grasp closed goes back: to its pre-shape value where the plan has one, else fully open
-        yield from m.ramp(m.with_hand(m.target(), RELEASE_HAND | plan.open_hand), self.config.release_steps)
+        opened = RELEASE_HAND if plan is None else RELEASE_HAND | plan.open_hand
+        yield from m.ramp(m.with_hand(m.target(), opened), self.config.release_steps)
         self.held = None
-        back = -plan.approach + np.array([0.0, 0.0, 1.0])
-        yield from m.cartesian(0.05 * back / np.linalg.norm(back), 0.01)
-
+        back = np.array([0.0, 0.0, 1.0]) - (0.0 if plan is None else plan.approach)
+        back = back / np.linalg.norm(back)
+        yield from m.cartesian(0.05 * back, 0.01)
+        for _ in range(RETREATS):
+            if held is None or float(self.env.hand_forces(held)[0].max()) <= RETREAT_FORCE_N:
+                return
+            if (yield from m.cartesian(RETREAT_M * back, 0.01, partial=True)) < 1.0:
+                return  # as far as the arm reaches
+            yield from m.hold(RETREAT_WAIT_STEPS)

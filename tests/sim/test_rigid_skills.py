@@ -1,6 +1,8 @@
 """Rigid skills beyond pick-and-carry: ``place`` (a held object is centred over its destination and let down until it
 rests there) and ``push`` (an object slid across the table with the flat hand, closed loop on its measured pose)."""
 
+import logging
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -102,7 +104,6 @@ def test_an_object_flung_onto_something_higher_is_grasped_again(caplog):
     """On this seed the lemon squirts out of the pinch as the hand lifts and lands on the cutting board, 5 cm above
     the table: it rose, but nothing of the hand touches it. That is a slip (grasped again), not a grasp that held
     (which failed the carry that followed, generated batch 52817)."""
-    import logging
     from pathlib import Path
 
     import yaml
@@ -162,7 +163,6 @@ def test_a_tall_box_held_high_is_carried_from_as_high_as_the_arm_reaches(caplog)
     20 cm board (taken before fits_on: the box toppled off the board). The pinch taken instead holds the box low in
     the hand, so the carry first lifts it off the table, and the arm reaches only part of the 10 cm (the attempt
     stopped there with no_ik). It lifts as far as it reaches and the carry plans from there."""
-    import logging
 
     from gendex.solve.attempt import run_attempt
 
@@ -201,6 +201,29 @@ def test_a_ball_to_lie_on_a_board_is_set_down_on_it_not_dropped(seed):
         centre = transform_points(ball.p, ball.q, torch.tensor([0.0, 0.0, radius]))
         assert abs(float(centre[0, 2]) - radius - board_top) < 0.01  # on it, not in the air
         assert float(torch.linalg.norm(rest_point(env, "tennis_ball")[0, :2] - centre[0, :2])) < 1e-5
+    finally:
+        executor.rigid.close()
+        env.close()
+
+
+@pytest.mark.parametrize("seed", [52666200, 52666201])
+def test_a_bottle_the_grasp_tilted_is_stood_back_up_before_it_is_set_down(seed, caplog):
+    """Batch 109453's SetBottleOnTray: the side grasp lifts the bottle 24° askew, more than it stands at. Set down so,
+    it leaned on the opened thumb (0.35 N, so never ``released``) or, the hand backed away, fell over and lay off the
+    tray's middle. Turned back upright in the hand first, it stands on the tray and the hand leaves it untouched."""
+    from gendex.solve.attempt import run_attempt
+    from gendex_envs.geometry import quat_rotate
+
+    env = _data_task_env("SetBottleOnTray")
+    executor = StageExecutor()
+    try:
+        with caplog.at_level(logging.INFO, logger="gendex.solve.rigid"):
+            out = run_attempt(env, executor, seed)
+        assert any("back up before setting it down" in r.getMessage() for r in caplog.records)
+        assert out.succeeded, out.failure
+        up = quat_rotate(env.obj("bottle").pose.q, torch.tensor([[0.0, 0.0, 1.0]]))
+        assert float(up[0, 2]) > np.cos(np.radians(10))  # standing
+        assert float(env.hand_forces("bottle").max()) == 0.0
     finally:
         executor.rigid.close()
         env.close()
