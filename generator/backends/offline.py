@@ -591,7 +591,7 @@ class OfflineBackend:
                     goal = {"pos_m": [round(x, 3), round(float(gy), 3), 0.0], "radius_m": 0.03}
             objects.append(entry)
         if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P:
-            objects.append(self._distractor(proposal, assets, rng))
+            objects.append(self._distractor(proposal, assets, rng, movable))
         stages = []
         for i, s in enumerate(proposal["steps"]):
             method = "motion_planning" if s["skill"] in ("reach", "carry", "place") else "RL"
@@ -610,9 +610,10 @@ class OfflineBackend:
         return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
 
     @staticmethod
-    def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator) -> dict:
-        """One object of clutter: a graspable catalog object the task does not use, somewhere on the table front
-        (the critic moves it if it overlaps; the solver avoids it)."""
+    def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict:
+        """One object of clutter: a graspable catalog object the task does not use, somewhere in ``region`` (where
+        the task's movable objects go: in a composed task, away from the door or lid the hand works first, which
+        would shove it against its body and stall; the critic moves it if it overlaps; the solver avoids it)."""
         from generator.catalog_view import asset_dicts
 
         used = {o["asset"] for o in proposal["objects"]}
@@ -620,7 +621,7 @@ class OfflineBackend:
                        and a["category"] not in {assets[i]["category"] for i in used if i in assets}),
                       key=lambda a: a["id"])
         a = pool[int(rng.integers(len(pool)))]
-        (x0, x1), (y0, y1) = MOVABLE_REGION_M
+        (x0, x1), (y0, y1) = region
         return {"name": f"distractor_{a['category']}", "asset": a["id"], "distractor": True,
                 "pos_m": [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0],
                 "randomize": {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}}
