@@ -43,14 +43,15 @@ def transform_points(p: torch.Tensor, q_wxyz: torch.Tensor, local: torch.Tensor)
 
 def box_rest_point(p: torch.Tensor, q_wxyz: torch.Tensor, lo: torch.Tensor, hi: torch.Tensor) -> torch.Tensor:
     """[N, 3] where an object with the box ``[lo, hi]`` (its frame, [3] each) posed at ``p`` [N, 3], ``q_wxyz``
-    [N, 4] lies: the centre of the box seen from above, at the height of the frame's origin. For an object standing
-    as built (the origin at the centre of its box's bottom face) that is its origin, however it is turned about the
-    vertical; a bottle lying on its side lies at its middle, not at its base. The height stays the origin's (the
-    centre of the box's bottom face, where a catalog object stands on the table): an estimate of the lowest point
-    from the box (its lowest corner, or its inscribed ellipsoid's lowest point) put an apple scan rolled over in a
-    bowl 1.9 cm under its collision shape's lowest point, and under the bowl."""
+    [N, 4] lies: the centre of the box seen from above, at the height of the frame's origin or of the box's centre,
+    whichever is lower. For an object standing as built (the origin at the centre of its box's bottom face) that is
+    its origin, however it is turned about the vertical; a bottle lying on its side lies at its middle, not at its
+    base; a ball rolled upside down, its origin now on top, at its centre's height, not 6.6 cm over its bottom. Both
+    heights are points of the object's own box that the object sits around: an estimate of the lowest point from the
+    box (its lowest corner, or its inscribed ellipsoid's lowest point) put an apple scan rolled over in a bowl 1.9 cm
+    under its collision shape's lowest point, and under the bowl."""
     center = transform_points(p, q_wxyz, (lo + hi) / 2)
-    return torch.cat([center[:, :2], p[:, 2:]], dim=-1)
+    return torch.cat([center[:, :2], torch.minimum(p[:, 2:], center[:, 2:])], dim=-1)
 
 
 def xy_distance(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:

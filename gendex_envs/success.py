@@ -54,10 +54,10 @@ def _anchor(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
 
 def rest_point(env: TaskEnv, name: str) -> torch.Tensor:
     """[N, 3] where object ``name`` lies, as ``near``, ``over`` and ``inside`` measure it: the centre of its box seen
-    from above, at its origin's height (:func:`~gendex_envs.geometry.box_rest_point`). A catalog object's origin is
-    the bottom centre of its box, so an object standing as it was spawned is measured at its origin; one that lies
-    on its side is measured at its middle, not at its base. An articulated object is measured at its root's
-    origin."""
+    from above, at its origin's or its box centre's height, the lower (:func:`~gendex_envs.geometry.box_rest_point`).
+    A catalog object's origin is the bottom centre of its box, so an object standing as it was spawned is measured at
+    its origin; one that lies on its side at its middle, not at its base; a ball upside down at its centre's height,
+    not on its top. An articulated object is measured at its root's origin."""
     pose = env.obj_pose(name)
     if name in env.articulations:
         return pose.p

@@ -6,6 +6,7 @@ import torch
 from gymnasium.utils.env_checker import check_env
 
 from gendex_envs.registry import registered_tasks
+from gendex_envs.success import conditions_hold
 
 REFERENCE_TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
 
@@ -179,3 +180,23 @@ def test_a_bottle_lying_on_the_plate_is_on_it(make_env):
     limit = u.task_spec.success.conditions[0].max_dist_m
     assert (torch.linalg.norm(bottle.pose.p - plate.pose.p, dim=-1) > limit).all(), "the origin alone is off it"
     assert u.evaluate()["success"].all(), f"bottle at {bottle.pose.p} {bottle.pose.q}, plate at {plate.pose.p}"
+
+
+def test_a_ball_resting_upside_down_on_the_board_is_on_it(make_env):
+    """A ball rolled upside down has its origin (the bottom centre of its box) on top: ``near`` measures it at its
+    centre's height instead, so a baseball resting on the cutting board is on it whichever way it rolled (measured at
+    its origin, 8 cm of ``near`` missed it by its own diameter)."""
+    env = make_env("GenDex/SetBaseballOnCuttingBoard-v1", gym_api=False)
+    u = env.unwrapped
+    env.reset(seed=0)
+    ball, board = u.obj("baseball"), u.obj("cutting_board")
+    diameter = u.asset_record("baseball").size_m[2]
+    p = board.pose.p.clone()
+    p[:, 2] += u.asset_record("cutting_board").size_m[2] + diameter + 0.002  # the origin on top
+    flipped = torch.tensor([[0.0, 1.0, 0.0, 0.0]]).expand_as(ball.pose.q)
+    ball.set_pose(type(ball.pose).create_from_pq(p, flipped))
+    for _ in range(60):  # 0.5 s of physics, no control
+        u.scene.step()
+    near = next(c for c in u.task_spec.success.conditions if c.type == "near")
+    assert (torch.linalg.norm(ball.pose.p - board.pose.p, dim=-1) > near.max_dist_m).all(), "the origin is over it"
+    assert conditions_hold(u, (near,)).all(), f"ball at {ball.pose.p} {ball.pose.q}, board at {board.pose.p}"

@@ -46,7 +46,7 @@ def test_transform_points_and_xy_distance():
 def test_box_rest_point_is_the_origin_of_a_standing_box_and_the_middle_of_a_lying_one():
     """A 0.22 m bottle-like box, origin at its bottom centre: standing (turned about z, anywhere) it lies at its
     origin; laid on its side, at the middle of its length seen from above, at its origin's height. A ball turned
-    any way lies under its centre."""
+    any way lies under its centre, no higher than its centre."""
     lo, hi = torch.tensor([-0.03, -0.03, 0.0]), torch.tensor([0.03, 0.03, 0.22])
     p = torch.tensor([[0.1, -0.2, 0.76], [0.1, -0.2, 0.76]])
     standing = yaw_quat(torch.tensor([0.0, 1.1]))
@@ -59,5 +59,9 @@ def test_box_rest_point_is_the_origin_of_a_standing_box_and_the_middle_of_a_lyin
     turned = torch.tensor(Rotation.random(8, random_state=4).as_quat()[:, [3, 0, 1, 2]], dtype=torch.float32)
     origin = torch.rand(8, 3)
     centre = origin + quat_rotate(turned, torch.tensor([[0.0, 0.0, 0.033]]).expand(8, 3))
-    expected = torch.cat([centre[:, :2], origin[:, 2:]], dim=-1)
+    expected = torch.cat([centre[:, :2], torch.minimum(origin[:, 2:], centre[:, 2:])], dim=-1)
     torch.testing.assert_close(box_rest_point(origin, turned, ball_lo, ball_hi), expected)
+    # upside down (half a turn about x) the origin is on top of the ball: it lies at its centre's height
+    flipped = torch.tensor([[0.0, 1.0, 0.0, 0.0]])
+    top = torch.tensor([[0.2, 0.1, 0.766 + 0.066]])
+    torch.testing.assert_close(box_rest_point(top, flipped, ball_lo, ball_hi), torch.tensor([[0.2, 0.1, 0.799]]))
