@@ -2,8 +2,8 @@
 
 Two entry points:
 
-* :func:`check_scene_static` needs no simulator (milliseconds): reach, off_table, scale, joint_state, unsupported
-  and penetration estimated from bounding boxes.
+* :func:`check_scene_static` needs no simulator (milliseconds): reach, off_table, in_front, scale, joint_state,
+  unsupported and penetration estimated from bounding boxes.
 * :func:`~generator.critic.physical_sim.check_scene` (:mod:`generator.critic.physical_sim`) builds the scene in
   SAPIEN and replaces the bounding-box penetration estimate with PhysX's own contacts, then lets the scene settle
   and measures what fell or still moves.
@@ -48,6 +48,10 @@ How each check is measured (the thresholds are the module constants below):
 ``off_table`` (static)
     Footprint centre (of the rotated bounding box) outside the table top. Fix: move so the whole footprint is on the
     table, OFF_TABLE_MARGIN_M from the edge (centred when it is larger than the table), combined with the reach fix.
+``in_front`` (static)
+    An object that no stage or condition names (clutter) whose footprint, widened by its randomization, reaches into
+    the front zone (:func:`~generator.critic.layout.front_zone`) of an articulated object a stage works: a door
+    pressed shut shoves it against the body and stalls. Fix: moved out of the zone, as a penetration fix moves.
 ``scale``
     (a) :func:`check_raw_scales` on a raw task mapping: a scale outside SCALE_RANGE (such a spec cannot be parsed);
     fix: the factor back into range. (b) A graspable, rigid object that the task grasps (a stage targeting it has a
@@ -73,27 +77,21 @@ import math
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
-from gendex_envs.spec import (
-    SCALE_RANGE,
-    ObjectSpec,
-    TaskSpec,
-    parse_task_spec,
-    spec_to_dict,
-)
+from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec, parse_task_spec, spec_to_dict
 from generator.critic.directives import Directive
 from generator.critic.layout import Room, choose_move, front_zone
 from generator.errors import DirectiveError
 
 log = logging.getLogger(__name__)
 
-CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "scale", "joint_state"]
-CHECKS: tuple[str, ...] = ("penetration", "floating", "unsupported", "out_of_reach", "off_table", "scale",
-                           "joint_state")
+CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "in_front", "scale",
+                  "joint_state"]
+CHECKS: tuple[str, ...] = get_args(CheckId)
 
 # ----------------------------------------------------------------------------------------------- thresholds
 PENETRATION_TOL_M = 0.003
@@ -170,7 +168,7 @@ class Violation:
     severity: Literal["error", "warning"] = "error"
     """Warnings are reported but do not make the report fail."""
     other: str | None = None
-    """The second party of a penetration: an object name, ``table`` or ``robot:<link>``."""
+    """The second party: of a penetration an object, ``table`` or ``robot:<link>``; of in_front, the articulated one."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"check": self.check, "object": self.object, "message": self.message,
@@ -455,6 +453,24 @@ def _overlaps(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations:
                 measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=other.spec.name))
 
 
+def _clutter_in_front(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+    named, worked = _task_objects(spec), {s.target for s in spec.stages if s.target}
+    for owner, a in ((n, a) for n, a in placed.items() if a.record.articulated and n in worked):
+        lo, hi, origin = _frame(a.spec)
+        zone = front_zone(lo, hi, _rotation(a.spec.quat_wxyz), origin, a.spec.randomize.xy_m, a.spec.randomize.yaw_deg)
+        for name, p in placed.items():
+            j = np.asarray(p.spec.randomize.xy_m, dtype=float)
+            depth = float(np.min(np.minimum(p.hi[:2] + j, zone[1]) - np.maximum(p.lo[:2] - j, zone[0])))
+            if name in named or p.record.articulated or depth <= 0.0:
+                continue
+            d = choose_move(p.lo, p.hi, np.r_[zone[0], 0.0], np.r_[zone[1], 0.0], room_for(spec, placed, (name,)),
+                            float(zone[:, 1].mean()), j, j)
+            meas[name] = {owner: rounded(depth)}
+            violations.append(Violation("in_front", name, f"{name!r}, which the task does not use, reaches {depth:.3f} "
+                                        f"m (randomized) into the room in front of {owner!r} that its moving part "
+                                        "sweeps", measured=depth, limit=0.0, fix=moves(name, d), other=owner))
+
+
 def room_for(spec: TaskSpec, placed: dict[str, Placed], skip: Iterable[str]) -> Room:
     """Where a penetration fix may put an object (:class:`~generator.critic.layout.Room`): the table, the reach
     limits with REACH_MARGIN_M to spare, the objects not in ``skip``, and the front zones of the articulated objects
@@ -568,6 +584,7 @@ def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dic
         _overlaps(spec, placed, meas["penetration"], violations)
     unsupported = _unsupported(placed, meas["unsupported"], violations)
     _position_fixes(spec, placed, meas["out_of_reach"], meas["off_table"], violations)
+    _clutter_in_front(spec, placed, meas["in_front"], violations)
     _scale_checks(spec, placed, meas["scale"], violations)
     _joint_checks(spec, placed, meas["joint_state"], violations)
     return violations, meas, placed, unsupported

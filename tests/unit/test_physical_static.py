@@ -250,3 +250,23 @@ def test_report_does_not_modify_the_spec():
     before = copy.deepcopy(spec_to_dict(spec))
     check_scene_static(spec)
     assert spec_to_dict(spec) == before
+
+
+def test_clutter_in_front_of_the_door_a_stage_works_is_moved_out_of_its_way():
+    """A lemon no stage or condition names, laid in front of the cabinet the task opens (batch 103589: a lemon in
+    front of a refrigerator, shoved against its body by the door pressed shut, stalled it): ``in_front``, fixed by a
+    move out of the zone; beside it, or once something names it, it is left where it is."""
+    raw = spec_to_dict(reference("OpenCabinet"))
+    lemon = {"name": "lemon", "asset": "lemon", "pos_m": [0.2, 0.1, 0.0], "distractor": True,
+             "randomize": {"xy_m": [0.08, 0.08], "yaw_deg": 45.0}}
+    raw["objects"].append(lemon)
+    spec = parse_task_spec(raw)
+    (v,) = check_scene_static(spec).violations
+    assert (v.check, v.object, v.other) == ("in_front", "lemon", "cabinet") and v.measured > 0.1, v
+    assert check_scene_static(spec).measurements["in_front"] == {"lemon": {"cabinet": round(v.measured, 4)}}
+    assert check_scene_static(apply_directives(spec, v.fix)).violations == []
+    lemon["pos_m"] = [0.1, -0.35, 0.0]
+    assert check_scene_static(parse_task_spec(raw)).violations == []
+    lemon["pos_m"], lemon["distractor"] = [0.2, 0.1, 0.0], False
+    raw["success"]["conditions"].append({"type": "lifted", "object": "lemon", "negate": True, "min_height_m": 0.1})
+    assert "in_front" not in [c for c, _ in checks(check_scene_static(parse_task_spec(raw)))]
