@@ -611,9 +611,8 @@ class OfflineBackend:
 
     @staticmethod
     def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict:
-        """One object of clutter: a graspable catalog object the task does not use, somewhere in ``region`` (where
-        the task's movable objects go: in a composed task, away from the door or lid the hand works first, which
-        would shove it against its body and stall; the critic moves it if it overlaps; the solver avoids it)."""
+        """One object of clutter: a graspable catalog object the task does not use, in ``region``: where the task's
+        movable objects go, clear of a door the hand works first (the critic moves it if it overlaps)."""
         from generator.catalog_view import asset_dicts
 
         used = {o["asset"] for o in proposal["objects"]}
