@@ -39,6 +39,10 @@ if TYPE_CHECKING:  # pragma: no cover
 
 log = logging.getLogger(__name__)
 
+EASE_STEPS = 16
+EASE_FRACTION = 0.85
+"""Grip easing (:func:`ease_grip`): steps at most, and the part of the finger targets' lead over the measured angles
+kept each step."""
 TRIAL_HOLD_STEPS = 20
 """1 s at 20 Hz."""
 HELD_FRACTION = 0.8
@@ -82,6 +86,22 @@ def approach(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[
     """The straight move from the pre-grasp pose to the grasp pose, then a short settle."""
     yield from m.cartesian(plan.palm.p - plan.pregrasp.p, speed.approach_m_per_step)
     yield from m.hold(speed.settle_steps)
+
+
+def ease_grip(m: ArmHandMotion, require: tuple[ConditionSpec, ...]) -> Iterator[np.ndarray]:
+    """When ``require`` (a grasp stage's own conditions) fails only by a palm-force ceiling (fingers pulling the
+    object into the palm too hard), ease the finger targets towards the measured angles a step at a time until it
+    holds (at most :data:`EASE_STEPS`)."""
+    require = tuple(c for c in require if c.max_palm_force_n is not None)
+    loose = tuple(replace(c, max_palm_force_n=None) for c in require)
+    for _ in range(EASE_STEPS if require else 0):
+        if bool(conditions_hold(m.env, require)[0]):
+            return
+        if not bool(conditions_hold(m.env, loose)[0]):
+            return  # not a matter of force: easing would only loosen a grasp that already fails otherwise
+        t, q = m.target(), m.qpos()
+        t[m.hand] = q[m.hand] + EASE_FRACTION * (t[m.hand] - q[m.hand])
+        yield m.emit(t)
 
 
 def with_margin(c: ConditionSpec) -> ConditionSpec:
@@ -205,6 +225,7 @@ class GraspTrials:
             run(close_hand(m, plan, speed))
             pushed = float(np.linalg.norm(obj.pose.p[0, :2].cpu().numpy() - xy0))
             run(m.cartesian(np.array([0.0, 0.0, speed.lift_m]), speed.lift_m_per_step, guard=True))
+            run(ease_grip(m, tuple(map(with_margin, require))))  # as the executor's grasp does after its lift
             run(m.hold(TRIAL_HOLD_STEPS))
         except ExecutionError as exc:  # an IK failure mid-motion is a failed trial, not a crash
             why = f"motion failed: {exc}"

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -44,13 +44,20 @@ from gendex.solve.grasp import (
     palm_rotation,
     pose_of,
 )
-from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand, fits_on
+from gendex.solve.grasp_trial import (
+    GraspMotion,
+    GraspTrials,
+    TrialResult,
+    approach,
+    close_hand,
+    ease_grip,
+    fits_on,
+)
 from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import ConditionSpec
-from gendex_envs.success import conditions_hold
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex.solve.motion import ArmHandMotion
@@ -63,10 +70,6 @@ STAGING_M = tuple(sorted(((b, u, a) for b in (0.0, 0.06, 0.12) for u in (0.0, 0.
                           if b + u + a > 0), key=lambda o: (sum(x * x for x in o), o)))
 """(back along the approach, up, away from the object) offsets of the staging poses tried on the way to a pre-grasp
 pose, metres, nearest first."""
-EASE_STEPS = 16
-EASE_FRACTION = 0.85
-"""Grip easing (:meth:`RigidPrimitives._ease_grip`): steps at most, and the part of the finger targets' lead over
-the measured angles kept each step."""
 ESCAPE_M = 0.15
 """Highest rise of the opened hand out of the collision model's margins before a staged approach is planned."""
 UNTILT_MAX_RAD = 0.8
@@ -361,7 +364,7 @@ class RigidPrimitives:
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
             if risen >= 0.5 * lift and touched >= 2:
-                yield from self._ease_grip()
+                yield from ease_grip(m, self._require)
                 return
             self.held = None
             why = f"rose {risen:.3f} m of {lift:.3f} m, touched by {touched} part(s) of the hand"
@@ -370,23 +373,6 @@ class RigidPrimitives:
             log.info("%r slipped (%s): opening and grasping again", name, why)
             yield from self._let_go()
             yield from self.approach(name, self._require, self._set_on)
-
-    def _ease_grip(self) -> Iterator[np.ndarray]:
-        """When the grasp stage's own conditions fail only by a force ceiling (fingers pulling the object into the
-        palm too hard), ease the finger targets towards the measured angles a step at a time until they hold."""
-        require = tuple(c for c in self._require if c.max_palm_force_n is not None)
-        if not require:
-            return
-        m = self.m
-        for _ in range(EASE_STEPS):
-            if bool(conditions_hold(self.env, require)[0]):
-                return
-            loose = tuple(replace(c, max_palm_force_n=None) for c in require)
-            if not bool(conditions_hold(self.env, loose)[0]):
-                return  # not a matter of force: easing would only loosen a grasp that already fails otherwise
-            t, q = m.target(), m.qpos()
-            t[m.hand] = q[m.hand] + EASE_FRACTION * (t[m.hand] - q[m.hand])
-            yield m.emit(t)
 
     def _let_go(self) -> Iterator[np.ndarray]:
         """Open the hand and back off upwards (as far as the arm reaches, up to 8 cm)."""
