@@ -465,7 +465,7 @@ def _clutter_in_front(spec: TaskSpec, placed: dict[str, Placed], meas: dict, vio
                 continue
             d = choose_move(p.lo, p.hi, np.r_[zone[0], 0.0], np.r_[zone[1], 0.0], room_for(spec, placed, (name,)),
                             float(zone[:, 1].mean()), j, j)
-            meas[name] = {owner: rounded(depth)}
+            meas.setdefault(name, {})[owner] = rounded(depth)
             violations.append(Violation("in_front", name, f"{name!r}, which the task does not use, reaches {depth:.3f} "
                                         f"m (randomized) into the room in front of {owner!r} that its moving part "
                                         "sweeps", measured=depth, limit=0.0, fix=moves(name, d), other=owner))

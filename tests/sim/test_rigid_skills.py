@@ -223,7 +223,7 @@ def test_a_bottle_the_grasp_tilted_is_stood_back_up_before_it_is_set_down(seed, 
         assert out.succeeded, out.failure
         up = quat_rotate(env.obj("bottle").pose.q, torch.tensor([[0.0, 0.0, 1.0]]))
         assert float(up[0, 2]) > np.cos(np.radians(10))  # standing
-        assert float(env.hand_forces("bottle").max()) == 0.0
+        assert float(env.hand_forces("bottle").max()) < 0.05  # the hand left it (the release backs off past 0.05 N)
     finally:
         executor.rigid.close()
         env.close()
