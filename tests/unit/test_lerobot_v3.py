@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
@@ -343,6 +344,27 @@ def test_camera_images_as_video_files_in_the_v3_layout(tmp_path, codec):
         assert frames.shape == (e.length, 16, 24, 3)  # T frames: one per action, like the parquet rows
         assert np.abs(frames.astype(int) - e.images["front"][:e.length]).mean() < 12
         assert path.read_bytes() == (roots[1] / path.relative_to(roots[0])).read_bytes()
+
+
+def test_the_encoder_never_sees_uninitialised_row_padding(tmp_path):
+    """FFmpeg pads each plane's rows to an aligned stride and leaves the padding uninitialised; x264 reads it, which
+    made a 24-pixel-wide video's bytes differ about once in 300 encodes (a CI failure of the test above). The frames
+    handed to the encoder have zeroed padding, so repeated encodes give one set of bytes."""
+    from gendex_envs.video import PIX_FMT, _yuv_frame, encode
+
+    rgb = _smooth_episode(6, 1).images["front"]
+    frame = _yuv_frame(rgb[0])
+    assert frame.format.name == PIX_FMT
+    padded = [p for p in frame.planes if p.line_size > p.width]
+    assert padded  # 24 px rows (12 px chroma) are padded to the stride: the case that mattered
+    for plane in padded:
+        rows = np.frombuffer(memoryview(plane), dtype=np.uint8).reshape(-1, plane.line_size)
+        assert not rows[:, plane.width:].any()
+    digests = set()
+    for _ in range(100):
+        encode(rgb, tmp_path / "v.mp4", FPS, "libx264")
+        digests.add(hashlib.sha256((tmp_path / "v.mp4").read_bytes()).hexdigest())
+    assert len(digests) == 1
 
 
 def test_video_options_are_checked(tmp_path):
