@@ -42,8 +42,10 @@ stall where they start and their answers change with the last bits of any comput
 :func:`gendex.solve.grasp.pinch_shape` and :meth:`HandModel.finger_ik` still take scipy's step, so their answers are
 those the published tasks were measured with. With this step there too, the knife held 12/20 and the hammer 13/20
 on seeds 9500.. (without it, on seeds 9300..: 0/20 and 3/20), but every other pinch moved as well and three seeded
-scenario tests of the rigid skills changed outcome: that change waits for a library-wide re-measure (the variant is
-on branch wip/pinch-diff-step). The knife has since been taken by the tip pinch instead (19/20 on seeds 9940..)."""
+scenario tests of the rigid skills changed outcome: that change waits for a library-wide re-measure (the variant,
+this step passed as ``diff_step`` to those two solves, was measured on a local branch that was not kept). The knife
+has since been taken by the tip pinch instead (19/20 on seeds 9940..), and the hammer by a squeeze that grows with
+the load (:data:`gendex.solve.grasp.MAX_SQUEEZE_GAIN`)."""
 
 
 def actuated(finger: str) -> tuple[str, ...]:

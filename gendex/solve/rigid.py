@@ -57,6 +57,7 @@ from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
 from gendex_envs.errors import ExecutionError
+from gendex_envs.physx import px_bodies
 from gendex_envs.spec import ConditionSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -226,7 +227,7 @@ class RigidPrimitives:
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
         prefer = object_heading(shape.footprint().center, m.ik.base.p[:2])
-        synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others)
+        synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others, px_bodies(env.obj(name))[0].mass)
         self._synth = synth
         m.avoid_objects(exclude=(name,))
         q0 = m.target()

@@ -37,6 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from gendex.solve.grasp import ELONGATED
 from gendex.solve.hand import DIFF_STEP, PAD_RADIUS_M, HandModel, actuated
 from gendex.solve.shape import PosedShape
 
@@ -74,8 +75,6 @@ WIDTH_STEP_MM = 4
 """Tip pinches are solved for widths in these steps; an object up to this much narrower is met during the squeeze."""
 ALONG_STEP_M = 0.005
 """Spacing of the candidate lines along an elongated object."""
-ELONGATED = 1.6
-"""An object whose footprint is this many times longer than wide is pinched across its long axis."""
 MAX_IK_ERR_M = 0.002
 """A hand solution counts when both fingertips are within this of their targets and no sphere dips into the table by
 more than :data:`MAX_DIP_M`."""

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.grasp import GraspSynthesizer, object_heading, pinch_shape
+from gendex.solve.grasp import GraspSynthesizer, object_heading, pinch_shape, squeeze_gain
 from gendex.solve.grasp_trial import GraspTrials
-from gendex.solve.hand import PAD_RADIUS_M, HandModel
+from gendex.solve.hand import PAD_RADIUS_M, HandModel, actuated
 from gendex.solve.ik import ArmIK
 from gendex.solve.lift_check import LiftChecker, lift_spec
 from gendex.solve.shape import ObjectShape
@@ -291,3 +291,47 @@ def test_an_elongated_object_is_pinched_across_its_centroid_first():
         assert abs(float((first.center[:2] - fp.center) @ fp.axis) - s_com) < 0.002
     finally:
         s.env.close()
+
+
+def test_a_heavy_object_is_pinched_harder_in_proportion_to_its_weight():
+    """Across an elongated object (a hammer's handle) the pinching fingers' closing lead over the touching hand grows
+    with the object's mass above 0.2 kg, at most twice (the guard stops the pads on the surface, so the lead is what
+    sets how hard they press); a compact object (a can) keeps the planned lead whatever it weighs."""
+    assert squeeze_gain(0.05) == squeeze_gain(0.2) == 1.0
+    assert squeeze_gain(0.3) == pytest.approx(1.5) and squeeze_gain(0.42) == squeeze_gain(3.0) == 2.0
+    for asset, elongated in (("hammer", True), ("can", False)):
+        s = Scene(asset, seed=1000)
+        try:
+            prefer = object_heading(s.shape.footprint().center, s.ik.base.p[:2])
+            heavy = GraspSynthesizer(s.hand, s.shape, 0.0, prefer, mass_kg=0.42)
+            line = s.synth.pinch_lines()[0]
+            light, firm = (next(synth._pinch_plans(line))[0] for synth in (s.synth, heavy))
+            assert light.note == firm.note  # the same grasp, only closed harder
+            assert np.allclose(light.palm.p, firm.palm.p) and np.allclose(light.palm.q, firm.palm.q)
+            axis_palm = tuple(float(v) for v in light.note.split("palm axis (")[1].split(")")[0].split(", "))
+            shape = pinch_shape(s.hand, axis_palm, line.width)
+            assert shape.middle
+            fingers = actuated("th") + actuated("ff") + actuated("mf")
+            if not elongated:
+                assert all(firm.closed_hand[j] == light.closed_hand[j] == shape.close[j] for j in fingers)
+                continue
+            lo, hi = s.hand.bounds(fingers)
+            for j, low, high in zip(fingers, lo, hi, strict=True):
+                assert light.closed_hand[j] == pytest.approx(shape.close[j])
+                doubled = float(np.clip(shape.contact[j] + 2 * (shape.close[j] - shape.contact[j]), low, high))
+                assert firm.closed_hand[j] == pytest.approx(doubled), (asset, j)
+            assert any(abs(firm.closed_hand[j] - light.closed_hand[j]) > 0.1 for j in fingers)
+        finally:
+            s.env.close()
+
+
+def test_a_hammer_pinched_hard_enough_for_its_weight_is_lifted():
+    """Dev seed 781002: with the plain closing lead each of the ten pinches tried pressed its pads at 1-3 N and the
+    hammer (0.42 kg) slid out as it rose: grasp_failed. Squeezed in proportion to its weight, it is lifted."""
+    checker = LiftChecker("hammer")
+    try:
+        result = checker(781002)
+    finally:
+        checker.close()
+    assert result.held and result.rise_m >= 0.10, result.failure
+    assert result.grasp.startswith("pinch")
