@@ -118,8 +118,8 @@ times the mass over that, at most :data:`MAX_SQUEEZE_GAIN` (a grip that grows wi
 guard still caps the lead at :data:`GUARD_RAD`). Across a handle the object's weight mostly acts off the pinch line
 and twists it out of two pads: a 0.42 kg hammer pinched with the plain lead pressed at 1-3 N a pad and slid out while
 it rose (benchmarks/grasp.py: 30 % in the record of seeds 9940-9959, 6/20 on 9960-9979); squeezed so, 20/20 on
-9960-9979 and on 9980-9999. With the index and the thumb alone squeezed harder, 15/20 on 9980-9999: the middle
-finger along the handle is what holds the twist.
+9960-9979 and on 9980-9999. With the index and the thumb alone squeezed harder, 15/20 on 9980-9999 and 20/20 on
+10000-10019: the middle finger along the handle helps hold the twist.
 
 A compact object keeps the plain lead. Squeezed harder, pinches that had held a can (0.35 kg) or a sugar box (0.51 kg)
 well enough let them turn in the hand while carried: SetCanOnTray-v1 15/20 against 18/20 (seeds 263000-263019, the
