@@ -129,6 +129,15 @@ def test_physics_trial_holds_a_good_grasp_and_rejects_a_bad_one(golf):
         trials.close()
 
 
+def lift_once(asset: str, seed: int):
+    """One lift-and-hold attempt of ``asset`` (at the size a task holds it) on ``seed``."""
+    checker = LiftChecker(asset)
+    try:
+        return checker(seed)
+    finally:
+        checker.close()
+
+
 def torch_equal(a, b) -> bool:
     return bool((a == b).all())
 
@@ -136,11 +145,7 @@ def torch_equal(a, b) -> bool:
 @pytest.mark.parametrize("asset", ["dice", "bowl", "spatula", "bowl_large"])
 def test_lift_and_hold_beyond_the_two_objects_the_old_grasp_knew(asset):
     """Each at the size a task holds it: the 22 cm bowl is fitted to the hand (scale ~0.41) as the generator does."""
-    checker = LiftChecker(asset)
-    try:
-        result = checker(1004)
-    finally:
-        checker.close()
+    result = lift_once(asset, 1004)
     assert result.held, result.failure
     assert result.rise_m >= 0.10 and result.trials >= 1 and result.grasp.startswith("pinch")
 
@@ -164,11 +169,7 @@ def test_a_ball_wider_than_a_pinch_is_pinched_above_its_middle_and_held(golf):
     gfp = golf.shape.footprint()
     heights = {round(float(ln.center[2] - gfp.bottom), 3) for ln in golf.synth.pinch_lines()}
     assert heights == {round(gfp.height / 2, 3), round(gfp.height - 0.012, 3)}
-    checker = LiftChecker("softball")
-    try:
-        result = checker(1002)
-    finally:
-        checker.close()
+    result = lift_once("softball", 1002)
     assert result.held and result.rise_m >= 0.10, result.failure
 
 
@@ -270,11 +271,7 @@ def test_a_utensil_lying_flat_is_lifted_by_a_fingertip_pinch_at_the_table(asset,
     the tip pinch. The spoon's tip pinches often lift it between the index and the curled middle finger with the
     thumb off it, which does not count as held (seed 1001, 16 trials: 4 of them lifted it so, none with the thumb on
     it); on this seed the 12th trial holds it with thumb and index."""
-    checker = LiftChecker(asset)
-    try:
-        result = checker(seed)
-    finally:
-        checker.close()
+    result = lift_once(asset, seed)
     assert result.held and result.rise_m >= 0.10, result.failure
     assert result.grasp.startswith("tip")
 
@@ -328,10 +325,6 @@ def test_a_heavy_object_is_pinched_harder_in_proportion_to_its_weight():
 def test_a_hammer_pinched_hard_enough_for_its_weight_is_lifted():
     """Dev seed 781002: with the plain closing lead each of the ten pinches tried pressed its pads at 1-3 N and the
     hammer (0.42 kg) slid out as it rose: grasp_failed. Squeezed in proportion to its weight, it is lifted."""
-    checker = LiftChecker("hammer")
-    try:
-        result = checker(781002)
-    finally:
-        checker.close()
+    result = lift_once("hammer", 781002)
     assert result.held and result.rise_m >= 0.10, result.failure
     assert result.grasp.startswith("pinch")
