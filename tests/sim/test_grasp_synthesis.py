@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.grasp import GraspSynthesizer, object_heading, pinch_shape, squeeze_gain
+from gendex.solve.grasp import TALL_M, GraspSynthesizer, object_heading, pinch_shape, squeeze_gain
 from gendex.solve.grasp_trial import GraspTrials
 from gendex.solve.hand import PAD_RADIUS_M, HandModel, actuated
 from gendex.solve.ik import ArmIK
-from gendex.solve.lift_check import LiftChecker, lift_spec
+from gendex.solve.lift_check import LiftChecker, fitted_scale, lift_spec
 from gendex.solve.shape import ObjectShape
 from gendex_envs.task_env import TaskEnv
 
@@ -16,8 +16,8 @@ from gendex_envs.task_env import TaskEnv
 class Scene:
     """One object in a lift scene, with its shape, the hand model and a synthesizer."""
 
-    def __init__(self, asset: str, seed: int = 3):
-        self.env = TaskEnv(task_spec=lift_spec(asset), control_mode="pd_joint_pos", obs_mode="none",
+    def __init__(self, asset: str, seed: int = 3, scale: float = 1.0):
+        self.env = TaskEnv(task_spec=lift_spec(asset, scale), control_mode="pd_joint_pos", obs_mode="none",
                            reward_mode="none")
         self.env.reset(seed=seed)
         self.ik = ArmIK(self.env.agent)
@@ -288,6 +288,33 @@ def test_an_elongated_object_is_pinched_across_its_centroid_first():
         assert abs(float((first.center[:2] - fp.center) @ fp.axis) - s_com) < 0.002
     finally:
         s.env.close()
+
+
+def test_a_tall_object_is_pinched_level_with_its_centroid_first():
+    """A can (12 cm tall) pinched 3 cm above the table turned about the pinch line as it rose and slid down the pads:
+    on seed 10032 (the grasp record at 10020-10039) none of its ten trials held. Its first pinch lines now pass
+    through its centroid's height, and it is lifted. A tall ball too wide to pinch at its middle (the softball at the
+    size tasks give it) keeps the usual order: low first, then where it fits above its middle."""
+    s = Scene("can", seed=1000)
+    try:
+        z_com = float(s.shape.centroid()[2])
+        assert s.shape.footprint().height > TALL_M and z_com > 0.05
+        first = s.synth.pinch_lines()[0]
+        assert abs(float(first.center[2]) - z_com) < 1e-6
+    finally:
+        s.env.close()
+    s = Scene("softball", seed=1000, scale=fitted_scale("softball"))
+    try:
+        fp, z_com = s.shape.footprint(), float(s.shape.centroid()[2])
+        assert fp.height > TALL_M
+        lines = s.synth.pinch_lines()
+        assert abs(float(lines[0].center[2]) - (fp.bottom + 0.03)) < 1e-6  # the usual order: 3 cm up first
+        assert all(abs(float(ln.center[2]) - z_com) > 0.005 for ln in lines)
+    finally:
+        s.env.close()
+    result = lift_once("can", 10032)
+    assert result.held and result.rise_m >= 0.10, result.failure
+    assert result.grasp.startswith("pinch")
 
 
 def test_a_heavy_object_is_pinched_harder_in_proportion_to_its_weight():
