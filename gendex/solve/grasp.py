@@ -482,12 +482,12 @@ class GraspSynthesizer:
         fit = self._widest_fit(across3)
         if fit is not None and min(abs(fit - z) for z in heights) > 0.005:
             heights.insert(1, fit)
+        com = self.shape.centroid()
         if h > TALL_M and fit is None:  # level with the centre of mass first: the weight pulls along the pads
-            z_com = float(self.shape.centroid()[2])
-            heights = [z_com] + [z for z in heights if abs(z - z_com) > 0.005]
+            heights = [float(com[2])] + [z for z in heights if abs(z - float(com[2])) > 0.005]
         s_com = 0.0
         if self._elongated():  # across it, at several places along it, its centroid first
-            s_com = float((self.shape.centroid()[:2] - fp.center) @ fp.axis)
+            s_com = float((com[:2] - fp.center) @ fp.axis)
             places = [s * fp.length for s in (0.0, -0.15, 0.15, -0.3, 0.3)]
             if min(abs(s_com - s) for s in places) > CENTROID_APART_M:
                 places.append(s_com)
