@@ -9,7 +9,8 @@ import sapien
 import torch
 
 from gendex_envs.assets.bounds import entity_aabb
-from gendex_envs.assets.catalog import catalog
+from gendex_envs.assets.catalog import THIN_M, THIN_SOLVER_ITERATIONS, catalog
+from gendex_envs.physx import px_bodies, px_objects
 from gendex_envs.spec import parse_task_spec
 from gendex_envs.task_env import TaskEnv
 
@@ -86,6 +87,21 @@ def test_rigid_asset_rests_on_table(rigid_scene, asset_id):
     lo, _ = entity_aabb(env.obj(name))
     assert lo[2] > -0.004, f"{asset_id} sank {1000 * -lo[2]:.1f} mm into the table"
     assert lo[2] < 0.004, f"{asset_id} floats {1000 * lo[2]:.1f} mm above the table"
+
+
+def test_only_thin_objects_get_more_contact_solver_iterations(rigid_scene):
+    """A knife, a spoon or a fork is solved at THIN_SOLVER_ITERATIONS, everything else at the scene's 15."""
+    env, _ = rigid_scene
+    got = {aid: px_bodies(env.obj(f"a_{aid}"))[0].solver_position_iterations for aid in RIGID}
+    thin = {aid for aid in RIGID if min(catalog()[aid].size_m) < THIN_M}
+    assert {"knife", "spoon", "fork", "scissors"} <= thin and not {"apple", "dice", "plate", "marker"} & thin
+    assert {aid for aid, n in got.items() if n == THIN_SOLVER_ITERATIONS} == thin
+    assert {n for aid, n in got.items() if aid not in thin} == {15}
+    robot = px_objects(env.agent.robot)[0]
+    assert robot.solver_position_iterations == 15
+    knife = catalog()["knife"]
+    assert knife.solver_position_iterations(1.0) == THIN_SOLVER_ITERATIONS
+    assert knife.solver_position_iterations(1.5) is None  # an 18 mm-thick knife is not thin
 
 
 @pytest.mark.parametrize("asset_id", RIGID)
