@@ -35,6 +35,7 @@ import numpy as np
 import sapien
 
 from gendex.solve.collision import box_spheres
+from gendex.solve.edge_pinch import EdgePinch
 from gendex.solve.grasp import (
     PALM_THICKNESS_M,
     RELEASE_HAND,
@@ -286,7 +287,18 @@ class RigidPrimitives:
         self._require, self._set_on = require, set_on
         for attempt in range(self.config.replans + 1):
             before = self._pose_now(name)
-            plan, q_pre = self.choose_grasp(name, require, set_on)
+            try:
+                plan, q_pre = self.choose_grasp(name, require, set_on)
+            except ExecutionError as err:  # a flat ringed tool: dragged to the table's edge and pinched there
+                edge = EdgePinch.of(m, self.hand, name, self.shape(name)) if err.cause == "grasp_failed" else None
+                if edge is None:
+                    raise
+                log.info("%s; dragging %r to the table's edge by its ring", err, name)
+                yield from edge.drag()
+                self.plan = edge.plan(self.shape(name))
+                yield from edge.bring_hand(self.plan)
+                yield from approach(m, self.plan, self.config.motion)
+                return
             yield from self._bring_hand(name, plan, q_pre)
             moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
             if moved <= MOVED_M or attempt == self.config.replans:
