@@ -41,6 +41,8 @@ FLAT_M = 0.012
 RING_MIN_RADIUS_M = 0.006
 """A hole the index fingertip fits in (its end cap, 7.1 mm radius, is narrower at the height of a 7 mm ring;
 the wrench's octagonal 15 mm ring is 6.9 mm to its flats)."""
+RING_MAX_RADIUS_M = 0.015
+"""Larger holes are not looked for (a point that far from all material is beside the tool)."""
 RING_ROUND = 1.5
 """A hole is a ring when material surrounds it in every horizontal direction within this many times its radius (a
 notch in the outline is open on one side)."""
@@ -91,9 +93,10 @@ def find_ring(shape: PosedShape, step_m: float = 0.001) -> np.ndarray | None:
     b = np.arange(-fp.width / 2, fp.width / 2, step_m)
     pts = np.array([[*(fp.center + s * fp.axis + t * side), z] for s in a for t in b])
     sd = shape.signed_distance(pts)
-    order = np.argsort(-sd)
     dirs = [np.array([np.cos(t), np.sin(t), 0.0]) for t in np.linspace(0, 2 * np.pi, 8, endpoint=False)]
-    for i in order:
+    for i in np.argsort(-sd):
+        if sd[i] > RING_MAX_RADIUS_M:
+            continue  # open table beside the tool, not a hole in it
         if sd[i] < RING_MIN_RADIUS_M:
             return None
         ahead = [[a for a, b in shape.ray_intervals(pts[i], d) if b > 0.0] for d in dirs]

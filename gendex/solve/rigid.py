@@ -9,7 +9,7 @@ Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is 
   (:class:`~gendex.solve.grasp_trial.GraspTrials`) until one holds. The arm then goes to a staging pose with the
   opened hand in the collision model and the target an obstacle, and straight on to the pre-grasp pose. If the
   object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from where it
-  is now. Then the straight approach.
+  is now. Then the straight approach. A flat ringed tool no grasp holds goes to the table's edge first (edge_pinch).
 - ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m``. If the object did not come
   up with the hand (it slipped), the hand opens, backs off and grasps once more from where it is (``regrasps``).
 - ``lift`` — raise the held object to the task's ``lifted`` height.
