@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterator
-from dataclasses import dataclass
 
 import numpy as np
 import sapien
@@ -52,7 +51,8 @@ DRAG_HAND = {"FFJ3": 0.0, "FFJ2": 0.0, "FFJ1": 0.0, "FFJ0": 0.0,
 """The index straight, the other fingers and the thumb curled out of its way."""
 DRAG_TILT_RAD = np.radians(25.0)
 DRAG_TIP_Z_M = 0.004
-"""Height of the index's end-cap centre above the table while it drags (the finger's end rests on the table)."""
+"""Commanded height of the index's end-cap centre while it drags: 3 mm below where the finger's end rests on the
+table, so that it presses lightly and stays in the ring."""
 DRAG_M_PER_STEP = 0.005
 DRAG_LEAD_MAX_M = 0.025
 DRAG_MAX_STEPS = 200
@@ -71,14 +71,6 @@ LEAD_M = 0.012
 APPROACH_OUT_M = 0.07
 ABOVE_M = 0.12
 BRING_STEPS = 40
-
-
-@dataclass(frozen=True)
-class Ring:
-    """A hole through a flat object, in the object's frame: centre [3] (at mid-height) and inner radius."""
-
-    center: np.ndarray
-    radius: float
 
 
 def find_ring(shape: PosedShape, step_m: float = 0.001) -> np.ndarray | None:
