@@ -8,10 +8,10 @@ hole a fingertip fits in (:func:`find_ring`):
 
 1. **drag** — the index fingertip goes down into the ring (fingers pointing down, the index straight and tilted
    :data:`DRAG_TILT_RAD` so its tip trails its knuckle: a finger whose tip leads is lifted out of the ring by the
-   wall's reaction), its end :data:`DRAG_TIP_Z_M` above the table, and pulls the ring towards the side edge the ring
-   leads to (a tool pushed ahead of its ring goes over the edge first), re-aimed every step from the ring's measured
-   position, the commanded tip at most :data:`DRAG_LEAD_MAX_M` ahead of it; it stops when the ring's centre is
-   :data:`OVERHANG_M` past the edge;
+   wall's reaction), its end pressed lightly on the table (:data:`DRAG_TIP_Z_M`), and pulls the ring towards the
+   side edge the ring leads to (a tool pushed ahead of its ring goes over the edge first), re-aimed every step from
+   the ring's measured position, the commanded tip at most :data:`DRAG_LEAD_MAX_M` ahead of it; it stops when the
+   ring's centre is :data:`OVERHANG_M` past the edge;
 2. **pinch** — the finger comes out, and the open hand comes down outside the edge and slides in with the fingers
    along the edge (+x) and the palm facing the table's side: the thumb pad under the ring and the index pad over it
    at the +y edge, the other way round at the -y edge (the arm reaches no pose with the fingers pointing across the
@@ -102,7 +102,6 @@ class EdgePinch:
 
     def __init__(self, m: ArmHandMotion, hand: HandModel, name: str, ring_in_object: np.ndarray, edge_y: float):
         self.m, self.hand, self.name = m, hand, name
-        self.env = m.env
         self.ring_local = ring_in_object
         self.edge_y = edge_y
 
@@ -155,7 +154,6 @@ class EdgePinch:
         m = self.m
         ring = self.ring()
         if abs(ring[1]) > self.edge_y:  # over the edge already (a second try after a slip)
-            self.side = float(np.sign(ring[1]))
             return
         com = self._pose(m, self.name).p
         lead = ring[1] - com[1]
@@ -200,12 +198,12 @@ class EdgePinch:
         tip = np.array([ring[0], ring[1], tip[2]])
         for k in range(1, 11):
             yield self._move_tip(rot, tip + [0.0, 0.0, 0.005 * k])
-        self.side = side
 
     def plan(self, shape: PosedShape) -> GraspPlan:
         """The pinch across the overhanging ring's far side (``shape``: the object's geometry now)."""
-        out = np.array([0.0, self.side, 0.0])
         ring = self.ring()
+        side = float(np.sign(ring[1]))  # the edge it was dragged over
+        out = np.array([0.0, side, 0.0])
         spans = sorted((a, b) for a, b in shape.ray_intervals(ring, out) if b > 0.0)
         if not spans:
             raise ExecutionError(f"no material of {self.name!r} beyond its ring", cause="grasp_failed")
@@ -221,7 +219,7 @@ class EdgePinch:
 
         return GraspPlan("edge", pose_of(rot, point - rot @ PINCH_POINT_PALM), -out, approach_m=APPROACH_OUT_M,
                          open_hand=pads(OPEN_GAP_M), closing=((pads(-LEAD_M), 15),),
-                         note=f"edge pinch of the ring {1000 * (point[1] - self.side * self.edge_y) * self.side:.0f} "
+                         note=f"edge pinch of the ring {1000 * (side * point[1] - self.edge_y):.0f} "
                               "mm past the table's edge, thumb " + ("below" if rot[2, 0] < 0 else "above"))
 
     def bring_hand(self, plan: GraspPlan) -> Iterator[np.ndarray]:
