@@ -63,6 +63,23 @@ def task_copy(tmp_path):
 
 
 @pytest.fixture
+def stage_run():
+    """``stage_run(version, "lift_bottle", tmp_path / "run")``: a training run folder of ``version`` already holding
+    four start states of the stage, which ``train_stage`` then uses instead of collecting the 64 ``gendex train``
+    collects (40 s of a one-rollout test run; collecting them is tested on its own)."""
+
+    def make(version: TaskVersion, stage: str, run_dir: Path, n: int = 4) -> Path:
+        from gendex.train.start_states import collect_executor_states
+        from gendex.train.train import open_run
+
+        run = open_run(run_dir, version)
+        collect_executor_states(version, stage, n, seed=0).states.save(run.start_states(stage))
+        return run_dir
+
+    return make
+
+
+@pytest.fixture
 def make_env():
     """Factory for GenDex envs that closes every env it made when the test ends."""
     made = []

@@ -82,13 +82,13 @@ def test_later_stage_needs_start_states_and_restores_them(bottle, tmp_path):
         env.close()
 
 
-def test_executor_runs_a_present_policy(bottle, tmp_path):
+def test_executor_runs_a_present_policy(bottle, stage_run, tmp_path):
     """With a trained policy of a stage in its sources the executor runs it (here: a real SB3 model trained for one
     rollout, in a training run folder)."""
     from gendex.train.presets import PRESETS
     from gendex.train.train import train_stage
 
-    run = tmp_path / "run"
+    run = stage_run(bottle, "lift_bottle", tmp_path / "run")
     r = train_stage(bottle, "lift_bottle", steps=256, n_envs=1, run_dir=run, eval_episodes=1, progress=False,
                     preset=dataclasses.replace(PRESETS["cpu"], n_steps=256, batch_size=64, n_epochs=1))
     layout = Artifacts(run).layout

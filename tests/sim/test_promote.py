@@ -18,10 +18,10 @@ from gendex_envs.task_version import Artifacts, TaskLayout
 TINY = dataclasses.replace(PRESETS["cpu"], n_steps=128, batch_size=64, n_epochs=1)
 
 
-def test_train_then_promote_makes_a_new_version_and_keeps_the_old_one(task_copy, tmp_path):
+def test_train_then_promote_makes_a_new_version_and_keeps_the_old_one(task_copy, stage_run, tmp_path):
     v0 = task_copy("PickUpBottle", as_name="ScratchBottle")
     before = v0.file_digest()
-    run = tmp_path / "run"
+    run = stage_run(v0, "lift_bottle", tmp_path / "run")
     r = train_stage(v0, "lift_bottle", steps=128, n_envs=1, run_dir=run, eval_episodes=1, progress=False,
                     preset=TINY, command="test")
     assert v0.file_digest() == before and v0.policy("lift_bottle") is None  # training left v0 untouched
@@ -61,9 +61,9 @@ def test_train_then_promote_makes_a_new_version_and_keeps_the_old_one(task_copy,
         unregister_tasks(new)
 
 
-def test_a_run_of_another_version_or_a_changed_version_is_refused(task_copy, tmp_path):
+def test_a_run_of_another_version_or_a_changed_version_is_refused(task_copy, stage_run, tmp_path):
     v0 = task_copy("PickUpBottle", as_name="ScratchBottle")
-    run = tmp_path / "run"
+    run = stage_run(v0, "lift_bottle", tmp_path / "run")
     train_stage(v0, "lift_bottle", steps=128, n_envs=1, run_dir=run, eval_episodes=1, progress=False, preset=TINY)
     other = CliRunner().invoke(app, ["train", "GenDex/PickUpBottle-v0", "--stage", "lift_bottle", "--out", str(run),
                                      "--steps", "2048"])
