@@ -53,6 +53,7 @@ from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_
 from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
+from gendex_envs.heap import freeze_long_lived
 from gendex_envs.observation import flat_float_state
 from gendex_envs.physx import read_pose
 from gendex_envs.placement import Footprint, Item, place
@@ -166,6 +167,7 @@ class TaskEnv(BaseEnv):
             for o in self.task_spec.objects
         }
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
+        freeze_long_lived()  # ManiSkill's full collection at each scene rebuild then walks only what came after
         super().__init__(*args, **kwargs)
 
     @property
