@@ -8,8 +8,9 @@ to those collections.
 
 :func:`freeze_long_lived` moves what is alive before the first scene is built (modules, classes, import-time tables,
 which live as long as the process) to the collector's permanent generation, so later collections walk only what was
-made after: scenes, tensors, episodes. Scenes torn down later are still collected as before. The cost: cyclic
-garbage among the frozen objects is never reclaimed, so a collection runs first.
+made after: scenes, tensors, episodes. Scenes torn down later are still collected as before. The cost: a frozen
+object that later ends up in an unreachable reference cycle is never reclaimed (the collection just before the freeze
+leaves no garbage to freeze).
 """
 
 from __future__ import annotations
