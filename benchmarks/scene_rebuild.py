@@ -2,8 +2,9 @@
 
 A grasp choice rebuilds its trial scene for every candidate it tries in physics (``env.reset(options=
 {"reconfigure": True})``), and ManiSkill ends each teardown with a full ``gc.collect()``. In one process this times,
-alternating on each repeat: (a) a rebuild with the heap frozen, as GenDex runs, and (b) the same after
-``gc.unfreeze()``, as plain ManiSkill runs; then (c) collecting start states (the scripted solver, grasp trials
+alternating on each repeat: (a) a rebuild with the heap frozen, as GenDex runs (GenDex freezes before its first
+scene; here the env built before the timing is frozen too, a few thousand objects more), and (b) the same after
+``gc.unfreeze()``, as plain ManiSkill runs; then collecting start states (the scripted solver, grasp trials
 included) both ways. Prints medians and the ratio (b) / (a).
 """
 
