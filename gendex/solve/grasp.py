@@ -182,6 +182,8 @@ class GraspPlan:
     """Guarded ramps that close the hand, in order: (joint targets, control steps)."""
     note: str = ""
     """What the candidate is (family, heading, width), for logs."""
+    lift: tuple[float, float, float] | None = None
+    """World offset the palm moves by after closing; None: straight up by the motion's ``lift_m``."""
 
     @property
     def pregrasp(self) -> sapien.Pose:
@@ -421,12 +423,16 @@ class GraspSynthesizer:
         world = cover.centers @ m[:3, :3].T + m[:3, 3]
         for t in np.linspace(0.0, 1.0, samples + 1):
             pts = world + (1 - t) * np.asarray(start) + t * np.asarray(end)
-            if np.any(pts[:, 2] - cover.radii < self.table_z + TABLE_CLEARANCE_M):
+            if np.any(self.table_gap(pts, cover.radii) < TABLE_CLEARANCE_M):
                 return False
             for shape in (self.shape, *self.others):
                 if np.any(shape.signed_distance(pts) - cover.radii < OBJECT_CLEARANCE_M):
                     return False
         return True
+
+    def table_gap(self, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
+        """[n] how far each sphere (world ``centers`` [n, 3], ``radii`` [n]) is above the table (negative: in it)."""
+        return centers[:, 2] - radii - self.table_z
 
     # ------------------------------------------------------------------ families
     def _top(self) -> Iterator[list[GraspPlan]]:
@@ -544,9 +550,12 @@ class GraspSynthesizer:
 
     def _pinch(self) -> Iterator[list[GraspPlan]]:
         for line in self.pinch_lines():
-            yield from self._pinch_plans(line)
+            yield from self.pinch_plans(line)
 
-    def _pinch_plans(self, line: PinchLine) -> Iterator[list[GraspPlan]]:
+    def pinch_plans(self, line: PinchLine) -> Iterator[list[GraspPlan]]:
+        """Pinches along ``line``: per palm direction and roll whose open hand dips no more than
+        :data:`MAX_RAISE_M` into the table (raised clear of it), the group of its idle-finger variants; the hand's
+        clearance of the objects is left to :meth:`hand_clear`."""
         a_w = line.axis
         down = np.array([0.0, 0.0, -1.0])
         for a_p in PINCH_AXES_PALM:
@@ -562,8 +571,7 @@ class GraspSynthesizer:
                     continue  # the palm must face the table to come from above
                 palm = line.center - rot @ shape.center  # the width was rounded up: the pads centre on the line
                 cover = self.hand.spheres(shape.open)
-                low = float(np.min(cover.centers @ rot[2] + palm[2] - cover.radii))
-                dip = self.table_z + TABLE_CLEARANCE_M - low
+                dip = TABLE_CLEARANCE_M - float(np.min(self.table_gap(cover.centers @ rot.T + palm, cover.radii)))
                 if dip > MAX_RAISE_M:
                     continue
                 palm = palm + np.array([0.0, 0.0, max(dip + RAISE_MARGIN_M, 0.0)])

@@ -367,20 +367,21 @@ class RigidPrimitives:
         self.placed_on = None
         for attempt in range(c.regrasps + 1):
             z0 = float(self.env.obj(name).pose.p[0, 2])
-            lift = c.motion.lift_m
-            if lift_to is not None:
-                lift = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, lift))
+            planned = self.plan.lift is not None  # an edge pinch's: kept whole, unhurried, as far as the arm reaches
+            offset = np.array(self.plan.lift if planned else [0.0, 0.0, c.motion.lift_m])
+            if lift_to is not None and not planned:
+                offset[2] = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, offset[2]))
             yield from close_hand(m, self.plan, c.motion)
             self.held = name
-            yield from m.cartesian(np.array([0.0, 0.0, lift]), c.motion.lift_m_per_step, guard=True, paced=True)
+            yield from m.cartesian(offset, c.motion.lift_m_per_step, guard=True, paced=not planned, partial=planned)
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
-            if risen >= 0.5 * lift and touched >= 2:
+            if risen >= 0.5 * offset[2] and touched >= 2:
                 yield from ease_grip(m, self._require)
                 return
             self.held = None
-            why = f"rose {risen:.3f} m of {lift:.3f} m, touched by {touched} part(s) of the hand"
+            why = f"rose {risen:.3f} m of {offset[2]:.3f} m, touched by {touched} part(s) of the hand"
             if attempt == c.regrasps:
                 raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting ({why})", cause="slipped")
             log.info("%r slipped (%s): opening and grasping again", name, why)

@@ -179,7 +179,7 @@ def test_a_pinch_raised_off_the_table_passes_its_own_clearance_check():
     across the robot's view had no pinch with the fingers pointing away from the robot (seed 1014: 0 reachable)."""
     s = Scene("marker", seed=1014)
     try:
-        plans = [p for line in s.synth.pinch_lines() for group in s.synth._pinch_plans(line) for p in group]
+        plans = [p for line in s.synth.pinch_lines() for group in s.synth.pinch_plans(line) for p in group]
         assert plans
         for p in plans:
             cover = s.hand.spheres(p.open_hand)
@@ -339,7 +339,7 @@ def test_a_heavy_object_is_pinched_harder_in_proportion_to_its_weight():
             prefer = object_heading(s.shape.footprint().center, s.ik.base.p[:2])
             heavy = GraspSynthesizer(s.hand, s.shape, 0.0, prefer, mass_kg=0.42)
             line = s.synth.pinch_lines()[0]
-            light, firm = (next(synth._pinch_plans(line))[0] for synth in (s.synth, heavy))
+            light, firm = (next(synth.pinch_plans(line))[0] for synth in (s.synth, heavy))
             assert light.note == firm.note  # the same grasp, only closed harder
             assert np.allclose(light.palm.p, firm.palm.p) and np.allclose(light.palm.q, firm.palm.q)
             axis_palm = tuple(float(v) for v in light.note.split("palm axis (")[1].split(")")[0].split(", "))
