@@ -68,7 +68,8 @@ CURL_INDEX = {"FFJ2": 1.4, "FFJ1": 1.4, "FFJ0": 1.2}
 DRAG_TILT_RAD = np.radians(25.0)
 DRAG_TIP_Z_M = 0.004
 """Commanded height of the index's end-cap centre while it drags: 3 mm below where the finger's end rests on the
-table, so that it presses lightly and stays in the ring."""
+table, so that it presses lightly and stays in the ring (not where the finger is wedged in a narrow ring:
+:data:`WEDGED_Z_M`)."""
 SETTLE_STEPS = 6
 WEDGED_Z_M = 0.0085
 """A finger's end whose centre stays higher than this in the ring, :data:`SETTLE_STEPS` after it was sent down (it
@@ -96,11 +97,11 @@ GRAVITY = 9.81
 HINGE_MIN_MOMENT_NM = 0.08
 """A tool whose weight pulls this hard (N m) about its ring is hinged, not clamped. The clamp held the closed
 scissors (0.08 kg, 0.03 N m about the ring) in 50-80 % of the grasp benchmark's attempts and the wrench (0.15 kg,
-0.11 N m) in 5-15 %: its pads resist the tool's turn about the ring by friction over the 7 mm of its thickness. The
+0.11 N m) in 0-15 %: its pads resist the tool's turn about the ring by friction over the 7 mm of its thickness. The
 hinge lets the tool turn, and the tool hangs below it."""
 HANG_HEADINGS_DEG = (0.0, 20.0, -20.0, 40.0, -40.0)
 """Pinch lines through the ring's centre, level with it, in degrees from square to the tool (each both ways round):
-across both of the scissors' rings, across the wrench's ring, and the tool turns about the line in its own plane."""
+square to it, the line crosses the wrench's ring through its centre and the tool turns about it in its own plane."""
 HANG_UP_M = 0.24
 """The lift after the pinch, straight up: the tool turns about the pinch line and hangs below the pads, its far end
 above the table top. Its far end leaves the edge when it hangs nearly straight down and it barely swings; lifted 6 cm
