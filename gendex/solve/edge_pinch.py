@@ -195,10 +195,7 @@ class EdgePinch:
     def drag(self) -> Iterator[np.ndarray]:
         """Index into the ring, ring dragged :data:`OVERHANG_M` past the side edge, index out and up."""
         m = self.m
-        ring = self.ring()
-        if ring[2] < m.env.table_height - 0.02:
-            raise ExecutionError(f"{self.name!r} is off the table (its ring {-ring[2]:.2f} m below the top)",
-                                 cause="slipped")
+        ring = self._ring_on_table()
         if abs(ring[1]) > self.edge_y:  # over the edge already (a second try after a slip)
             return
         com = self._pose(m, self.name).p
@@ -290,18 +287,28 @@ class EdgePinch:
     def plan(self, shape: PosedShape) -> GraspPlan:
         """The pinch of the overhanging ring (``shape``: the object's geometry now): a clamp across its far side
         when the tool's weight twists it little about the ring, else a hinge across it (:data:`HINGE_MIN_MOMENT_NM`)."""
+        ring = self._ring_on_table()
+        lever = float(np.linalg.norm(shape.centroid()[:2] - ring[:2]))
+        return (self._hinge(shape, ring) if self.mass_kg * GRAVITY * lever >= HINGE_MIN_MOMENT_NM else
+                self._clamp(shape, ring))
+
+    def _ring_on_table(self) -> np.ndarray:
+        """The ring's centre now; an ``ExecutionError`` when the tool has fallen off the table."""
         ring = self.ring()
         if ring[2] < self.m.env.table_height - 0.02:
-            raise ExecutionError(f"{self.name!r} fell off the table at its edge", cause="slipped")
-        lever = float(np.linalg.norm(shape.centroid()[:2] - ring[:2]))
-        return (self._hinge(shape) if self.mass_kg * GRAVITY * lever >= HINGE_MIN_MOMENT_NM else
-                self._clamp(shape))
+            raise ExecutionError(f"{self.name!r} is off the table (its ring {-ring[2]:.2f} m below the top)",
+                                 cause="slipped")
+        return ring
 
-    def _clamp(self, shape: PosedShape) -> GraspPlan:
+    def _over(self, plan: GraspPlan) -> np.ndarray | None:
+        """Arm joints :data:`ABOVE_M` over ``plan``'s pre-grasp pose (the hand open as planned), or None."""
+        start = self.m.with_hand(self.m.target(), plan.open_hand)
+        return self.m.ik.solve(sapien.Pose(plan.pregrasp.p + [0.0, 0.0, ABOVE_M], plan.palm.q), start, restarts=16)
+
+    def _clamp(self, shape: PosedShape, ring: np.ndarray) -> GraspPlan:
         """The thumb's and the index's pads closed on the ring's far side from below and above, the fingers along
         the edge and the palm facing the table's side: the thumb under the ring at the +y edge, over it at the -y
         edge (the arm reaches no pose with the fingers pointing across the table)."""
-        ring = self.ring()
         side = float(np.sign(ring[1]))  # the edge it was dragged over
         out = np.array([0.0, side, 0.0])
         spans = sorted((a, b) for a, b in shape.ray_intervals(ring, out) if b > 0.0)
@@ -321,18 +328,15 @@ class EdgePinch:
                          open_hand=pads(OPEN_GAP_M), closing=((pads(-LEAD_M), 15),),
                          note=f"clamp of the ring {1000 * (side * point[1] - self.edge_y):.0f} mm past the table's "
                               "edge, thumb " + ("below" if rot[2, 0] < 0 else "above"))
-        start = self.m.with_hand(self.m.target(), plan.open_hand)
-        self._high = self.m.ik.solve(sapien.Pose(plan.pregrasp.p + [0.0, 0.0, ABOVE_M], plan.palm.q), start,
-                                     restarts=16)
+        self._high = self._over(plan)
         if self._high is None:
             raise ExecutionError(f"no IK over the edge clamp of {self.name!r}", cause="no_ik")
         return plan
 
-    def _hinge(self, shape: PosedShape) -> GraspPlan:
+    def _hinge(self, shape: PosedShape, ring: np.ndarray) -> GraspPlan:
         """A pinch across the overhanging ring, level with it (``shape``: the object's geometry now): the first
         candidate whose open hand keeps out of the table and the tool and that the arm reaches over the edge."""
         m = self.m
-        ring = self.ring()
         side = float(np.sign(ring[1]))  # the edge it was dragged over
         fp = shape.footprint()
         centre = np.array([ring[0], ring[1], fp.bottom + fp.height / 2])
@@ -390,10 +394,10 @@ class EdgePinch:
         top of the lift from there, keeping the arm and the open hand out of the table top on the way (the joint
         ramp there included), else None."""
         m = self.m
-        start = m.with_hand(m.target(), plan.open_hand)
-        q = m.ik.solve(sapien.Pose(plan.pregrasp.p + [0.0, 0.0, ABOVE_M], plan.palm.q), start, restarts=16)
+        q = self._over(plan)
         if q is None:
             return None
+        start = m.with_hand(m.target(), plan.open_hand)
         path = [start + t * (q - start) for t in np.linspace(0.0, 1.0, 9)[1:]]
         for p in (plan.pregrasp.p, plan.palm.p, plan.palm.p + lift):
             path.append(m.ik.solve(sapien.Pose(p, plan.palm.q), path[-1], restarts=4))
