@@ -10,8 +10,9 @@ Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is 
   opened hand in the collision model and the target an obstacle, and straight on to the pre-grasp pose. If the
   object was disturbed on the way (moved more than :data:`MOVED_M`), the grasp is synthesized again from where it
   is now. Then the straight approach. A flat ringed tool no grasp holds goes to the table's edge first (edge_pinch).
-- ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m``. If the object did not come
-  up with the hand (it slipped), the hand opens, backs off and grasps once more from where it is (``regrasps``).
+- ``grasp`` — the grasp's guarded closing ramps and squeeze, then a lift of ``lift_m`` (an edge pinch's: as far as
+  the arm reaches). If the object did not rise half as far as the hand did (it slipped), the hand opens, backs off
+  and grasps once more from where it is (``regrasps``).
 - ``lift`` — raise the held object to the task's ``lifted`` height.
 - ``carry`` — the held object over the target: a level, eased palm path where the hand's orientation can be kept,
   else a planned arm motion, the held object attached to the palm in the collision model; an object that is no
@@ -20,8 +21,7 @@ Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is 
 - ``push`` — slide an object across the table with the flat hand, closed loop on its measured pose.
 - ``release`` — open the hand back to the grasp's pre-shape and back off.
 
-Every :class:`~gendex_envs.errors.ExecutionError` raised here names its cause (``no_ik``, ``no_plan``,
-``grasp_failed``, ``slipped``, ...).
+Every :class:`~gendex_envs.errors.ExecutionError` raised here names its cause (``no_ik``, ``slipped``, ...).
 """
 
 from __future__ import annotations
@@ -70,8 +70,7 @@ MOVED_M = 0.005
 """An object that moved more than this between planning its grasp and reaching the pre-grasp is re-planned."""
 STAGING_M = tuple(sorted(((b, u, a) for b in (0.0, 0.06, 0.12) for u in (0.0, 0.08, 0.16, 0.24) for a in (0.0, 0.08)
                           if b + u + a > 0), key=lambda o: (sum(x * x for x in o), o)))
-"""(back along the approach, up, away from the object) offsets of the staging poses tried on the way to a pre-grasp
-pose, metres, nearest first."""
+"""Staging offsets (m) from a pre-grasp pose (back along the approach, up, away from the object), nearest first."""
 ESCAPE_M = 0.15
 """Highest rise of the opened hand out of the collision model's margins before a staged approach is planned."""
 UNTILT_MAX_RAD = 0.8
@@ -373,15 +372,16 @@ class RigidPrimitives:
                 offset[2] = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, offset[2]))
             yield from close_hand(m, self.plan, c.motion)
             self.held = name
-            yield from m.cartesian(offset, c.motion.lift_m_per_step, guard=True, paced=not planned, partial=planned)
+            done = yield from m.cartesian(offset, c.motion.lift_m_per_step, True, not planned, partial=planned)
+            lifted = max(done * offset[2], MIN_LIFT_M)  # an edge pinch's lift ends where the arm's reach does
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
-            if risen >= 0.5 * offset[2] and touched >= 2:
+            if risen >= 0.5 * lifted and touched >= 2:
                 yield from ease_grip(m, self._require)
                 return
             self.held = None
-            why = f"rose {risen:.3f} m of {offset[2]:.3f} m, touched by {touched} part(s) of the hand"
+            why = f"rose {risen:.3f} m of {lifted:.3f} m, touched by {touched} part(s) of the hand"
             if attempt == c.regrasps:
                 raise ExecutionError(f"{name!r} slipped out of the {self.plan} while lifting ({why})", cause="slipped")
             log.info("%r slipped (%s): opening and grasping again", name, why)
