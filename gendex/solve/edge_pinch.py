@@ -1,5 +1,5 @@
 """Flat tools with a finger ring (closed scissors, a ring wrench): dragged by the ring to the table's side edge, then
-pinched across the ring where it overhangs.
+hooked on the index through the ring, or pinched across the ring where it overhangs.
 
 No pinch from the table lifts a tool 6-7 mm tall: the fingertip pads (7.1 and 9.2 mm radius) meet its top edge from
 above and push it into the table (``docs/solving.md``). A person slides such a tool off the edge of the table first.
@@ -15,26 +15,35 @@ hole a fingertip fits in (:func:`find_ring`):
    first), re-aimed every step from the ring's measured position, the commanded tip at most
    :data:`DRAG_LEAD_MAX_M` ahead of it (where the arm's configuration reaches no further, the finger grips the
    ring again from one solved past the edge, :data:`MAX_REGRIPS`); it stops when the ring's centre is
-   :data:`OVERHANG_M` past the edge;
-2. **pinch** — the finger comes out (curled out where the arm rises no higher), and the open hand pinches the
-   overhanging ring. A tool whose weight turns it little about the ring (:data:`HINGE_MIN_MOMENT_NM`: the closed
-   scissors) is *clamped*: the hand comes down outside the edge and slides in with the fingers along the edge and the
-   palm facing the table's side, the thumb's pad under the ring and the index's over it at the +y edge, the other way
-   round at the -y edge (the arm reaches no pose with the fingers pointing across the table), both closed on the
-   ring's far side with a :data:`LEAD_M` lead. A heavier one (the wrench) is *hinged*: the hand comes down over the
-   ring and pinches it across, level with it, along a line about square to the tool (:data:`HANG_HEADINGS_DEG`):
-   past the edge the fingers may reach below the table top, so the pads meet the ring's outer wall side-on. Of the
-   pinches the synthesis offers there (:meth:`~gendex.solve.grasp.GraspSynthesizer.pinch_plans`, the table cut off
-   at its edge), the one whose pads cross their contact points at the most even height while closing comes first (a
-   pad passing low lifts its side and rolls the tool over); the arm must reach it without the arm or the open hand
-   dipping into the table top. Lifted :data:`HANG_UP_M` straight up, the tool turns about the pinch line, its far end
-   slides to the edge, and it hangs below the pads, held by friction along them rather than against its own moment.
+   :data:`OVERHANG_M` past the edge (:data:`HOOK_OVERHANG_M` for a ring to be hooked);
+2. **hook** — a hole wider than the finger's end with room to spare (:data:`HOOK_MIN_RADIUS_M`: the scissors'): the
+   finger is turned straight down in the ring and pushed through it below the table top (:data:`HOOK_TIP_Z_M`;
+   backed up and sent once more where the ring goes down with it, :data:`HOOK_JAM_M`), and the index curls
+   (:data:`HOOK_CURL`): the ring's wall is caught in the crook of its middle joint. The hand rises
+   :data:`HOOK_RISE_M` with the tool hanging from the finger, the curl eases (:data:`HOOK_HOLD`) and the knuckle flexes
+   (:data:`HOOK_FLEX`), bringing the ring to where the thumb reaches; the thumb closes on the ring (guarded) and the
+   hand lifts. A ring threaded on the finger cannot slip out of a pinch: the clamp below held the scissors in 50-80 %
+   of the grasp benchmark's attempts, mostly slipping. Where the finger does not go through, it is pinched instead;
+3. **pinch** — the finger comes out (curled out where the arm rises no higher), and the open hand pinches the
+   overhanging ring. A tool whose weight turns it little about the ring (:data:`HINGE_MIN_MOMENT_NM`) is *clamped*:
+   the hand comes down outside the edge and slides in with the fingers along the edge and the palm facing the
+   table's side, the thumb's pad under the ring and the index's over it at the +y edge, the other way round at the -y
+   edge (the arm reaches no pose with the fingers pointing across the table), both closed on the ring's far side
+   with a :data:`LEAD_M` lead. A heavier one (the wrench, whose 6.9 mm hole the finger does not pass) is *hinged*:
+   the hand comes down over the ring and pinches it across, level with it, along a line about square to the tool
+   (:data:`HANG_HEADINGS_DEG`): past the edge the fingers may reach below the table top, so the pads meet the ring's
+   outer wall side-on. Of the pinches the synthesis offers there
+   (:meth:`~gendex.solve.grasp.GraspSynthesizer.pinch_plans`, the table cut off at its edge), the one whose pads
+   cross their contact points at the most even height while closing comes first (a pad passing low lifts its side
+   and rolls the tool over); the arm must reach it without the arm or the open hand dipping into the table top.
+   Lifted :data:`HANG_UP_M` straight up, the tool turns about the pinch line, its far end slides to the edge, and it
+   hangs below the pads, held by friction along them rather than against its own moment.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Generator, Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import replace
 
 import numpy as np
@@ -109,6 +118,39 @@ outwards as well, the far end left the edge early, the tool swung down and the w
 ARM_MARGIN_M = 0.01
 ABOVE_M = 0.12
 BRING_STEPS = 40
+HOOK_MIN_RADIUS_M = 0.008
+"""A ring whose hole is at least this wide (the largest circle in it) is hooked, not pinched: the index's end (7.1 mm
+radius) passes through it straight down (the scissors' rings, 8.6-8.8 mm; not the wrench's, 6.9 mm)."""
+HOOK_OVERHANG_M = 0.013
+"""How far past the edge a hooked ring's centre is dragged: far enough for the finger to pass the table's side
+through it, close enough that the tool does not tip over the edge while the finger turns in it (at 2 cm, closed
+scissors tipped off on 1 of 3 dev seeds)."""
+HOOK_TIP_Z_M = -0.05
+"""Height of the index's end below the table top before it curls: its middle joint level with the ring (at -3 cm
+the curling middle phalanx folded the finger back up out of the ring)."""
+HOOK_CURL = {"FFJ1": 1.3, "FFJ0": 1.3}
+"""The index's middle and end joints (coupled) curled round the ring's wall."""
+HOOK_RISE_M = 0.16
+"""The hand rises this far with the tool hanging from the curled index before the knuckle flexes: the tool hangs
+clear of the table (the scissors are 14 cm long)."""
+HOOK_HOLD = {"FFJ1": 0.9, "FFJ0": 0.9}
+"""The curl eased before the knuckle flexes: still a hook, but no longer squeezing the ring into the crook (the
+squeeze, 50-70 N, pressed the finger's first phalanx back, and the knuckle did not move on 2 of 10 dev seeds)."""
+HOOK_FLEX = {"FFJ2": 1.2}
+"""The index's knuckle flexed: the hooked ring comes 2-3 cm from the thumb's reach to within it (the thumb's pad
+reaches the middle joint from 1.2 rad on)."""
+HOOK_FLEX_MORE = {"FFJ2": 1.5}
+HOOK_THUMB_MISS_M = 0.01
+"""Where the thumb's pad reaches no nearer than this to the ring's centre after :data:`HOOK_FLEX`, the knuckle flexes
+on to :data:`HOOK_FLEX_MORE` (the ring caught nearer the finger's end: the thumb 17-23 mm short of it and, on 1 of 30
+dev seeds, not touching it)."""
+HOOK_STEPS = 15
+HOOK_JAM_M = 0.008
+"""The finger is jammed in the ring when the ring's centre drops this far while the finger goes down through it (the
+tool then tips over the edge: 2 of 20 dev seeds)."""
+HOOK_LAG_M = 0.02
+"""The arm does not follow the index through the ring when its end is this far from where it was sent (the forearm
+on the table's edge after a re-grip: 3 of 60 dev runs)."""
 
 
 def find_ring(shape: PosedShape, step_m: float = 0.001) -> np.ndarray | None:
@@ -139,11 +181,15 @@ class EdgePinch:
     """The drag and the pinch of one flat ringed object (see the module docstring)."""
 
     def __init__(self, m: ArmHandMotion, hand: HandModel, name: str, ring_in_object: np.ndarray, edge_y: float,
-                 mass_kg: float = 0.0):
+                 mass_kg: float = 0.0, hole_m: float = 0.0):
         self.m, self.hand, self.name, self.mass_kg = m, hand, name, mass_kg
         self.ring_local = ring_in_object
         self.edge_y = edge_y
         self.half_x = float(m.env.task_spec.table.size_m[0]) / 2
+        self.hooks = hole_m >= HOOK_MIN_RADIUS_M
+        """The ring is hooked (its hole, ``hole_m`` in radius, lets the finger through), not pinched."""
+        self.hooked = False
+        """The index is curled through the ring and the tool hangs from it (:meth:`drag` did it)."""
         self._high: np.ndarray | None = None
         """Arm joints over the planned pinch (:meth:`plan`), where :meth:`bring_hand` takes the open hand first."""
 
@@ -155,7 +201,7 @@ class EdgePinch:
             return None
         local = (cls._pose(m, name).inv() * sapien.Pose(ring)).p
         return cls(m, hand, name, local, float(m.env.task_spec.table.size_m[1]) / 2,
-                   float(px_bodies(m.env.obj(name))[0].mass))
+                   float(px_bodies(m.env.obj(name))[0].mass), float(shape.signed_distance(ring[None])[0]))
 
     @staticmethod
     def _pose(m: ArmHandMotion, name: str) -> sapien.Pose:
@@ -170,17 +216,18 @@ class EdgePinch:
     def _tip(self, q: np.ndarray) -> np.ndarray:
         return (self.m.ik.fk(q, "ffdistal") * sapien.Pose([0.0, 0.0, TIP_ALONG_M])).p
 
-    def _palm_for_tip(self, rot: np.ndarray, tip: np.ndarray, q: np.ndarray, restarts: int = 0) -> np.ndarray | None:
+    def _palm_for_tip(self, rot: np.ndarray, tip: np.ndarray, q: np.ndarray, restarts: int = 0,
+                      valid: Callable[[np.ndarray], bool] | None = None) -> np.ndarray | None:
         """Arm joints putting the index's end at ``tip`` with the palm turned ``rot`` (fixed point on the tip's
-        offset from the palm)."""
+        offset from the palm; ``valid``: a check of the joints, as in :meth:`~gendex.solve.ik.ArmIK.solve`)."""
         palm = pose_of(rot, tip + (self.m.ik.fk(q).p - self._tip(q)))
         for _ in range(3):
-            sol = self.m.ik.solve(palm, q, restarts=restarts)
+            sol = self.m.ik.solve(palm, q, restarts=restarts, valid=valid)
             if sol is None:
                 return None
             palm = pose_of(rot, palm.p + tip - self._tip(sol))
             q, restarts = sol, 0
-        return self.m.ik.solve(palm, q, restarts=0)
+        return self.m.ik.solve(palm, q, restarts=0, valid=valid)
 
     def _move_tip(self, rot: np.ndarray, tip: np.ndarray, q: np.ndarray | None = None) -> np.ndarray:
         q = self._palm_for_tip(rot, tip, self.m.target()) if q is None else q
@@ -193,11 +240,13 @@ class EdgePinch:
 
     # ------------------------------------------------------------------ the sequence
     def drag(self) -> Iterator[np.ndarray]:
-        """Index into the ring, ring dragged :data:`OVERHANG_M` past the side edge, index out and up."""
+        """Index into the ring, ring dragged :data:`OVERHANG_M` past the side edge, index out and up; or, for a
+        ring the finger passes through, dragged :data:`HOOK_OVERHANG_M` past it and hooked (:meth:`_hook`)."""
         m = self.m
         ring = self._ring_on_table()
-        if abs(ring[1]) > self.edge_y:  # over the edge already (a second try after a slip)
+        if abs(ring[1]) > self.edge_y and not self.hooks:  # over the edge already (a second try after a slip)
             return
+        overhang = HOOK_OVERHANG_M if self.hooks else OVERHANG_M
         com = self._pose(m, self.name).p
         lead = ring[1] - com[1]
         side = float(np.sign(lead) if abs(lead) > 0.02 else (np.sign(ring[1]) or 1.0))
@@ -207,12 +256,13 @@ class EdgePinch:
         d0 /= np.linalg.norm(d0)
         fingers = -np.cos(DRAG_TILT_RAD) * np.array([0.0, 0.0, 1.0]) - np.sin(DRAG_TILT_RAD) * d0
         normal = np.cross(d0, [0.0, 0.0, 1.0])
-        rot = palm_rotation(fingers, normal * (np.sign(normal[0]) or 1.0))
+        normal *= np.sign(normal[0]) or 1.0
+        rot = palm_rotation(fingers, normal)
         z_drag = yield from self._enter_ring(rot, m.with_hand(m.target(), DRAG_HAND))
         tip, regrips = self._tip(m.target()), 0
         for _ in range(DRAG_MAX_STEPS):
             ring = self.ring()
-            if side * ring[1] > self.edge_y + OVERHANG_M:
+            if side * ring[1] > self.edge_y + overhang:
                 break
             d = goal - ring
             d[2] = 0.0
@@ -226,7 +276,7 @@ class EdgePinch:
                 # the arm's configuration reaches no further: finger out, and back in from a configuration that
                 # reaches past the edge (solved there with restarts)
                 regrips += 1
-                past = ring + d / np.linalg.norm(d) * (self.edge_y + OVERHANG_M + 0.01 - side * ring[1])
+                past = ring + d / np.linalg.norm(d) * (self.edge_y + overhang + 0.01 - side * ring[1])
                 seed = self._palm_for_tip(rot, np.array([past[0], past[1], z_drag]),
                                           m.with_hand(m.target(), DRAG_HAND), restarts=12)
                 if seed is not None:
@@ -241,7 +291,11 @@ class EdgePinch:
         else:
             raise ExecutionError(f"{self.name!r}'s ring is still {self.edge_y - side * self.ring()[1]:.3f} m short of "
                                  f"the table's edge after {DRAG_MAX_STEPS} steps", cause="target_not_reached")
-        yield from self._leave_ring(rot, tip)
+        if self.hooks and z_drag == DRAG_TIP_Z_M:
+            self.hooked = yield from self._hook(tip, d0, normal)
+            tip = self._tip(m.target())
+        if not self.hooked:
+            yield from self._leave_ring(rot, tip)
 
     def _enter_ring(self, rot: np.ndarray, seed: np.ndarray) -> Generator[np.ndarray, None, float]:
         """The straight index down into the ring (the arm solved near ``seed``, a joint vector); returns the height
@@ -267,14 +321,7 @@ class EdgePinch:
         cm; where the arm reaches no further, from where it is, and by curling (:data:`CURL_INDEX`) where the arm
         rises no higher (at the +y edge the arm often reaches no pose 2.5 cm above the dragged ring)."""
         m = self.m
-        ring = self.ring()
-        for k in range(1, 4):  # centre the finger in the ring, so that it leaves without pulling
-            goal = tip + (np.array([ring[0], ring[1], tip[2]]) - tip) * k / 3
-            q = self._palm_for_tip(rot, goal, m.target())
-            if q is None:  # at the arm's reach: the finger leaves from where it is
-                log.debug("no IK centring the finger in %r's ring: raising it from where it is", self.name)
-                break
-            yield self._move_tip(rot, goal, q)
+        yield from self._centre(rot, tip)  # so that it leaves without pulling
         tip = self._tip(m.target())
         for k in range(1, 11):
             q = self._palm_for_tip(rot, tip + [0.0, 0.0, 0.005 * k], m.target())
@@ -284,13 +331,133 @@ class EdgePinch:
                 return
             yield self._move_tip(rot, tip + [0.0, 0.0, 0.005 * k], q)
 
+    def _centre(self, rot: np.ndarray, tip: np.ndarray) -> Iterator[np.ndarray]:
+        """The index's end moved from ``tip`` to the ring's centre, at its height (as far as the arm reaches)."""
+        m = self.m
+        ring = self.ring()
+        for k in range(1, 4):
+            goal = tip + (np.array([ring[0], ring[1], tip[2]]) - tip) * k / 3
+            q = self._palm_for_tip(rot, goal, m.target())
+            if q is None:
+                log.debug("no IK centring the finger in %r's ring: it goes on from where it is", self.name)
+                return
+            yield self._move_tip(rot, goal, q)
+
+    def _hook(self, tip: np.ndarray, ahead: np.ndarray, normal: np.ndarray) -> Generator[np.ndarray, None, bool]:
+        """The dragged ring hooked on the index (the drag's end at ``tip``, its horizontal direction ``ahead``, the
+        palm's normal ``normal``): centred, the finger turned straight down and pushed through the ring, curled,
+        raised with the tool hanging from it, and flexed at the knuckle (see the module docstring). False when the
+        finger does not pass through the ring (:meth:`_through_ring`), nor after entering it again
+        (:meth:`_enter_again`)."""
+        m = self.m
+        up = np.array([0.0, 0.0, 1.0])
+        rots = [palm_rotation(-np.cos(t) * up - np.sin(t) * ahead, normal) for t in np.linspace(DRAG_TILT_RAD, 0, 8)]
+        yield from self._centre(rots[0], tip)
+        through = yield from self._through_ring(rots)
+        if not through:
+            through = yield from self._enter_again(rots[-1], rots[0])
+        if not through:
+            return False
+        yield from m.ramp(m.with_hand(m.target(), HOOK_CURL), HOOK_STEPS)
+        yield from m.hold(SETTLE_STEPS)
+        yield from m.cartesian(HOOK_RISE_M * up, DRAG_M_PER_STEP, partial=True)
+        yield from m.ramp(m.with_hand(m.target(), HOOK_HOLD), HOOK_STEPS)
+        yield from m.ramp(m.with_hand(m.target(), HOOK_FLEX), HOOK_STEPS)
+        if self._thumb_reach()[1] > HOOK_THUMB_MISS_M:  # the ring sits further out along the finger
+            yield from m.ramp(m.with_hand(m.target(), HOOK_FLEX_MORE), HOOK_STEPS)
+        return True
+
+    def _through_ring(self, rots: list[np.ndarray]) -> Generator[np.ndarray, None, bool]:
+        """The index straightened where it is (``rots``: palm rotations from the drag's tilt to straight down; a
+        tilted finger pushed down takes the ring down with it), then pushed through the ring to :data:`HOOK_TIP_Z_M`.
+        Where the ring goes down with it all the same (:data:`HOOK_JAM_M`), the finger goes back up and tries once
+        more; False (the finger back at the ring's height) when it jams again, or where the arm does not follow
+        (:data:`HOOK_LAG_M`: the arm on the table's edge) or reaches no further."""
+        m = self.m
+        z = float(self._tip(m.target())[2])
+        steps = [(rot, z, False) for rot in rots[1:]]
+        for attempt in range(2):
+            steps += [(rots[-1], h, True) for h in np.linspace(z, HOOK_TIP_Z_M, 15)[1:]]
+            ring_z = None
+            for rot, h, down in steps:
+                ring = self.ring()
+                ring_z = float(ring[2]) if down and ring_z is None else ring_z
+                goal = np.array([ring[0], ring[1], h])
+                q = self._palm_for_tip(rot, goal, m.target())
+                if q is None:
+                    log.debug("no IK for the index's end at %s through %r's ring", np.round(goal, 3), self.name)
+                    return False
+                yield self._move_tip(rot, goal, q)
+                if np.linalg.norm(self._tip(m.qpos()) - goal) > HOOK_LAG_M:
+                    log.debug("the arm does not follow the index through %r's ring: no hook", self.name)
+                    return False
+                if down and self.ring()[2] < ring_z - HOOK_JAM_M:
+                    break
+            else:
+                return True
+            log.debug("%r's ring goes down with the finger (try %d): the finger goes back up", self.name, attempt + 1)
+            yield from self._raise_tip(rots[-1], z)
+            steps = []
+        return False
+
+    def _enter_again(self, down: np.ndarray, tilted: np.ndarray) -> Generator[np.ndarray, None, bool]:
+        """The finger out of the ring (turned ``tilted``) and back in, straight down (``down``), from an arm
+        configuration that takes it through the ring with the arm clear of the table top (solved with restarts), then
+        through it (:meth:`_through_ring`): where the drag's configuration does not let the finger straighten (the
+        forearm met the table's edge: 3 of 60 dev runs) or the finger jammed twice. False when that fails too."""
+        m = self.m
+        yield from self._leave_ring(tilted, self._tip(m.target()))
+        ring = self.ring()
+        deep = self._palm_for_tip(down, np.array([ring[0], ring[1], HOOK_TIP_Z_M]),
+                                  m.with_hand(m.target(), DRAG_HAND), restarts=12,
+                                  valid=lambda q: self._out_of_table(q, 0))
+        if deep is None:
+            log.debug("no arm configuration takes the index through %r's ring clear of the table", self.name)
+            return False
+        log.debug("the index enters %r's ring again, straight down", self.name)
+        try:
+            rest = yield from self._enter_ring(down, deep)
+        except ExecutionError as err:
+            log.debug("%s", err)
+            return False
+        return rest == DRAG_TIP_Z_M and (yield from self._through_ring([down, down]))
+
+    def _raise_tip(self, rot: np.ndarray, z: float) -> Iterator[np.ndarray]:
+        """The index's end back up to height ``z`` over the ring's centre (as far as the arm reaches)."""
+        m = self.m
+        for h in np.linspace(float(self._tip(m.target())[2]), z, 6)[1:]:
+            ring = self.ring()
+            q = self._palm_for_tip(rot, np.array([ring[0], ring[1], h]), m.target())
+            if q is None:
+                return
+            yield self._move_tip(rot, np.array([ring[0], ring[1], h]), q)
+
     def plan(self, shape: PosedShape) -> GraspPlan:
         """The pinch of the overhanging ring (``shape``: the object's geometry now): a clamp across its far side
-        when the tool's weight twists it little about the ring, else a hinge across it (:data:`HINGE_MIN_MOMENT_NM`)."""
+        when the tool's weight twists it little about the ring, else a hinge across it (:data:`HINGE_MIN_MOMENT_NM`);
+        the thumb closed on a hooked ring."""
+        if self.hooked:
+            return self._thumb_on_hook()
         ring = self._ring_on_table()
         lever = float(np.linalg.norm(shape.centroid()[:2] - ring[:2]))
         return (self._hinge(shape, ring) if self.mass_kg * GRAVITY * lever >= HINGE_MIN_MOMENT_NM else
                 self._clamp(shape, ring))
+
+    def _thumb_on_hook(self) -> GraspPlan:
+        """The hooked ring's grasp: the thumb's pad closed (guarded) towards the ring's measured centre, the hand where
+        it is, then the lift."""
+        m = self.m
+        thumb, miss = self._thumb_reach()
+        hand = {j: float(m.target()[m.ik.joint_names.index(j)]) for j in DRAG_HAND | HOOK_HOLD | HOOK_FLEX}
+        return GraspPlan("edge", m.ik.fk(m.target()), np.array([0.0, 0.0, -1.0]), approach_m=0.0,
+                         open_hand=hand, closing=((thumb, HOOK_STEPS),),
+                         note=f"hook, the index curled through the ring, the thumb closed on it ({1000 * miss:.0f} mm "
+                              "short of its centre)", lift=(0.0, 0.0, HANG_UP_M))
+
+    def _thumb_reach(self) -> tuple[dict[str, float], float]:
+        """The thumb's joints putting its pad nearest the hooked ring's measured centre, and how far from it (m)."""
+        m = self.m
+        return self.hand.finger_ik("th", (m.ik.fk(m.qpos()).inv() * sapien.Pose(self._ring_on_table())).p)
 
     def _ring_on_table(self) -> np.ndarray:
         """The ring's centre now; an ``ExecutionError`` when the tool has fallen off the table."""
@@ -424,6 +591,8 @@ class EdgePinch:
         plane everywhere, and past the edge the forearm hangs below it (both ends of the ramp are over the edge,
         the hand 5 cm or more above the table)."""
         m = self.m
+        if self.hooked:  # the hand is at the hooked ring's grasp already
+            return
         start = m.with_hand(m.target(), plan.open_hand)
         goal = start.copy()
         goal[m.arm] = self._high[m.arm]

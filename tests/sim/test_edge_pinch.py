@@ -1,5 +1,5 @@
-"""Flat ringed tools (closed scissors, a ring wrench) are dragged by the ring to the table's side edge and pinched
-across the overhang (``gendex/solve/edge_pinch.py``)."""
+"""Flat ringed tools (closed scissors, a ring wrench) are dragged by the ring to the table's side edge, and hooked on
+the index through the ring or pinched across the overhang (``gendex/solve/edge_pinch.py``)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.edge_pinch import find_ring
+from gendex.solve.edge_pinch import HOOK_MIN_RADIUS_M, find_ring
+from gendex.solve.hand import PAD_RADIUS_M
 from gendex.solve.lift_check import LiftChecker, lift_spec
 from gendex.solve.shape import ObjectShape
 from gendex_envs.task_env import TaskEnv
@@ -42,19 +43,37 @@ def test_no_ring_in_objects_without_one(asset, scale):
     assert _ring_in_object_frame(asset, scale) is None
 
 
-def test_closed_scissors_are_dragged_to_the_edge_and_pinched_there():
+def test_closed_scissors_are_hooked_through_a_ring_at_the_edge():
     """No grasp of closed scissors (6 mm tall) held in a physics trial on any seed of the grasp records (0/20
-    each). Seed 783514 (a dev seed of the edge pinch): dragged by a ring to the table's side edge, pinched across
-    the overhang, lifted and held."""
+    each). Seed 785026 (a dev seed of the hook): dragged by a ring to the table's side edge, the index through the ring
+    and curled, the tool lifted hanging from it with the thumb on the ring, and held."""
     checker = LiftChecker("scissors")
     try:
-        result = checker(783514)
+        result = checker(785026)
         y = float(checker.env.obj("obj").pose.p[0, 1])
     finally:
         checker.close()
     assert result.held and result.rise_m >= 0.10, result.failure
-    assert result.grasp.startswith("edge"), result.grasp
+    assert result.grasp.startswith("edge grasp (hook"), result.grasp
     assert abs(y) > 0.5  # at the side edge (0.6 m from the centre line), not where it lay (|y| < 0.22)
+
+
+@pytest.mark.parametrize("asset,hooked", [("scissors", True), ("wrench", False)])
+def test_only_a_ring_the_finger_passes_through_is_hooked(asset, hooked):
+    """The scissors' holes (8.6-8.8 mm to their walls) let the index's end (7.1 mm) through; the wrench's (6.9 mm)
+    does not, and it is pinched instead."""
+    env = TaskEnv(task_spec=lift_spec(asset), obs_mode="none", reward_mode="none")
+    try:
+        env.reset(seed=5)
+        p = env.obj("obj").pose
+        shape = ObjectShape.of_actor(env.obj("obj")).posed(
+            sapien.Pose(p.p[0].numpy(), p.q[0].numpy()).to_transformation_matrix())
+        ring = find_ring(shape)
+        hole = float(shape.signed_distance(ring[None])[0])
+    finally:
+        env.close()
+    assert (hole >= HOOK_MIN_RADIUS_M) == hooked, hole
+    assert hole > PAD_RADIUS_M["ff"] if hooked else hole < PAD_RADIUS_M["ff"]
 
 
 def test_the_wrench_is_hinged_across_its_ring_and_hangs_from_the_pads():
