@@ -22,7 +22,7 @@ hole a fingertip fits in (:func:`find_ring`):
    (:data:`HOOK_CURL`): the ring's wall is caught in the crook of its middle joint. The hand rises
    :data:`HOOK_RISE_M` with the tool hanging from the finger, the curl eases (:data:`HOOK_HOLD`) and the knuckle flexes
    (:data:`HOOK_FLEX`), bringing the ring to where the thumb reaches; the thumb closes on the ring (guarded) and the
-   hand lifts. A ring threaded on the finger cannot slip out of a pinch: the clamp below held the scissors in 50-80 %
+   hand lifts. A ring threaded on the finger cannot slip out of a pinch: the clamp below held the scissors in 45-90 %
    of the grasp benchmark's attempts, mostly slipping. Where the finger does not go through, it is pinched instead;
 3. **pinch** — the finger comes out (curled out where the arm rises no higher), and the open hand pinches the
    overhanging ring. A tool whose weight turns it little about the ring (:data:`HINGE_MIN_MOMENT_NM`) is *clamped*:
@@ -105,7 +105,7 @@ APPROACH_OUT_M = 0.07
 GRAVITY = 9.81
 HINGE_MIN_MOMENT_NM = 0.08
 """A tool whose weight pulls this hard (N m) about its ring is hinged, not clamped. The clamp held the closed
-scissors (0.08 kg, 0.03 N m about the ring) in 50-80 % of the grasp benchmark's attempts and the wrench (0.15 kg,
+scissors (0.08 kg, 0.03 N m about the ring) in 45-90 % of the grasp benchmark's attempts and the wrench (0.15 kg,
 0.11 N m) in 0-15 %: its pads resist the tool's turn about the ring by friction over the 7 mm of its thickness. The
 hinge lets the tool turn, and the tool hangs below it."""
 HANG_HEADINGS_DEG = (0.0, 20.0, -20.0, 40.0, -40.0)
