@@ -373,7 +373,7 @@ class RigidPrimitives:
             yield from close_hand(m, self.plan, c.motion)
             self.held = name
             done = yield from m.cartesian(offset, c.motion.lift_m_per_step, True, not planned, partial=planned)
-            lifted = max(done * offset[2], MIN_LIFT_M)  # an edge pinch's lift ends where the arm's reach does
+            lifted = max(done * offset[2], MIN_LIFT_M) if planned else offset[2]  # where the arm's reach ended
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
