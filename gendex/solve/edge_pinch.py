@@ -142,8 +142,9 @@ reaches the middle joint from 1.2 rad on)."""
 HOOK_FLEX_MORE = {"FFJ2": 1.5}
 HOOK_THUMB_MISS_M = 0.01
 """Where the thumb's pad reaches no nearer than this to the ring's centre after :data:`HOOK_FLEX`, the knuckle flexes
-on to :data:`HOOK_FLEX_MORE` (the ring caught nearer the finger's end: the thumb 17-23 mm short of it and, on 1 of 30
-dev seeds, not touching it)."""
+on to :data:`HOOK_FLEX_MORE`. Where the hanging tool leans on the other, curled fingers the knuckle stops short all
+the same (dev seed 785011: 0.78 rad, the thumb 17 mm short, and it held; 785020: 27 mm short, the thumb did not touch
+the ring, and the attempt failed)."""
 HOOK_STEPS = 15
 HOOK_JAM_M = 0.008
 """The finger is jammed in the ring when the ring's centre drops this far while the finger goes down through it (the
