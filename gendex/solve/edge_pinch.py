@@ -583,8 +583,7 @@ class EdgePinch:
         :data:`ARM_MARGIN_M`, the hand's (the last ``n_hand``) by nothing, as in the grasp synthesis."""
         c, r = self.m.collision.sphere_centres(q)
         margin = np.where(np.arange(len(r)) < len(r) - n_hand, ARM_MARGIN_M, 0.0)
-        over = (np.abs(c[:, 0]) < self.half_x + r) & (np.abs(c[:, 1]) < self.edge_y + r)
-        return not np.any(over & (c[:, 2] - r < self.m.env.table_height + margin))
+        return bool(np.all(_table_top_gap(c, r, self.m.env.table_height, self.edge_y, self.half_x) >= margin))
 
     def bring_hand(self, plan: GraspPlan) -> Iterator[np.ndarray]:
         """The open hand to :data:`ABOVE_M` over the pre-grasp pose, then straight down outside the edge to it.
@@ -609,5 +608,11 @@ class _PastEdge(GraspSynthesizer):
         self.edge_y, self.half_x = edge_y, half_x
 
     def table_gap(self, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
-        off = (np.abs(centers[:, 1]) >= self.edge_y + radii) | (np.abs(centers[:, 0]) >= self.half_x + radii)
-        return np.where(off, np.inf, super().table_gap(centers, radii))
+        return _table_top_gap(centers, radii, self.table_z, self.edge_y, self.half_x)
+
+
+def _table_top_gap(centers: np.ndarray, radii: np.ndarray, table_z: float, edge_y: float, half_x: float) -> np.ndarray:
+    """[n] how far each sphere (``centers`` [n, 3], ``radii`` [n]) is above the table top (negative: in it), the top
+    a slab ending at ``|y| = edge_y`` and ``|x| = half_x``: inf for a sphere wholly past an edge."""
+    off = (np.abs(centers[:, 1]) >= edge_y + radii) | (np.abs(centers[:, 0]) >= half_x + radii)
+    return np.where(off, np.inf, centers[:, 2] - radii - table_z)
