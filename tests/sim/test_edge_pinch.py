@@ -3,11 +3,13 @@ the index through the ring or pinched across the overhang (``gendex/solve/edge_p
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.edge_pinch import HOOK_MIN_RADIUS_M, find_ring
+from gendex.solve.edge_pinch import HINGE_OVERHANG_M, HOOK_MIN_RADIUS_M, OVERHANG_M, find_ring
 from gendex.solve.hand import PAD_RADIUS_M
 from gendex.solve.lift_check import LiftChecker, lift_spec
 from gendex.solve.shape import ObjectShape
@@ -91,3 +93,17 @@ def test_the_wrench_is_hinged_across_its_ring_and_hangs_from_the_pads():
     w, x, y, z = q
     long_axis_z = 2 * (x * z - w * y)  # z component of the tool's long (x) axis in the world
     assert abs(long_axis_z) > 0.5, long_axis_z
+
+
+def test_the_wrench_is_dragged_further_past_the_edge_before_the_hinge():
+    """Dev seed 786011: dragged 2 cm past the edge, the wrench twisted out of the hinge while it rose and fell off the
+    table; dragged until its ring is ``HINGE_OVERHANG_M`` past (its centre of mass still ``COM_INSIDE_M`` inside the
+    edge), it is pinched there and held."""
+    checker = LiftChecker("wrench")
+    try:
+        result = checker(786011)
+    finally:
+        checker.close()
+    assert result.held and result.rise_m >= 0.10, result.failure
+    past_mm = int(re.search(r"ring (\d+) mm past the edge", result.grasp).group(1))
+    assert 1000 * OVERHANG_M + 10 <= past_mm <= 1000 * HINGE_OVERHANG_M + 10, result.grasp
