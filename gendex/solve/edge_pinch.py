@@ -99,8 +99,8 @@ moved)."""
 HINGE_OVERHANG_M = 0.04
 """How far past the edge the ring of a tool to be hinged is dragged, unless its centre of mass comes within
 :data:`COM_INSIDE_M` of the edge first. With the ring 2 cm past the edge the pads' pinch often dipped into the table
-or its edge (no candidate clear of it) or the tool went off the table; 4 cm held the wrench in 13 of 20 fresh seeds
-(10220-10239) against 8 of 20 (the same seeds, 2 cm)."""
+or its edge (no candidate clear of it) or the tool went off the table. At 4 cm the wrench held in 23 of 40 fresh
+seeds (10220-10259) against 14 of 40 at 2 cm (the same seeds; ``docs/solving.md``)."""
 COM_INSIDE_M = 0.03
 """The drag stops once the ring is :data:`OVERHANG_M` past the edge and the tool's centre of mass this close to it
 (a tool lying at a slant to the edge)."""
