@@ -266,8 +266,7 @@ class EdgePinch:
         if abs(ring[1]) > self.edge_y and not self.hooks:  # over the edge already (a second try after a slip)
             return
         overhang = HOOK_OVERHANG_M if self.hooks else HINGE_OVERHANG_M
-        com = self._pose(m, self.name).p
-        lead = ring[1] - com[1]
+        lead = ring[1] - self._pose(m, self.name).p[1]  # from the tool's origin
         side = float(np.sign(lead) if abs(lead) > 0.02 else (np.sign(ring[1]) or 1.0))
         goal = np.array([DRAG_AIM_X_M, side * (self.edge_y + 0.06), 0.0])
         d0 = goal - ring
@@ -283,8 +282,8 @@ class EdgePinch:
             ring = self.ring()
             if side * ring[1] > self.edge_y + overhang:
                 break
-            past = side * ring[1] > self.edge_y + OVERHANG_M
-            if past and not self.hooks and side * self._com()[1] > self.edge_y - COM_INSIDE_M:
+            least = side * ring[1] > self.edge_y + OVERHANG_M
+            if least and not self.hooks and side * self._com()[1] > self.edge_y - COM_INSIDE_M:
                 break  # further, and the tool's weight would tip it over the edge
             d = goal - ring
             d[2] = 0.0
