@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -182,8 +182,10 @@ class GraspPlan:
     """Guarded ramps that close the hand, in order: (joint targets, control steps)."""
     note: str = ""
     """What the candidate is (family, heading, width), for logs."""
-    lift: tuple[float, float, float] | None = None
-    """World offset the palm moves by after closing; None: straight up by the motion's ``lift_m``."""
+    lift: Callable[[float], Generator[np.ndarray, None, float]] | None = None
+    """The object's own lift after closing (an edge pinch's: kept whole, unhurried, as far as the arm reaches), given
+    the motion's metres per step: yields joint targets and returns how far the palm rose; None: straight up by the
+    motion's ``lift_m``."""
 
     @property
     def pregrasp(self) -> sapien.Pose:

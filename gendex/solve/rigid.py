@@ -45,15 +45,7 @@ from gendex.solve.grasp import (
     palm_rotation,
     pose_of,
 )
-from gendex.solve.grasp_trial import (
-    GraspMotion,
-    GraspTrials,
-    TrialResult,
-    approach,
-    close_hand,
-    ease_grip,
-    fits_on,
-)
+from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand, ease_grip, fits_on
 from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
@@ -366,14 +358,15 @@ class RigidPrimitives:
         self.placed_on = None
         for attempt in range(c.regrasps + 1):
             z0 = float(self.env.obj(name).pose.p[0, 2])
-            planned = self.plan.lift is not None  # an edge pinch's: kept whole, unhurried, as far as the arm reaches
-            offset = np.array(self.plan.lift if planned else [0.0, 0.0, c.motion.lift_m])
+            planned = self.plan.lift is not None  # the grasp's own lift (an edge pinch's)
+            offset = np.array([0.0, 0.0, c.motion.lift_m])
             if lift_to is not None and not planned:
                 offset[2] = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, offset[2]))
             yield from close_hand(m, self.plan, c.motion)
             self.held = name
-            done = yield from m.cartesian(offset, c.motion.lift_m_per_step, True, not planned, partial=planned)
-            lifted = max(done * offset[2], MIN_LIFT_M) if planned else offset[2]  # where the arm's reach ended
+            done = yield from (self.plan.lift(c.motion.lift_m_per_step) if planned else
+                               m.cartesian(offset, c.motion.lift_m_per_step, True, True))
+            lifted = max(done, MIN_LIFT_M) if planned else offset[2]  # where the arm's reach ended
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))

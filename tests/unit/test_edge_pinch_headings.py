@@ -1,4 +1,4 @@
-"""The hinge's pinch lines across a wrench's ring (``edge_pinch.hinge_headings``): the fixed headings from square to
+"""The hinge's pinch lines across a wrench's ring (``edge_geometry.hinge_headings``): the fixed headings from square to
 the tool, and the line along the table's side edge where the tool lies slanted to it."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gendex.solve.edge_pinch import ALONG_EDGE_MAX_DEG, HANG_HEADINGS_DEG, hinge_headings
+from gendex.solve.edge_geometry import ALONG_EDGE_MAX_DEG, HANG_HEADINGS_DEG, hinge_headings
 
 
 def _line_heading(across: float, deg: float) -> float:

@@ -10,15 +10,17 @@ import numpy as np
 import pytest
 import sapien
 
-from gendex.solve.edge_pinch import ARM_MARGIN_M, EdgePinch, _PastEdge
+from gendex.solve.edge_drag import ARM_MARGIN_M
+from gendex.solve.edge_geometry import PastEdge
+from gendex.solve.edge_pinch import EdgePinch
 from gendex.solve.grasp import GraspPlan, PinchLine
 from gendex.solve.hand import PAD_RADIUS_M
 
 EDGE_Y, HALF_X = 0.6, 0.8
 
 
-def _past_edge() -> _PastEdge:
-    synth = _PastEdge.__new__(_PastEdge)
+def _past_edge() -> PastEdge:
+    synth = PastEdge.__new__(PastEdge)
     synth.table_z, synth.edge_y, synth.half_x = 0.0, EDGE_Y, HALF_X
     return synth
 

@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gendex.solve.edge_pinch import HOOK_JAM_M, HOOK_TIP_Z_M, EdgePinch
+from gendex.solve.edge_drag import HOOK_JAM_M, HOOK_TIP_Z_M
+from gendex.solve.edge_pinch import EdgePinch
 
 RING = np.array([-0.2, 0.62, 0.0035])
 START_Z = 0.004

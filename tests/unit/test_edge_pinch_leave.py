@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gendex.solve.edge_pinch import CURL_INDEX, EdgePinch
+from gendex.solve.edge_drag import CURL_INDEX
+from gendex.solve.edge_pinch import EdgePinch
 
 JOINTS = ["arm0", "FFJ2", "FFJ1", "FFJ0"]
 RING = np.array([-0.2, 0.62, 0.003])

@@ -52,8 +52,12 @@ def _grasp(monkeypatch, lift_m: float | None, reach: float, follows: float) -> R
     prims = RigidPrimitives.__new__(RigidPrimitives)
     prims.m, prims.env, prims.config = _Motion(env, reach, follows), env, RigidConfig(regrasps=0)
     prims.held, prims._require = None, ()
-    lift = None if lift_m is None else (0.0, 0.0, lift_m)
-    prims.plan = GraspPlan("edge", sapien.Pose(), np.array([0.0, 0.0, -1.0]), lift=lift)
+
+    def lift(m_per_step: float):  # an edge grasp's own lift: straight up, as far as the arm reaches
+        done = yield from prims.m.cartesian(np.array([0.0, 0.0, lift_m]), m_per_step, True, partial=True)
+        return done * lift_m
+
+    prims.plan = GraspPlan("edge", sapien.Pose(), np.array([0.0, 0.0, -1.0]), lift=None if lift_m is None else lift)
     monkeypatch.setattr(rigid, "close_hand", lambda m, plan, motion: iter(()))
     monkeypatch.setattr(rigid, "ease_grip", lambda m, require: iter(()))
     list(prims.grasp("tool"))
