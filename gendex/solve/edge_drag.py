@@ -7,12 +7,13 @@ above and push it into the table (``docs/solving.md``). A person slides such a t
 :class:`EdgeDrag` does the same when no grasp of the object held in a physics trial and the object is flat with a
 hole a fingertip fits in (:func:`~gendex.solve.edge_geometry.find_ring`):
 
-1. **turn** — where the index rests wedged on the ring's rim (a hole narrower than the finger's end: the wrench), the
-   tool keeps its heading while it is dragged, and a tool lying slanted to the edge reaches it slanted (its centre of
-   mass near the edge before its ring is far enough past; or lying along it, over the edge whole). The finger goes
-   into the ring with the hand turned back about the vertical, and the hand turns about the finger's end: the wedged
-   finger turns the tool with it, its ring towards the edge (:func:`~gendex.solve.edge_geometry.turn_to_edge`;
-   the turn the arm reaches, :data:`TURN_STEP_RAD` a step, the finger held where it rests);
+1. **turn** — a ring that is not hooked (below) is narrower than the finger's end, and the index rests wedged on its
+   rim (the wrench): the tool keeps its heading while it is dragged, and a tool lying slanted to the edge reaches it
+   slanted (its centre of mass near the edge before its ring is far enough past; or lying along it, over the edge
+   whole). So the finger goes into such a ring with the hand turned back about the vertical, and the hand turns about
+   the finger's end: the wedged finger turns the tool with it, its ring towards the edge
+   (:func:`~gendex.solve.edge_geometry.turn_to_edge`; the turn the arm reaches, :data:`TURN_STEP_RAD` a step, the
+   finger held where it rests);
 2. **drag** — the index fingertip goes down into the ring (fingers pointing down, the index straight and tilted
    :data:`DRAG_TILT_RAD` so its tip trails its knuckle: a finger whose tip leads is lifted out of the ring by the
    wall's reaction), its end pressed lightly on the table (:data:`DRAG_TIP_Z_M`) or, where the hole is narrower than
@@ -267,7 +268,7 @@ class EdgeDrag:
     def _enter_turned(self, rot: np.ndarray, turn: float) -> Generator[np.ndarray, None, tuple[np.ndarray, float]]:
         """The index into the ring with the hand turned ``-turn`` about the vertical from the drag's ``rot`` (less
         where the arm reaches no such pose), then turned back about the finger's end: a finger wedged in the ring
-        turns the tool with it. Returns the palm's turn reached and the height to drag at."""
+        turns the tool with it. Returns the palm's rotation reached and the height to drag at."""
         m = self.m
         z = np.array([0.0, 0.0, 1.0])
         for f in (1.0, 0.75, 0.5, 0.25, 0.0):

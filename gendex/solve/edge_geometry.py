@@ -1,6 +1,6 @@
-"""Geometry of a flat ringed tool at the table's side edge (:mod:`gendex.solve.edge_pinch` moves it): where its
-ring is, which way a finger in the ring turns it before the drag, the pinch lines across the ring, the edge its far
-end stands up on, and the table top that ends at its edges."""
+"""Geometry of a flat ringed tool at the table's side edge (:mod:`gendex.solve.edge_drag` and
+:mod:`gendex.solve.edge_pinch` move it): where its ring is, which way a finger in the ring turns it before the drag, the
+pinch lines across the ring, the edge its far end stands up on, and the table top that ends at its edges."""
 
 from __future__ import annotations
 
