@@ -194,14 +194,10 @@ class EdgePinch(EdgeDrag):
             step = pivot_step(ring, far, self._axis, m_per_step)
             if step is None:
                 break
-            palm = m.ik.fk(m.target())
-            q = m.ik.solve(sapien.Pose(palm.p + step, palm.q), m.target(), restarts=0)
-            if q is None:
+            # one guarded palm step (an arc step's chord is shorter than m_per_step)
+            if (yield from m.cartesian(step, m_per_step, True, partial=True)) < 1.0:
                 log.debug("no IK standing %r up on its far end: it is lifted from here", self.name)
                 break
-            t = m.target()
-            t[m.arm] = q[m.arm]
-            yield m.emit(t, True)
         yield from self._rise(m_per_step, PIVOT_CLEAR_M)
         return float(m.ik.fk(m.target()).p[2]) - z0
 
