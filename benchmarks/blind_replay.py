@@ -19,6 +19,10 @@ import os
 import platform
 import time
 
+# isort: off
+import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads
+# isort: on
+
 import gymnasium as gym
 import numpy as np
 

@@ -36,6 +36,10 @@ from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 
+# isort: off
+import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads
+# isort: on
+
 import gymnasium as gym
 import numpy as np
 

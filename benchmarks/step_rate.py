@@ -24,6 +24,10 @@ import platform
 import statistics
 import time
 
+# isort: off
+import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads
+# isort: on
+
 import gymnasium as gym
 import numpy as np
 import sapien

@@ -6,6 +6,10 @@ version, as ``gym.make`` resolves it) or a version folder."""
 
 from __future__ import annotations
 
+# isort: off
+import gendex_envs.blas  # noqa: F401  (first: it pins OpenBLAS's kernels before anything loads numpy)
+# isort: on
+
 import functools
 import logging
 import time

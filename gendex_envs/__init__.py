@@ -6,8 +6,12 @@ load only when an env is made. Applications (solving, data, training, the genera
 reach it only through its public API.
 """
 
-from gendex_envs.registry import make_env, make_task_env, register_tasks, registered_tasks, resolve_task
-from gendex_envs.task_version import TaskVersion
+from gendex_envs.blas import pin_kernels
+
+pin_kernels()  # before anything below loads numpy
+
+from gendex_envs.registry import make_env, make_task_env, register_tasks, registered_tasks, resolve_task  # noqa: E402
+from gendex_envs.task_version import TaskVersion  # noqa: E402
 
 __all__ = ["TaskVersion", "make_env", "make_task_env", "register_tasks", "registered_tasks", "resolve_task"]
 __version__ = "0.1.0"

@@ -6,6 +6,10 @@ Tests reach committed tasks only through :func:`task_version` (a registered vers
 
 from __future__ import annotations
 
+# isort: off
+import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads; gendex_envs.blas
+# isort: on
+
 import logging
 import os
 import shutil
