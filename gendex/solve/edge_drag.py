@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Generator, Iterator
+from dataclasses import dataclass
 from typing import Self
 
 import numpy as np
@@ -128,13 +129,31 @@ HOOK_LAG_M = 0.02
 on the table's edge after a re-grip: 3 of 60 dev runs)."""
 
 
+@dataclass(frozen=True)
+class EdgeVariant:
+    """Where the drag takes the tool: the edge grasp's physics trials (:mod:`gendex.solve.edge_trial`) try several."""
+
+    other_side: bool = False
+    """To the side edge away from the one the ring leads to (turned up to :data:`~gendex.solve.edge_geometry.
+    TURN_MAX_RAD` first, as any ring that is not hooked)."""
+    aim_x_m: float = DRAG_AIM_X_M
+    """Where along the side edge the ring is dragged to (:data:`DRAG_AIM_X_M`)."""
+    turn: bool = True
+    """A ring that is not hooked is turned towards the edge before the drag (False: dragged as the tool lies)."""
+
+    def __str__(self) -> str:
+        edge = "the side edge away from its ring" if self.other_side else "its ring's side edge"
+        return f"{edge}, x = {self.aim_x_m:+.2f} m{'' if self.turn else ', not turned first'}"
+
+
 class EdgeDrag:
     """The drag of one flat ringed object to the table's side edge, and the hook of a ring the finger passes through
     (see the module docstring); :class:`~gendex.solve.edge_pinch.EdgePinch` adds the pinch."""
 
     def __init__(self, m: ArmHandMotion, hand: HandModel, name: str, ring_in_object: np.ndarray, edge_y: float,
-                 mass_kg: float = 0.0, hole_m: float = 0.0, vertices_in_object: np.ndarray | None = None):
-        self.m, self.hand, self.name, self.mass_kg = m, hand, name, mass_kg
+                 mass_kg: float = 0.0, hole_m: float = 0.0, vertices_in_object: np.ndarray | None = None,
+                 variant: EdgeVariant = EdgeVariant()):
+        self.m, self.hand, self.name, self.mass_kg, self.variant = m, hand, name, mass_kg, variant
         self.ring_local = ring_in_object
         self.verts_local = vertices_in_object
         """[V, 3] the tool's collision vertices in its own frame (where its far end is, as it stands up)."""
@@ -150,15 +169,18 @@ class EdgeDrag:
         """Arm joints over the planned pinch (:meth:`plan`), where :meth:`bring_hand` takes the open hand first."""
 
     @classmethod
-    def of(cls, m: ArmHandMotion, hand: HandModel, name: str, shape: PosedShape) -> Self | None:
-        """The edge grasp of ``name`` (whose posed shape is ``shape``), or None when it is not a flat ringed object."""
+    def of(cls, m: ArmHandMotion, hand: HandModel, name: str, shape: PosedShape, variant: EdgeVariant = EdgeVariant()
+           ) -> Self | None:
+        """The edge grasp of ``name`` (whose posed shape is ``shape``) taken as ``variant`` says, or None when it is
+        not a flat ringed object."""
         ring = find_ring(shape)
         if ring is None:
             return None
         inv = cls._pose(m, name).inv()
         verts = shape.vertices @ inv.to_transformation_matrix()[:3, :3].T + inv.p
         return cls(m, hand, name, (inv * sapien.Pose(ring)).p, float(m.env.task_spec.table.size_m[1]) / 2,
-                   float(px_bodies(m.env.obj(name))[0].mass), float(shape.signed_distance(ring[None])[0]), verts)
+                   float(px_bodies(m.env.obj(name))[0].mass), float(shape.signed_distance(ring[None])[0]), verts,
+                   variant)
 
     @staticmethod
     def _pose(m: ArmHandMotion, name: str) -> sapien.Pose:
@@ -206,12 +228,13 @@ class EdgeDrag:
         ring the finger passes through, dragged :data:`HOOK_OVERHANG_M` past it and hooked (:meth:`_hook`)."""
         m = self.m
         ring = self._ring_on_table()
-        if abs(ring[1]) > self.edge_y and not self.hooks:  # over the edge already (a second try after a slip)
+        if self.past_edge():  # over the edge already (a second try after a slip)
             return
         overhang = HOOK_OVERHANG_M if self.hooks else HINGE_OVERHANG_M
         lead = ring[1] - self._pose(m, self.name).p[1]  # from the tool's origin
         side = float(np.sign(lead) if abs(lead) > 0.02 else (np.sign(ring[1]) or 1.0))
-        goal = np.array([DRAG_AIM_X_M, side * (self.edge_y + 0.06), 0.0])
+        side = -side if self.variant.other_side else side
+        goal = np.array([self.variant.aim_x_m, side * (self.edge_y + 0.06), 0.0])
         d0 = goal - ring
         d0[2] = 0.0
         d0 /= np.linalg.norm(d0)
@@ -219,7 +242,7 @@ class EdgeDrag:
         normal = np.cross(d0, [0.0, 0.0, 1.0])
         normal *= np.sign(normal[0]) or 1.0
         rot = palm_rotation(fingers, normal)
-        turn = 0.0 if self.hooks else turn_to_edge(self.ring(), self._com(), side)
+        turn = turn_to_edge(self.ring(), self._com(), side) if self.variant.turn and not self.hooks else 0.0
         if turn:
             rot, z_drag = yield from self._enter_turned(rot, turn)
         else:
@@ -264,6 +287,10 @@ class EdgeDrag:
             tip = self._tip(m.target())
         if not self.hooked:
             yield from self._leave_ring(rot, tip)
+
+    def past_edge(self) -> bool:
+        """The ring of a tool to be pinched is over a side edge already: there is nothing to drag."""
+        return abs(self._ring_on_table()[1]) > self.edge_y and not self.hooks
 
     def _enter_turned(self, rot: np.ndarray, turn: float) -> Generator[np.ndarray, None, tuple[np.ndarray, float]]:
         """The index into the ring with the hand turned ``-turn`` about the vertical from the drag's ``rot`` (less

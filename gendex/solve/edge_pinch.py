@@ -63,6 +63,9 @@ much straight up: it hangs clear of the table."""
 PIVOT_MAX_STEPS = 120
 PIVOT_UPRIGHT_RAD = np.radians(12.0)
 """The tool stands up until the line from its centre of mass to the ring is this close to vertical."""
+PIVOT_LOST_M = 0.03
+"""The stand-up ends where the ring is this far from where it was in the hand: the pinch lost it (else the hand went
+on round an arc about a tool that stays on the table)."""
 PIVOT_PLAN_STEP_M = 0.03
 """Arc steps of the predicted stand-up along which the plan checks the arm's reach."""
 ABOVE_M = 0.12
@@ -183,8 +186,12 @@ class EdgePinch(EdgeDrag):
         m = self.m
         z0 = float(m.ik.fk(m.target()).p[2])
         toward = self._com()[:2] - self.ring()[:2]
+        held = m.ik.fk(m.qpos()).inv() * sapien.Pose(self.ring())  # the ring in the palm's frame
         for _ in range(PIVOT_MAX_STEPS):
             ring = self.ring()
+            if np.linalg.norm((m.ik.fk(m.qpos()) * held).p - ring) > PIVOT_LOST_M:
+                log.debug("%r's ring is no longer in the pinch: it is not stood up further", self.name)
+                break
             down = ring - self._com()
             if down[2] > np.cos(PIVOT_UPRIGHT_RAD) * np.linalg.norm(down):
                 break  # it stands (about) upright below the ring

@@ -14,12 +14,16 @@ The trial env's own history matters too: a PhysX scene keeps contact caches and 
 (a collection of 204 PutAppleBowl-v1 attempts in one process failed seed 71, which succeeds in a fresh process).
 :meth:`GraspTrials.renew` rebuilds the trial scene; the executor calls it at every episode's start, so an episode's
 trials depend only on that episode.
+
+A grasp that is a whole sequence of its own (a flat ringed tool's, dragged to the table's edge first:
+:mod:`gendex.solve.edge_trial`) is tried whole from where the robot is (:meth:`GraspTrials.rehearse`), each in a
+rebuilt scene.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -137,7 +141,8 @@ def fits_on(held: PosedShape, target: PosedShape) -> Callable[[float], bool]:
 
 @dataclass(frozen=True)
 class TrialResult:
-    plan: GraspPlan
+    plan: GraspPlan | None
+    """The grasp tried (None where a rehearsed grasp, :meth:`GraspTrials.rehearse`, failed before planning it)."""
     held: bool
     rise_m: float
     """How far the object rose by the end of the hold."""
@@ -157,7 +162,8 @@ class TrialResult:
     def __str__(self) -> str:
         verdict = "held" if self.held else f"failed ({self.why})"
         tilt = "" if self.upright else f", footprint spread {self.spread:.2f}x"
-        return f"{self.plan}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps{tilt}"
+        what = self.plan or "a grasp that failed before its plan"
+        return f"{what}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps{tilt}"
 
 
 class GraspTrials:
@@ -232,9 +238,7 @@ class GraspTrials:
             pushed = 0.0
         self.steps += steps
         rise = float(obj.pose.p[0, 2]) - z0
-        forces = sim.hand_forces(name)[0].cpu().numpy()
-        touching = bool(forces[0] > 0.3 and np.any(forces[1:5] > 0.3))
-        speed_now = float(torch.linalg.norm(obj.linear_velocity[0]))
+        touching, speed_now = self._grip(name)
         meets = bool(conditions_hold(sim, tuple(map(with_margin, require)))[0]) if require else True
         held = (not why and rise >= HELD_FRACTION * speed.lift_m and touching and speed_now < STILL_M_PER_S
                 and meets)
@@ -249,6 +253,56 @@ class GraspTrials:
         result = TrialResult(plan, held, rise, touching, speed_now, steps, why, grew)
         log.debug("grasp trial: %s", result)
         return result
+
+    def rehearse(self, main: ArmHandMotion, name: str,
+                 run: Callable[[ArmHandMotion], Generator[np.ndarray, None, tuple[GraspPlan, float]]]) -> TrialResult:
+        """Try a whole grasp of object ``name``, from where the robot is, in a rebuilt scene set to the state of
+        ``main``'s env now (``main``: the solved env's motion; its episode budget and its planner's searches carry
+        over, so that the trial paces and plans as the robot would). ``run(motion)`` yields the grasp's actions and
+        returns its plan and how far the palm rose; a hold of :data:`TRIAL_HOLD_STEPS` follows. It held when the
+        object rose at least half as far as the palm (the executor's own judgement of a grasp's own lift), ends
+        touched by the thumb and a finger, and is not moving."""
+        self.renew()
+        self._fresh_scene()
+        sim, m = self.sim, self.motion
+        sim.set_state(self.main.get_state())
+        left = main.left()
+        m.deadline, m.reserve = (None if left is None else m.steps + left), main.reserve
+        m.planner.follow(main.planner)
+        m.avoid_objects(exclude=(name,))
+        obj = sim.obj(name)
+        z0 = float(obj.pose.p[0, 2])
+        plan, lifted, why, steps, actions = None, 0.0, "", 0, run(m)
+        try:
+            while True:
+                sim.step(torch.as_tensor(next(actions)[None]))
+                steps += 1
+        except StopIteration as done:
+            plan, lifted = done.value
+        except ExecutionError as exc:
+            why = f"{exc.cause}: {exc}"
+        finally:
+            m.deadline, m.reserve = None, 0  # the grasp trials after it are not paced by this episode's budget
+        if not why:
+            for a in m.hold(TRIAL_HOLD_STEPS):
+                sim.step(torch.as_tensor(a[None]))
+                steps += 1
+        self.steps += steps
+        rise = float(obj.pose.p[0, 2]) - z0
+        touching, speed_now = self._grip(name)
+        held = not why and rise >= 0.5 * lifted and touching and speed_now < STILL_M_PER_S
+        if not held and not why:
+            why = (f"rose {rise:.3f} m as the palm rose {lifted:.3f} m" if rise < 0.5 * lifted else
+                   "not touched by the thumb and a finger" if not touching else f"still moving {speed_now:.2f} m/s")
+        result = TrialResult(plan, held, rise, touching, speed_now, steps, why)
+        log.debug("rehearsed grasp: %s", result)
+        return result
+
+    def _grip(self, name: str) -> tuple[bool, float]:
+        """Whether the thumb and at least one finger touch ``name`` in the trial scene, and its speed (m/s)."""
+        forces = self.sim.hand_forces(name)[0].cpu().numpy()
+        speed = float(torch.linalg.norm(self.sim.obj(name).linear_velocity[0]))
+        return bool(forces[0] > 0.3 and np.any(forces[1:5] > 0.3)), speed
 
 
 def _rotation(q: torch.Tensor) -> np.ndarray:

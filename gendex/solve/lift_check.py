@@ -26,6 +26,7 @@ from gendex.solve.executor import StageExecutor
 from gendex.solve.failure import Failure
 from gendex.solve.grasp import hand_fit_scale
 from gendex_envs.errors import ExecutionError
+from gendex_envs.registry import HISTORY_FREE
 from gendex_envs.spec import TaskSpec, parse_task_spec
 
 CENTER_XY_M = (0.10, 0.0)
@@ -69,6 +70,9 @@ class LiftResult:
     """Env steps of the episode (trials excluded)."""
     seconds: float
     failure: Failure | None = None
+    forecast: bool = False
+    """The last physics trial before the robot's grasp held: the grasp it did held in its trial (how often a forecast
+    came true is the benchmark's ``forecast_missed``)."""
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -88,7 +92,15 @@ def fitted_scale(asset: str) -> float:
 
 class LiftChecker:
     """Runs lift-and-hold attempts of one asset, keeping its env and executor between seeds; the asset at
-    ``scale`` (default: :func:`fitted_scale`)."""
+    ``scale`` (default: :func:`fitted_scale`).
+
+    Each attempt runs in a rebuilt scene (:data:`~gendex_envs.registry.HISTORY_FREE`, as collection and evaluation
+    run): a PhysX scene keeps contact caches and solver warm starts across resets, so an attempt in a scene that ran
+    others first depended on them (by 0.1 mm for a mug; for the wrench on seed 10311, a physics trial of its edge grasp
+    held and the robot, doing the same in a scene that had run eight attempts, let it slip), and a benchmark's rows
+    on how its seeds were split among workers. In a scene of its own an attempt depends on its seed alone, and the
+    executor's physics trials, which run in rebuilt scenes too, forecast what the robot then does
+    (:mod:`gendex.solve.edge_trial`)."""
 
     def __init__(self, asset: str, scale: float | None = None):
         from gendex_envs.task_env import TaskEnv
@@ -96,7 +108,7 @@ class LiftChecker:
         self.asset = asset
         self.scale = fitted_scale(asset) if scale is None else scale
         self.env = TaskEnv(task_spec=lift_spec(asset, self.scale), control_mode="pd_joint_pos", control_joint="both",
-                           obs_mode="none", reward_mode="none")
+                           obs_mode="none", reward_mode="none", **HISTORY_FREE)
         self.executor = StageExecutor()
 
     def close(self) -> None:
@@ -131,8 +143,9 @@ class LiftChecker:
             failure = Failure("slipped", "grasp", "grasp", f"rose {rise:.3f} m, thumb/finger contact {touched} after "
                                                            f"the {HOLD_STEPS}-step hold")
         plan = ex.grasp_plan
-        return LiftResult(self.asset, seed, held, rise, str(plan) if plan else "", len(ex.rigid.trial_log), steps,
-                          time.perf_counter() - t0, failure)
+        log = ex.rigid.trial_log
+        return LiftResult(self.asset, seed, held, rise, str(plan) if plan else "", len(log), steps,
+                          time.perf_counter() - t0, failure, bool(log) and log[-1].held)
 
 
 def measured_rates(path: Path = MEASURED_FILE) -> dict[str, float]:

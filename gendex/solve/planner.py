@@ -45,6 +45,11 @@ class ArmPlanner:
         self.seed = int(seed)
         self._searches = 0
 
+    def follow(self, other: ArmPlanner) -> None:
+        """Go on with ``other``'s searches: the next search here is the one ``other`` would run next (a physics trial
+        of what ``other``'s motion is about to do plans the same paths)."""
+        self.seed, self._searches = other.seed, other._searches
+
     def segment_free(self, a: np.ndarray, b: np.ndarray, floor: float = 0.0) -> bool:
         """True when every configuration on the straight joint-space segment a→b (arm entries) is free (its
         clearance at least ``floor``, which a start already in collision lowers to its own)."""

@@ -35,7 +35,9 @@ import numpy as np
 import sapien
 
 from gendex.solve.collision import box_spheres
-from gendex.solve.edge_pinch import EdgePinch
+from gendex.solve.edge_drag import EdgeVariant
+from gendex.solve.edge_geometry import find_ring
+from gendex.solve.edge_trial import EdgeTrials, reach_edge
 from gendex.solve.grasp import (
     PALM_THICKNESS_M,
     RELEASE_HAND,
@@ -281,14 +283,12 @@ class RigidPrimitives:
             try:
                 plan, q_pre = self.choose_grasp(name, require, set_on)
             except ExecutionError as err:  # a flat ringed tool: dragged to the table's edge and pinched there
-                edge = EdgePinch.of(m, self.hand, name, self.shape(name)) if err.cause == "grasp_failed" else None
-                if edge is None:
+                if err.cause != "grasp_failed" or find_ring(self.shape(name)) is None:
                     raise
                 log.info("%s; dragging %r to the table's edge by its ring", err, name)
-                yield from edge.drag()
-                self.plan = edge.plan(self.shape(name))
-                yield from edge.bring_hand(self.plan)
-                yield from approach(m, self.plan, self.config.motion)
+                trials = EdgeTrials(self.trials, self.hand, self._shapes[name]) if self.config.max_trials else None
+                variant = trials.choose(m, name, self.trial_log) if trials else EdgeVariant()
+                self.plan = yield from reach_edge(m, self.hand, name, self._shapes[name], variant, self.config.motion)
                 return
             yield from self._bring_hand(name, plan, q_pre)
             moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
