@@ -12,6 +12,10 @@ Run: ``.venv/bin/python benchmarks/generate.py [--tasks 3] [--seed 0]``.
 
 from __future__ import annotations
 
+# isort: off
+import gendex_envs.blas  # noqa: F401  (first: it pins OpenBLAS's kernels before numpy loads)
+# isort: on
+
 import argparse
 import logging
 import platform

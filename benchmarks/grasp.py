@@ -17,6 +17,10 @@ Run: ``.venv/bin/python benchmarks/grasp.py [--objects apple knife ...] [--seeds
 
 from __future__ import annotations
 
+# isort: off
+import gendex_envs.blas  # noqa: F401  (first: it pins OpenBLAS's kernels before numpy loads)
+# isort: on
+
 import argparse
 import json
 import logging

@@ -11,6 +11,10 @@ Run: ``.venv/bin/python benchmarks/library.py [--attempts 10] [--seed 97000] [--
 
 from __future__ import annotations
 
+# isort: off
+import gendex_envs.blas  # noqa: F401  (first: it pins OpenBLAS's kernels before numpy loads)
+# isort: on
+
 import argparse
 import json
 import logging
