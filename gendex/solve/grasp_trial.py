@@ -217,26 +217,18 @@ class GraspTrials:
         z0 = float(obj.pose.p[0, 2])
         xy0 = obj.pose.p[0, :2].cpu().numpy()
         rot0 = _rotation(obj.pose.q[0])
-        steps = 0
-        why = ""
-
-        def run(actions: Iterator[np.ndarray]) -> None:
-            nonlocal steps
-            for a in actions:
-                sim.step(torch.as_tensor(a[None]))
-                steps += 1
-
+        before, why = self.steps, ""
         try:
-            run(approach(m, plan, speed))
-            run(close_hand(m, plan, speed))
+            self._play(approach(m, plan, speed))
+            self._play(close_hand(m, plan, speed))
             pushed = float(np.linalg.norm(obj.pose.p[0, :2].cpu().numpy() - xy0))
-            run(m.cartesian(np.array([0.0, 0.0, speed.lift_m]), speed.lift_m_per_step, guard=True))
-            run(ease_grip(m, tuple(map(with_margin, require))))  # as the executor's grasp does after its lift
-            run(m.hold(TRIAL_HOLD_STEPS))
+            self._play(m.cartesian(np.array([0.0, 0.0, speed.lift_m]), speed.lift_m_per_step, guard=True))
+            self._play(ease_grip(m, tuple(map(with_margin, require))))  # as the executor's grasp does after its lift
+            self._play(m.hold(TRIAL_HOLD_STEPS))
         except ExecutionError as exc:  # an IK failure mid-motion is a failed trial, not a crash
             why = f"motion failed: {exc}"
             pushed = 0.0
-        self.steps += steps
+        steps = self.steps - before
         rise = float(obj.pose.p[0, 2]) - z0
         touching, speed_now = self._grip(name)
         meets = bool(conditions_hold(sim, tuple(map(with_margin, require)))[0]) if require else True
@@ -272,22 +264,15 @@ class GraspTrials:
         m.avoid_objects(exclude=(name,))
         obj = sim.obj(name)
         z0 = float(obj.pose.p[0, 2])
-        plan, lifted, why, steps, actions = None, 0.0, "", 0, run(m)
+        plan, lifted, why, before = None, 0.0, "", self.steps
         try:
-            while True:
-                sim.step(torch.as_tensor(next(actions)[None]))
-                steps += 1
-        except StopIteration as done:
-            plan, lifted = done.value
+            plan, lifted = self._play(run(m))
+            self._play(m.hold(TRIAL_HOLD_STEPS))
         except ExecutionError as exc:
             why = f"{exc.cause}: {exc}"
         finally:
             m.deadline, m.reserve = None, 0  # the grasp trials after it are not paced by this episode's budget
-        if not why:
-            for a in m.hold(TRIAL_HOLD_STEPS):
-                sim.step(torch.as_tensor(a[None]))
-                steps += 1
-        self.steps += steps
+        steps = self.steps - before
         rise = float(obj.pose.p[0, 2]) - z0
         touching, speed_now = self._grip(name)
         held = not why and rise >= 0.5 * lifted and touching and speed_now < STILL_M_PER_S
@@ -297,6 +282,17 @@ class GraspTrials:
         result = TrialResult(plan, held, rise, touching, speed_now, steps, why)
         log.debug("rehearsed grasp: %s", result)
         return result
+
+    def _play(self, actions: Iterator[np.ndarray]) -> object:
+        """Step the trial scene through ``actions`` (counted in :attr:`steps`, an error's partial run too); returns
+        what the generator returned."""
+        while True:
+            try:
+                action = next(actions)
+            except StopIteration as done:
+                return done.value
+            self.sim.step(torch.as_tensor(action[None]))
+            self.steps += 1
 
     def _grip(self, name: str) -> tuple[bool, float]:
         """Whether the thumb and at least one finger touch ``name`` in the trial scene, and its speed (m/s)."""

@@ -286,8 +286,8 @@ class RigidPrimitives:
                 if err.cause != "grasp_failed" or find_ring(self.shape(name)) is None:
                     raise
                 log.info("%s; dragging %r to the table's edge by its ring", err, name)
-                trials = EdgeTrials(self.trials, self.hand, self._shapes[name]) if self.config.max_trials else None
-                variant = trials.choose(m, name, self.trial_log) if trials else EdgeVariant()
+                variant = (EdgeTrials(self.trials, self.hand, self._shapes[name]).choose(m, name, self.trial_log)
+                           if self.config.max_trials else EdgeVariant())
                 self.plan = yield from reach_edge(m, self.hand, name, self._shapes[name], variant, self.config.motion)
                 return
             yield from self._bring_hand(name, plan, q_pre)
