@@ -47,6 +47,9 @@ EASE_STEPS = 16
 EASE_FRACTION = 0.85
 """Grip easing (:func:`ease_grip`): steps at most, and the part of the finger targets' lead over the measured angles
 kept each step."""
+MIN_LIFT_M = 0.08
+"""The least a grasp lifts its object (a slip shows as the object rising less than half of the lift, or of this when
+the arm's reach cut the lift shorter)."""
 TRIAL_HOLD_STEPS = 20
 """1 s at 20 Hz."""
 HELD_FRACTION = 0.8
@@ -84,6 +87,13 @@ def close_hand(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterato
     closed = plan.closed_hand
     for _ in range(speed.squeeze_steps):
         yield m.emit(m.with_hand(m.target(), closed), guard=True)
+
+
+def rose_with_hand(risen: float, palm_rise: float) -> bool:
+    """A grasp's own lift (an edge grasp's, cut short where the arm's reach ends) kept its object: the object rose
+    ``risen`` (m), at least half as far as the palm did (``palm_rise``), and half of :data:`MIN_LIFT_M` at least
+    (else a lift the arm barely started would pass any object that stayed on the table)."""
+    return risen >= 0.5 * max(palm_rise, MIN_LIFT_M)
 
 
 def approach(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[np.ndarray]:
@@ -252,7 +262,8 @@ class GraspTrials:
         ``main``'s env now (``main``: the solved env's motion; its episode budget and its planner's searches carry
         over, so that the trial paces and plans as the robot would). ``run(motion)`` yields the grasp's actions and
         returns its plan and how far the palm rose; a hold of :data:`TRIAL_HOLD_STEPS` follows. It held when the
-        object rose at least half as far as the palm (the executor's own judgement of a grasp's own lift), ends
+        object rose at least half as far as the palm, and half of :data:`MIN_LIFT_M` at least (the executor's own
+        judgement of a grasp's own lift), ends
         touched by the thumb and a finger, and is not moving."""
         self.renew()
         self._fresh_scene()
@@ -275,7 +286,7 @@ class GraspTrials:
         steps = self.steps - before
         rise = float(obj.pose.p[0, 2]) - z0
         touching, speed_now = self._grip(name)
-        held = not why and rise >= 0.5 * lifted and touching and speed_now < STILL_M_PER_S
+        held = not why and rose_with_hand(rise, lifted) and touching and speed_now < STILL_M_PER_S
         if not held and not why:
             why = (f"rose {rise:.3f} m as the palm rose {lifted:.3f} m" if rise < 0.5 * lifted else
                    "not touched by the thumb and a finger" if not touching else f"still moving {speed_now:.2f} m/s")

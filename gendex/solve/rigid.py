@@ -47,7 +47,17 @@ from gendex.solve.grasp import (
     palm_rotation,
     pose_of,
 )
-from gendex.solve.grasp_trial import GraspMotion, GraspTrials, TrialResult, approach, close_hand, ease_grip, fits_on
+from gendex.solve.grasp_trial import (
+    MIN_LIFT_M,
+    GraspMotion,
+    GraspTrials,
+    TrialResult,
+    approach,
+    close_hand,
+    ease_grip,
+    fits_on,
+    rose_with_hand,
+)
 from gendex.solve.hand import TIP_ALONG_M, HandModel
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
@@ -116,8 +126,6 @@ goal with extra heights, for a collision-free arm pose there."""
 CARRY_M_PER_STEP = 0.012
 CARRY_RAMP_STEPS = 6
 """Palm travel per step of a level (straight, orientation-keeping) carry, reached and left over this many steps."""
-MIN_LIFT_M = 0.08
-"""The least a grasp lifts its object (a slip shows as the object rising less than half of the lift)."""
 SLIP_M = 0.03
 """A held object that drifted more than this from its place in the hand during a carry has slipped."""
 
@@ -357,8 +365,7 @@ class RigidPrimitives:
             raise ExecutionError(f"grasping {name!r} needs a stage that approached it first", cause="unsupported")
         self.placed_on = None
         for attempt in range(c.regrasps + 1):
-            z0 = float(self.env.obj(name).pose.p[0, 2])
-            planned = self.plan.lift is not None  # the grasp's own lift (an edge pinch's)
+            z0, planned = float(self.env.obj(name).pose.p[0, 2]), self.plan.lift is not None  # its own lift (an edge's)
             offset = np.array([0.0, 0.0, c.motion.lift_m])
             if lift_to is not None and not planned:
                 offset[2] = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, offset[2]))
@@ -370,7 +377,7 @@ class RigidPrimitives:
             risen = float(self.env.obj(name).pose.p[0, 2]) - z0
             # an object flung onto something higher (a lemon onto a cutting board) rose but is out of the hand
             touched = int(np.sum(self.env.hand_forces(name)[0].cpu().numpy() > 0.3))
-            if risen >= 0.5 * lifted and touched >= 2:
+            if rose_with_hand(risen, lifted) and touched >= 2:
                 yield from ease_grip(m, self._require)
                 return
             self.held = None

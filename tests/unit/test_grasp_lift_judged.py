@@ -14,6 +14,7 @@ import torch
 
 import gendex.solve.rigid as rigid
 from gendex.solve.grasp import GraspPlan
+from gendex.solve.grasp_trial import rose_with_hand
 from gendex.solve.rigid import MIN_LIFT_M, RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 
@@ -90,3 +91,11 @@ def test_a_full_lift_is_judged_as_before(monkeypatch):
     with pytest.raises(ExecutionError) as err:
         _grasp(monkeypatch, lift_m=None, reach=1.0, follows=0.45)
     assert f"of {config_lift:.3f} m" in str(err.value)
+
+
+def test_a_rehearsed_edge_grasp_is_judged_as_the_executor_judges_it():
+    # the physics trials' rehearsal of an edge grasp and the executor share one judgement, floor included: a tool
+    # that stayed on the table while the arm barely rose did not come up with the hand
+    assert rose_with_hand(0.045, 0.09) and not rose_with_hand(0.04, 0.09)
+    assert not rose_with_hand(0.015, 0.02)  # with the palm: 1.5 of 2 cm; but not half of MIN_LIFT_M
+    assert rose_with_hand(0.5 * MIN_LIFT_M, 0.0)
