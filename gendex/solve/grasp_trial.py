@@ -262,8 +262,7 @@ class GraspTrials:
         ``main``'s env now (``main``: the solved env's motion; its episode budget and its planner's searches carry
         over, so that the trial paces and plans as the robot would). ``run(motion)`` yields the grasp's actions and
         returns its plan and how far the palm rose; a hold of :data:`TRIAL_HOLD_STEPS` follows. It held when the
-        object rose at least half as far as the palm, and half of :data:`MIN_LIFT_M` at least (the executor's own
-        judgement of a grasp's own lift), ends
+        object rose with the hand (:func:`rose_with_hand`, the executor's own judgement of a grasp's own lift), ends
         touched by the thumb and a finger, and is not moving."""
         self.renew()
         self._fresh_scene()
@@ -288,7 +287,7 @@ class GraspTrials:
         touching, speed_now = self._grip(name)
         held = not why and rose_with_hand(rise, lifted) and touching and speed_now < STILL_M_PER_S
         if not held and not why:
-            why = (f"rose {rise:.3f} m as the palm rose {lifted:.3f} m" if rise < 0.5 * lifted else
+            why = (f"rose {rise:.3f} m as the palm rose {lifted:.3f} m" if not rose_with_hand(rise, lifted) else
                    "not touched by the thumb and a finger" if not touching else f"still moving {speed_now:.2f} m/s")
         result = TrialResult(plan, held, rise, touching, speed_now, steps, why)
         log.debug("rehearsed grasp: %s", result)

@@ -365,7 +365,7 @@ class RigidPrimitives:
             raise ExecutionError(f"grasping {name!r} needs a stage that approached it first", cause="unsupported")
         self.placed_on = None
         for attempt in range(c.regrasps + 1):
-            z0, planned = float(self.env.obj(name).pose.p[0, 2]), self.plan.lift is not None  # its own lift (an edge's)
+            z0, planned = float(self.env.obj(name).pose.p[0, 2]), self.plan.lift is not None  # planned: an edge grasp's
             offset = np.array([0.0, 0.0, c.motion.lift_m])
             if lift_to is not None and not planned:
                 offset[2] = float(np.clip(lift_to - m.world_aabb(name)[0][2], MIN_LIFT_M, offset[2]))
