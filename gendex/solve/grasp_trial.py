@@ -63,6 +63,11 @@ UPRIGHT_SPREAD = 1.25
 hand: unless it still fits what it is set down in or on next (:func:`fits_on`), a poor grasp for that
 (:meth:`GraspTrials.trial`'s caller prefers one that keeps it upright)."""
 
+SHOVED_M = 0.03
+"""A held trial whose closing hand pushed the object further than this across the table held on the edge of holding:
+the robot's own approach, not the trial's teleport to the pre-grasp pose, may push it out of reach (a Rubik's cube's
+top grasps pushed it 1-4 cm; :attr:`TrialResult.shoved`; the caller keeps such a grasp as a fallback)."""
+
 FIT_FRACTION = 0.8
 """A held object fits what it is set down in or on when its footprint's diagonal is at most this fraction of that
 object's narrower side (:func:`fits_on`; the rest is the container's wall and the carry's aim)."""
@@ -78,6 +83,11 @@ class GraspMotion:
     """The grasp primitive lifts this far right after closing (and checks that the object came along)."""
     lift_m_per_step: float = 0.006
     settle_steps: int = 2
+    rest_rad_s: float = 0.05
+    """The approach starts once no arm joint turns faster than this (a trial starts at rest; an arm that arrives
+    still swinging at 0.5 rad/s pushed a Rubik's cube out of a top grasp that held in its trial)..."""
+    rest_steps: int = 10
+    """...or after this many steps."""
 
 
 def close_hand(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[np.ndarray]:
@@ -97,7 +107,9 @@ def rose_with_hand(risen: float, palm_rise: float) -> bool:
 
 
 def approach(m: ArmHandMotion, plan: GraspPlan, speed: GraspMotion) -> Iterator[np.ndarray]:
-    """The straight move from the pre-grasp pose to the grasp pose, then a short settle."""
+    """From rest (:attr:`GraspMotion.rest_rad_s`), the straight move from the pre-grasp pose to the grasp pose,
+    then a short settle."""
+    yield from m.come_to_rest(speed.rest_rad_s, speed.rest_steps)
     yield from m.cartesian(plan.palm.p - plan.pregrasp.p, speed.approach_m_per_step)
     yield from m.hold(speed.settle_steps)
 
@@ -163,6 +175,13 @@ class TrialResult:
     why: str = ""
     spread: float = 1.0
     """How much the object's footprint grew by the end of the hold (:func:`spread`; 1.0 when not measured)."""
+    pushed_m: float = 0.0
+    """How far the closing hand pushed the object across the table (0.0 when not measured)."""
+
+    @property
+    def shoved(self) -> bool:
+        """The closing hand pushed the object further than :data:`SHOVED_M`."""
+        return self.pushed_m > SHOVED_M
 
     @property
     def upright(self) -> bool:
@@ -172,6 +191,7 @@ class TrialResult:
     def __str__(self) -> str:
         verdict = "held" if self.held else f"failed ({self.why})"
         tilt = "" if self.upright else f", footprint spread {self.spread:.2f}x"
+        tilt += f", pushed {self.pushed_m:.3f} m while closing" if self.shoved and self.held else ""
         what = self.plan or "a grasp that failed before its plan"
         return f"{what}: {verdict}, rose {self.rise_m:.3f} m in {self.steps} steps{tilt}"
 
@@ -252,7 +272,7 @@ class GraspTrials:
             if pushed > 0.02:
                 why += f", pushed {pushed:.3f} m while closing"
         grew = 1.0 if shape is None else spread(shape, rot0, _rotation(obj.pose.q[0]))
-        result = TrialResult(plan, held, rise, touching, speed_now, steps, why, grew)
+        result = TrialResult(plan, held, rise, touching, speed_now, steps, why, grew, pushed)
         log.debug("grasp trial: %s", result)
         return result
 

@@ -120,6 +120,13 @@ class ArmHandMotion:
     def settle(self) -> Iterator[np.ndarray]:
         yield from self.hold(self.settle_steps)
 
+    def come_to_rest(self, max_rad_s: float, max_steps: int) -> Iterator[np.ndarray]:
+        """Targets held until no arm joint turns faster than ``max_rad_s`` (at most ``max_steps`` steps)."""
+        for _ in range(max_steps):
+            if float(np.abs(self.env.agent.robot.get_qvel()[0].cpu().numpy()[self.arm]).max()) < max_rad_s:
+                return
+            yield self.emit(self.target())
+
     def ramp(self, goal: np.ndarray, steps: int, guard: bool = False) -> Iterator[np.ndarray]:
         """Targets moving linearly from the current ones to ``goal`` over ``steps`` steps."""
         start = self.target()

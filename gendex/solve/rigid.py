@@ -221,10 +221,10 @@ class RigidPrimitives:
     def choose_grasp(self, name: str, require: tuple[ConditionSpec, ...] = (), set_on: str | None = None
                      ) -> tuple[GraspPlan, np.ndarray]:
         """The first reachable grasp of ``name`` that holds in a trial (meeting the ``grasped`` conditions
-        ``require`` as well), and its pre-grasp joint vector. ``set_on``: the object ``name`` is set down in or on
-        next; a grasp that let ``name`` swing over so far that its footprint no longer fits ``set_on``'s
-        (:func:`~gendex.solve.grasp_trial.fits_on`) is kept only as a fallback while the trials last (the least
-        swung one): a tilted object catches a container's rim, or lands on its side and topples off a board."""
+        ``require`` as well), and its pre-grasp joint vector. Fallbacks while the trials last: one whose closing pushed
+        ``name`` (:attr:`~gendex.solve.grasp_trial.TrialResult.shoved`, the least pushed first), then one that swung
+        it over past fitting ``set_on`` (:func:`~gendex.solve.grasp_trial.fits_on`; the least swung), what it is set
+        down in or on next: a tilted object catches a container's rim, or lands on its side and topples off a board."""
         m, c, env = self.m, self.config, self.env
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
@@ -234,7 +234,7 @@ class RigidPrimitives:
         m.avoid_objects(exclude=(name,))
         q0 = m.target()
         reachable, results, helped_trials = 0, [], 0
-        swung: list[tuple[TrialResult, np.ndarray]] = []
+        fallback: list[tuple[tuple[bool, float], TrialResult, np.ndarray]] = []  # (rank, trial, pre-grasp)
         shape_now = self._shapes[name] if set_on is not None else None
         fits = fits_on(shape, self.shape(set_on)) if set_on is not None else None
 
@@ -244,11 +244,11 @@ class RigidPrimitives:
             results.append(result)
             self.trial_log.append(result)
             fitting = fits is None or result.upright or fits(result.spread)
-            if result.held and not fitting:
-                swung.append((result, q))
+            if result.held and not (fitting and not result.shoved):
+                fallback.append(((not fitting, result.pushed_m if fitting else result.spread), result, q))
             elif result.held:
                 log.info("grasp of %r: %s (trial %d)", name, plan, len(results))
-            return result.held and fitting
+            return result.held and fitting and not result.shoved
 
         budget = max(c.max_trials, c.thin_trials) if c.max_trials and "tip" in synth.families() else c.max_trials
         for plan in synth.candidates():
@@ -271,9 +271,9 @@ class RigidPrimitives:
                     return helped, q_helped
             if len(results) - helped_trials >= budget:
                 break
-        if swung:
-            result, q = min(swung, key=lambda rq: rq[0].spread)
-            log.info("grasp of %r: %s (no trial kept it upright enough to fit %r)", name, result, set_on)
+        if fallback:
+            _, result, q = min(fallback, key=lambda f: f[0])
+            log.info("grasp of %r: %s (a fallback: every trial that held pushed it or swung it over)", name, result)
             return result.plan, q
         if not reachable:
             raise ExecutionError(f"no grasp of {name!r} that the arm reaches without collision (families "
