@@ -30,7 +30,7 @@ import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 from gendex_envs.errors import ExecutionError
 
-TASKS = ("GenDex/OpenCabinet-v1", "GenDex/PickUpBottle-v2", "GenDex/PutAppleBowl-v1")
+TASKS = ("GenDex/OpenCabinet-v2", "GenDex/PickUpBottle-v2", "GenDex/PutAppleBowl-v1")
 
 
 def _success(info: dict) -> bool:
