@@ -11,7 +11,10 @@ Per task, in one run:
 
 The issue's targets: (a) >= 95 %, (b) <= 1 M env steps per 1000 successes.
 
-Run: ``.venv/bin/python benchmarks/collect.py [--tasks GenDex/PutAppleBowl-v0 ...] [--episodes 50]``.
+Without ``--tasks`` it measures the newest registered version of each reference task (``REFERENCE_TASKS``), so the
+default follows the tasks as they gain versions.
+
+Run: ``.venv/bin/python benchmarks/collect.py [--tasks GenDex/PutAppleBowl-v1 ...] [--episodes 50] [--seed S]``.
 """
 
 from __future__ import annotations
@@ -28,7 +31,16 @@ import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex.data.collector import CollectConfig, collect
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 
-TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
+REFERENCE_TASKS = ("OpenCabinet", "PickUpBottle", "PutAppleBowl")
+
+
+def newest_reference_ids() -> list[str]:
+    """The env id of the highest registered version of each reference task."""
+    from gendex_envs.registry import registered_tasks
+    from generator.stats import latest_versions
+
+    newest = {v.name: env_id for env_id, v in latest_versions(registered_tasks()).items()}
+    return [newest[name] for name in REFERENCE_TASKS]
 
 
 def run(task: str, n: int, seed: int, workers: int, formats: tuple[str, ...] = ("h5",)):
@@ -42,7 +54,7 @@ def run(task: str, n: int, seed: int, workers: int, formats: tuple[str, ...] = (
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--tasks", nargs="+", default=list(TASKS))
+    ap.add_argument("--tasks", nargs="+", help="env ids (default: the newest version of each reference task)")
     ap.add_argument("--episodes", type=int, default=50)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers-trial", type=int, default=60, help="attempts per worker-count timing (0: skip)")
@@ -50,7 +62,7 @@ def main() -> None:
     logging.basicConfig(level=logging.ERROR)
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs")
     rows = []
-    for task in args.tasks:
+    for task in args.tasks or newest_reference_ids():
         state, secs = run(task, args.episodes, args.seed, workers=1)
         rate = state.successes / state.attempts if state.attempts else 0.0
         per = state.env_steps_per_success

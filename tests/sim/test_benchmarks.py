@@ -28,6 +28,23 @@ def test_collect_benchmark_reports_success_rate_and_steps_per_success(repo_root)
     assert int(m.group(1)) == 3 and 0 < float(m.group(2)) < 200, out.stdout
 
 
+def test_collect_benchmark_defaults_to_the_newest_reference_versions(repo_root):
+    import importlib.util
+
+    from gendex_envs.registry import registered_tasks
+
+    spec = importlib.util.spec_from_file_location("collect_bench", repo_root / "benchmarks" / "collect.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    ids = bench.newest_reference_ids()
+    versions = registered_tasks()
+    assert [versions[i].name for i in ids] == list(bench.REFERENCE_TASKS)
+    for env_id in ids:
+        mine = versions[env_id]
+        assert all(v.version <= mine.version for v in versions.values() if v.name == mine.name), env_id
+    assert "GenDex/PickUpBottle-v0" not in ids  # v1 and v2 exist
+
+
 def test_blind_replay_benchmark_replays_a_recorded_success_open_loop(repo_root):
     """On the seed it was recorded on, a replayed success succeeds again: the replay is exact, so what the benchmark
     reports on new seeds is the randomization's doing."""
