@@ -99,10 +99,13 @@ class ArmPlanner:
         except ImportError as e:  # pragma: no cover - ompl is a dependency
             raise PlanningError("the straight motion is blocked and OMPL is not importable "
                                 "(pip install ompl)") from e
-        ou.setLogLevel(ou.LOG_WARN)
         # OMPL seeds every RNG it creates from one global generator: reset it before each search, from the
-        # planner's seed and the search's rank in the episode, so the search does not depend on earlier ones
+        # planner's seed and the search's rank in the episode, so the search does not depend on earlier ones.
+        # OMPL logs that reset as an error once any RNG exists ("changing seed now will not lead to deterministic
+        # sampling"): true of RNGs made before it, but each search makes its own after it, so it is silenced
+        ou.setLogLevel(ou.LOG_NONE)
         ou.RNG.setSeed((self.seed * 7919 + self._searches) % (2**31 - 1) + 1)
+        ou.setLogLevel(ou.LOG_WARN)
         self._searches += 1
         arm = self.ik.arm
         lo, hi = self.ik.limits[arm, 0], self.ik.limits[arm, 1]
