@@ -204,7 +204,7 @@ class GraspTrials:
 
         self.main = env
         kwargs = dict(control_mode="pd_joint_pos", control_joint="both", obs_mode="none", reward_mode="none",
-                      sim_backend="physx_cpu", render_mode=None, num_envs=1)
+                      sim_backend="physx_cpu", render_mode=None, render_backend="none", num_envs=1)
         if env.task is not None:
             self.sim = TaskEnv(task=env.task, **kwargs)
         else:

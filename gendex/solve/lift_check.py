@@ -108,7 +108,7 @@ class LiftChecker:
         self.asset = asset
         self.scale = fitted_scale(asset) if scale is None else scale
         self.env = TaskEnv(task_spec=lift_spec(asset, self.scale), control_mode="pd_joint_pos", control_joint="both",
-                           obs_mode="none", reward_mode="none", **HISTORY_FREE)
+                           obs_mode="none", reward_mode="none", render_backend="none", **HISTORY_FREE)
         self.executor = StageExecutor()
 
     def close(self) -> None:
