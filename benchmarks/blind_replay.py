@@ -29,8 +29,7 @@ import numpy as np
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 from gendex_envs.errors import ExecutionError
-
-TASKS = ("GenDex/OpenCabinet-v2", "GenDex/PickUpBottle-v2", "GenDex/PutAppleBowl-v1")
+from gendex_envs.registry import REFERENCE_TASKS, resolve_task
 
 
 def _success(info: dict) -> bool:
@@ -72,7 +71,7 @@ def replay(env: gym.Env, seed: int, actions: np.ndarray) -> bool:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--tasks", nargs="+", default=list(TASKS))
+    ap.add_argument("--tasks", nargs="+", help="env ids (default: the newest version of each reference task)")
     ap.add_argument("--source-seed", type=int, default=0, help="first seed tried for the recorded success")
     ap.add_argument("--seeds", type=int, default=20, help="new seeds to replay on")
     ap.add_argument("--seed", type=int, default=9000, help="first new seed")
@@ -82,7 +81,7 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs; seeds "
           f"{args.seed}..{args.seed + args.seeds - 1}")
     worst = 0.0
-    for task in args.tasks:
+    for task in args.tasks or [resolve_task(name).env_id for name in REFERENCE_TASKS]:
         t0 = time.perf_counter()
         env = gym.make(task, **SOLVER_ENV_KWARGS["stages"])
         source, actions = args.source_seed, None

@@ -30,17 +30,12 @@ from pathlib import Path
 import gendex_envs  # noqa: F401  (registers the GenDex/* ids)
 from gendex.data.collector import CollectConfig, collect
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
-
-REFERENCE_TASKS = ("OpenCabinet", "PickUpBottle", "PutAppleBowl")
+from gendex_envs.registry import REFERENCE_TASKS, resolve_task
 
 
 def newest_reference_ids() -> list[str]:
     """The env id of the highest registered version of each reference task."""
-    from gendex_envs.registry import registered_tasks
-    from generator.stats import latest_versions
-
-    newest = {v.name: env_id for env_id, v in latest_versions(registered_tasks()).items()}
-    return [newest[name] for name in REFERENCE_TASKS]
+    return [resolve_task(name).env_id for name in REFERENCE_TASKS]
 
 
 def run(task: str, n: int, seed: int, workers: int, formats: tuple[str, ...] = ("h5",)):

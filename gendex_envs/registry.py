@@ -103,6 +103,10 @@ def registered_tasks() -> dict[str, TaskVersion]:
     return dict(_REGISTERED)
 
 
+REFERENCE_TASKS = ("OpenCabinet", "PickUpBottle", "PutAppleBowl")
+"""The GenDexHand paper's three reference tasks, by name: :func:`resolve_task` gives each one's highest version."""
+
+
 def resolve_task(task: str | Path) -> TaskVersion:
     """The task version named by ``task``: a registered id (``GenDex/PutAppleBowl-v0``), an unversioned name
     (``GenDex/PutAppleBowl`` or ``PutAppleBowl``: the highest registered version, as ``gym.make`` picks it), or a

@@ -97,10 +97,15 @@ def _pan(apple_env):
     return ik, model, planner, q0, q1, mid
 
 
+def _pillar_at(model, q):
+    """A 16 cm box around the wrist of arm configuration ``q``: the only obstacle."""
+    wrist = model.sphere_centres(q)[0][-1]
+    model.set_obstacles([Box(wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08], "pillar")])
+
+
 def test_planner_goes_around_an_obstacle_the_straight_motion_hits(apple_env):
     ik, model, planner, q0, q1, mid = _pan(apple_env)
-    wrist = model.sphere_centres(mid)[0][-1]
-    model.set_obstacles([Box(wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08], "pillar")])
+    _pillar_at(model, mid)
     assert model.is_free(q0) and model.is_free(q1)
     assert not planner.segment_free(q0, q1)
     path = planner.plan(q0, q1)
@@ -117,8 +122,7 @@ def test_a_search_depends_only_on_its_seed_and_says_nothing_about_reseeding(appl
     """Each search reseeds OMPL's global seed generator; OMPL logs that as an error once any RNG exists. The
     searches it then makes are the same for the same seed, so the log line is noise and must not reach the user."""
     ik, model, planner, q0, q1, mid = _pan(apple_env)
-    wrist = model.sphere_centres(mid)[0][-1]
-    model.set_obstacles([Box(wrist - [0.08, 0.08, 0.08], wrist + [0.08, 0.08, 0.08], "pillar")])
+    _pillar_at(model, mid)
     paths = []
     for _ in range(2):
         planner.reseed(11)
