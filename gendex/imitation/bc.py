@@ -11,6 +11,12 @@ smooth where consecutive predictions disagree.
 A checkpoint (``bc.pt``) holds the weights, the normalization, the feature names it was trained on, the dataset's
 task id, ``gym.make`` keyword arguments and the reset seeds of the episodes it learned from (an evaluation refuses
 seeds a policy was trained on).
+
+A checkpoint may come from anyone, so it holds only tensors and JSON values (str, int, float, bool, None, lists and
+dicts of them) and is read with ``torch.load(weights_only=True)``: nothing in it can run code. The network is the
+known MLP :func:`_mlp` built from the checkpoint's bounded ``config``, and its weights load strictly. Checkpoints of
+``CHECKPOINT_FORMAT`` 1 (numpy arrays, which need pickle) are refused with :class:`~gendex_envs.errors.PolicyError`;
+:func:`resave_trusted_checkpoint` converts one the user trusts.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ from gymnasium.envs.registration import parse_env_id
 from torch import nn
 
 from gendex.imitation.frames import DatasetReadError, Frames, lerobot_root, load_frames
-from gendex_envs.errors import GenDexError
+from gendex_envs.errors import GenDexError, PolicyError
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 
 log = logging.getLogger(__name__)
@@ -45,6 +51,12 @@ def _task_name(env_id: str) -> str:
     return f"{ns}/{name}" if ns else name
 
 CHECKPOINT = "bc.pt"
+CHECKPOINT_FORMAT = 2
+"""2: tensors and JSON values only (``weights_only``); 1 (no ``format`` key): numpy arrays, pickled."""
+MAX_CHECKPOINT_BYTES = 512_000_000
+"""A checkpoint file (the default 3 x 512 MLP is about 4 MB)."""
+MAX_HIDDEN, MAX_LAYERS, MAX_CHUNK, MAX_FEATURES = 8192, 16, 1000, 100_000
+"""Bounds of a checkpoint's ``config`` and input/action sizes, checked before a network is built."""
 STEP_SCALE = 200.0
 """The step-count input is ``step / STEP_SCALE``."""
 
@@ -153,18 +165,124 @@ def _train(frames: Frames, meta: dict, dataset: Path, out: Path, config: BCConfi
             progress(step + 1, loss_avg)
     out.mkdir(parents=True, exist_ok=True)
     seeds = meta.get("episode_seeds", [])[:frames.episodes]
-    ckpt = {"model": model.state_dict(), "config": asdict(config), "x_mean": xn.mean, "x_std": xn.std,
-            "a_mean": yn.mean, "a_std": yn.std, "names": frames.names, "task_id": meta["task_id"],
-            "env_kwargs": meta["env_kwargs"], "training_seeds": seeds, "demos": frames.episodes,
-            "frames": len(x), "dataset": str(dataset), "final_loss": loss_avg,
+    norm = {"x_mean": xn.mean, "x_std": xn.std, "a_mean": yn.mean, "a_std": yn.std}
+    info = {"config": asdict(config), "names": frames.names, "task_id": meta["task_id"],
+            "env_kwargs": meta["env_kwargs"], "training_seeds": [int(s) for s in seeds], "demos": int(frames.episodes),
+            "frames": len(x), "dataset": str(dataset), "final_loss": None if loss_avg is None else float(loss_avg),
             "seconds": round(time.perf_counter() - t0, 1)}
     path = out / CHECKPOINT
-    torch.save(ckpt, path)
-    (out / "bc.json").write_text(json.dumps({k: v for k, v in ckpt.items() if k not in
-                                             ("model", "x_mean", "x_std", "a_mean", "a_std")}, indent=1) + "\n")
+    save_checkpoint(path, model.state_dict(), norm, info)
+    (out / "bc.json").write_text(json.dumps(info, indent=1) + "\n")
     log.info("trained BC on %d demos (%d frames) of %s in %.0f s, loss %.4f -> %s", frames.episodes, len(x),
-             meta["task_id"], ckpt["seconds"], loss_avg, path)
+             meta["task_id"], info["seconds"], loss_avg, path)
     return path
+
+
+_NORMS = ("x_mean", "x_std", "a_mean", "a_std")
+_INFO = ("config", "names", "task_id", "env_kwargs", "training_seeds", "demos", "frames", "dataset", "final_loss",
+         "seconds")
+
+
+def _json_safe(value) -> bool:
+    """Only str/int/float/bool/None and lists/dicts (str keys) of them: what ``weights_only`` needs no pickle for."""
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, dict):
+            if not all(isinstance(k, str) for k in v):
+                return False
+            stack.extend(v.values())
+        elif isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif not (v is None or type(v) in (str, int, float, bool)):
+            return False
+    return True
+
+
+def save_checkpoint(path: Path | str, weights: dict, norm: dict, info: dict) -> Path:
+    """Write a checkpoint of :data:`CHECKPOINT_FORMAT` (tensors and JSON values only, module doc)."""
+    if not _json_safe(info):
+        raise PolicyError(f"{path}: a BC checkpoint's metadata must be JSON values (str, int, float, lists, dicts)")
+    ckpt = {"format": CHECKPOINT_FORMAT, "model": {k: v.detach().cpu() for k, v in weights.items()},
+            **{k: torch.as_tensor(np.asarray(norm[k], np.float32)) for k in _NORMS}, **info}
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    torch.save(ckpt, tmp)
+    tmp.replace(path)
+    return path
+
+
+def _bad(path, problem: str) -> PolicyError:
+    return PolicyError(f"BC checkpoint {path}: {problem}")
+
+
+def load_checkpoint(path: Path | str) -> dict:
+    """A checkpoint read with ``torch.load(weights_only=True)`` and checked (module doc): the normalization as
+    float32 numpy arrays, the weights as tensors. :class:`PolicyError` naming the file when it needs pickle, is
+    malformed, out of bounds or not finite."""
+    path = Path(path)
+    if not path.is_file():
+        raise _bad(path, "no such file")
+    size = path.stat().st_size
+    if size > MAX_CHECKPOINT_BYTES:
+        raise _bad(path, f"{size} bytes; at most MAX_CHECKPOINT_BYTES = {MAX_CHECKPOINT_BYTES} are allowed")
+    try:
+        ckpt = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:
+        text = str(exc).strip().splitlines()
+        raise _bad(path, f"it holds objects that only pickle can load, which can run code from the file "
+                         f"({type(exc).__name__}: {(text[-1] if text else '')[:300]}). GenDex loads checkpoints "
+                         f"of format {CHECKPOINT_FORMAT} (tensors and JSON values); retrain with `gendex bc train`, "
+                         "or, only if you trust the file, convert it with "
+                         "gendex.imitation.bc.resave_trusted_checkpoint(PATH)") from None
+    if not isinstance(ckpt, dict) or ckpt.get("format") != CHECKPOINT_FORMAT:
+        found = ckpt.get("format") if isinstance(ckpt, dict) else type(ckpt).__name__
+        raise _bad(path, f"format {found!r}; this GenDex reads format {CHECKPOINT_FORMAT}")
+    missing = [k for k in ("model", *_NORMS, *_INFO) if k not in ckpt]
+    if missing:
+        raise _bad(path, f"missing {missing}")
+    if not _json_safe({k: ckpt[k] for k in _INFO}):
+        raise _bad(path, f"{list(_INFO)} must be JSON values")
+    weights = ckpt["model"]
+    if not isinstance(weights, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
+                                                and v.is_floating_point() and bool(torch.isfinite(v).all())
+                                                for k, v in weights.items()):
+        raise _bad(path, "model must map names to finite floating-point tensors")
+    for k in _NORMS:
+        v = ckpt[k]
+        if not isinstance(v, torch.Tensor) or v.ndim != 1 or not 0 < len(v) <= MAX_FEATURES \
+                or not v.is_floating_point() or not bool(torch.isfinite(v).all()):
+            raise _bad(path, f"{k} must be a 1-D finite float tensor of 1 to MAX_FEATURES = {MAX_FEATURES} values")
+        ckpt[k] = v.numpy().astype(np.float32)
+    if len(ckpt["x_std"]) != len(ckpt["x_mean"]) or len(ckpt["a_std"]) != len(ckpt["a_mean"]) \
+            or (ckpt["x_std"] <= 0).any() or (ckpt["a_std"] <= 0).any():
+        raise _bad(path, "x_std and a_std must match their means in length and be > 0")
+    cfg = ckpt["config"]
+    bounds = {"chunk": MAX_CHUNK, "hidden": MAX_HIDDEN, "layers": MAX_LAYERS}
+    for key, bound in bounds.items():
+        value = cfg.get(key) if isinstance(cfg, dict) else None
+        if type(value) is not int or not 1 <= value <= bound:
+            raise _bad(path, f"config.{key} {value!r} must be an integer from 1 to {bound}")
+    decay = cfg.get("ensemble_decay")
+    if type(decay) not in (int, float) or not 0 <= decay <= 100:
+        raise _bad(path, f"config.ensemble_decay {decay!r} must be a number from 0 to 100")
+    if not isinstance(ckpt["task_id"], str) or not isinstance(ckpt["env_kwargs"], dict) \
+            or not all(type(s) is int for s in ckpt["training_seeds"]):
+        raise _bad(path, "task_id must be a string, env_kwargs a mapping and training_seeds integers")
+    return ckpt
+
+
+def resave_trusted_checkpoint(path: Path | str, out: Path | str | None = None) -> Path:
+    """Convert a format-1 checkpoint (numpy arrays) to the current format. It unpickles the file, which runs any
+    code in it: call it only on a file you made yourself or trust like your own code."""
+    old = torch.load(Path(path), map_location="cpu", weights_only=False)
+    info = {k: old[k] for k in _INFO}
+    info["training_seeds"] = [int(s) for s in info["training_seeds"]]
+    info["final_loss"] = None if info["final_loss"] is None else float(info["final_loss"])
+    for k in ("demos", "frames"):
+        info[k] = int(info[k])
+    return save_checkpoint(Path(out) if out is not None else Path(path), old["model"],
+                           {k: old[k] for k in _NORMS}, info)
 
 
 @dataclass
@@ -175,12 +293,15 @@ class BCPolicy:
     ckpt: dict = field(init=False, repr=False)
 
     def __post_init__(self):
-        self.ckpt = torch.load(Path(self.path), map_location="cpu", weights_only=False)
+        self.ckpt = load_checkpoint(self.path)
         cfg = self.ckpt["config"]
         self.chunk, self.decay = cfg["chunk"], cfg["ensemble_decay"]
         n_in, n_out = len(self.ckpt["x_mean"]), len(self.ckpt["a_mean"]) * self.chunk
         self.model = _mlp(n_in, n_out, cfg["hidden"], cfg["layers"])
-        self.model.load_state_dict(self.ckpt["model"])
+        try:
+            self.model.load_state_dict(self.ckpt["model"], strict=True)
+        except RuntimeError as exc:
+            raise _bad(self.path, f"its weights do not fit the MLP its config describes ({exc})") from None
         self.model.eval()
         self.x = Normalizer(self.ckpt["x_mean"], self.ckpt["x_std"])
         self.a = Normalizer(self.ckpt["a_mean"], self.ckpt["a_std"])
@@ -268,4 +389,5 @@ def load_policy(spec: str) -> BCPolicy | BCPolicies:
     return BCPolicy(paths[0]) if len(paths) == 1 else BCPolicies(paths)
 
 
-__all__ = ["BCConfig", "BCPolicies", "BCPolicy", "CHECKPOINT", "PolicyTaskError", "load_policy", "train"]
+__all__ = ["BCConfig", "BCPolicies", "BCPolicy", "CHECKPOINT", "CHECKPOINT_FORMAT", "PolicyTaskError",
+           "load_checkpoint", "load_policy", "resave_trusted_checkpoint", "save_checkpoint", "train"]

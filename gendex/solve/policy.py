@@ -8,13 +8,24 @@ same task (the stage executor's, which drives every joint with absolute targets,
 :meth:`~gendex_envs.task_env.TaskEnv.state_observation`) and turns the policy's deltas into absolute targets for all
 joints, so one policy file serves training, evaluation and data collection. Everything is batched over
 ``num_envs``. Where the files lie is the task version's business (:class:`~gendex_envs.task_version.PolicyFiles`).
+
+A policy file may come from an untrusted task folder, so it is loaded as *weights plus a known architecture*, never
+by unpickling: :func:`read_policy_weights` reads only the ``policy.pth`` entry of the stable-baselines3 zip with
+``torch.load(weights_only=True)`` (the zip's ``data`` entry, which holds cloudpickle, is never read), and
+:func:`build_policy_network` builds the MLP actor-critic ``gendex train`` creates (the record's ``architecture``;
+derived from its ``preset`` for records written before it was recorded) and loads the weights strictly. The result
+is the same ``ActorCriticPolicy`` class with the same weights that ``PPO.load`` gave, so its actions are identical.
+Sizes are bounded before anything is read (the ``MAX_POLICY_*`` constants, docs/security.md).
 """
 
 from __future__ import annotations
 
-import json
+import io
 import logging
+import math
+import zipfile
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -31,6 +42,26 @@ POLICY_FORMAT = 1
 WHOLE_TASK = "task"
 """Stage name of a policy trained on the whole task (every joint, the task's reward and success)."""
 
+ARCHITECTURE_KIND = "sb3-mlp-actor-critic"
+"""The only network a policy file may hold: stable-baselines3's ``ActorCriticPolicy`` with separate MLP policy and
+value nets (``net_arch``, ``activation``), a Gaussian action head over a Box(-1, 1) action space."""
+ACTIVATIONS = {"relu": torch.nn.ReLU, "tanh": torch.nn.Tanh}
+"""Activation names a record may give -> module (every preset trains with ReLU)."""
+WEIGHTS_ENTRY = "policy.pth"
+"""The entry of a stable-baselines3 zip that holds the policy's state dict (the only entry GenDex reads)."""
+MAX_POLICY_RECORD_BYTES = 1_000_000
+"""A policy's JSON record (about 9 KB for 136 observations)."""
+MAX_POLICY_ZIP_ENTRIES = 64
+"""Entries in a policy zip (stable-baselines3 writes 6)."""
+MAX_POLICY_WEIGHTS_BYTES = 256_000_000
+"""Uncompressed size of ``policy.pth`` (0.8 MB for the cpu preset; about 30 MB for the paper's [1024, 1024, 512]
+at 1000 observations)."""
+MAX_OBS_DIM = 10_000
+MAX_ACTION_DIM = 64
+MAX_LAYERS = 8
+MAX_LAYER_WIDTH = 4096
+"""Bounds of a recorded architecture, checked before a network is built (the paper preset is 3 layers of <= 1024)."""
+
 
 def stage_observation(env, judge: Judge, info: dict | None = None) -> torch.Tensor:
     """[N, D] the flat ``state`` observation a stage env judged by ``judge`` would return for ``env``'s state
@@ -44,6 +75,148 @@ def success_hold_steps(version: TaskVersion, stage: str) -> int:
     return 1 if own else max(1, version.spec.success.hold_steps)
 
 
+def _refuse(path, problem: str) -> PolicyError:
+    return PolicyError(f"{path}: {problem}")
+
+
+def read_policy_record(path: str | Path) -> dict:
+    """A policy's JSON record, parsed with the bounded loader and checked: format, control joint group, observation
+    normalization (finite numbers, as many variances as means); :class:`PolicyError` naming what is wrong."""
+    from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS
+    from gendex_envs.typed_yaml import parse_json_bounded
+
+    path = Path(path)
+    size = path.stat().st_size
+    if size > MAX_POLICY_RECORD_BYTES:
+        raise _refuse(path, f"policy record of {size} bytes; at most MAX_POLICY_RECORD_BYTES = "
+                            f"{MAX_POLICY_RECORD_BYTES} are allowed")
+    try:
+        meta = parse_json_bounded(path.read_bytes(), str(path), max_bytes=MAX_POLICY_RECORD_BYTES,
+                                  max_string=None, max_nodes=4 * MAX_OBS_DIM + 10_000)
+    except ValueError as exc:
+        raise _refuse(path, f"not a readable policy record ({exc})") from None
+    if not isinstance(meta, dict):
+        raise _refuse(path, "a policy record is a JSON object")
+    if meta.get("format") != POLICY_FORMAT:
+        raise _refuse(path, f"policy format {meta.get('format')!r}, this GenDex reads {POLICY_FORMAT}")
+    if meta.get("control_joint") not in CONTROL_JOINT_GROUPS:
+        raise _refuse(path, f"control_joint {meta.get('control_joint')!r} is not one of {sorted(CONTROL_JOINT_GROUPS)}")
+    norm = meta.get("obs_norm")
+    if not isinstance(norm, dict) or not all(isinstance(norm.get(k), list) for k in ("mean", "var")):
+        raise _refuse(path, "obs_norm must hold lists `mean` and `var`")
+    n = len(norm["mean"])
+    if not 0 < n <= MAX_OBS_DIM or len(norm["var"]) != n:
+        raise _refuse(path, f"obs_norm: {n} means and {len(norm['var'])} variances; both must have the same "
+                            f"length, 1 to MAX_OBS_DIM = {MAX_OBS_DIM}")
+    values = [*norm["mean"], *norm["var"], norm.get("clip")]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values):
+        raise _refuse(path, "obs_norm: mean, var and clip must be finite numbers")
+    if min(norm["var"]) < 0 or not norm["clip"] > 0:
+        raise _refuse(path, "obs_norm: variances must be >= 0 and clip > 0")
+    return meta
+
+
+def policy_architecture(meta: dict, action_dim: int | None = None) -> dict:
+    """The network of a policy record: its ``architecture`` entry, or (records written before it was recorded)
+    the one ``gendex train`` built from its ``preset``: ``net_arch`` hidden layers with ReLU for both the policy and
+    the value net, ``obs_dim`` observations, one action per free joint of its ``control_joint`` group."""
+    if "architecture" in meta:
+        return meta["architecture"]
+    preset = meta.get("preset") if isinstance(meta.get("preset"), dict) else {}
+    return dict(kind=ARCHITECTURE_KIND, net_arch=preset.get("net_arch"), activation="relu",
+                obs_dim=len(meta["obs_norm"]["mean"]),
+                action_dim=action_dim if action_dim is not None else len(free_joints(meta["control_joint"])))
+
+
+def architecture_of(net_arch, obs_dim: int, action_dim: int, activation: str = "relu") -> dict:
+    """What a policy record says about the network ``gendex train`` made (:func:`policy_architecture`)."""
+    return dict(kind=ARCHITECTURE_KIND, net_arch=[int(w) for w in net_arch], activation=activation,
+                obs_dim=int(obs_dim), action_dim=int(action_dim))
+
+
+def _check_architecture(arch, path) -> dict:
+    if not isinstance(arch, dict) or arch.get("kind") != ARCHITECTURE_KIND:
+        raise _refuse(path, f"architecture {arch!r}: GenDex loads only {ARCHITECTURE_KIND!r} networks")
+    if set(arch) != {"kind", "net_arch", "activation", "obs_dim", "action_dim"}:
+        raise _refuse(path, f"architecture keys {sorted(arch)}; expected kind, net_arch, activation, obs_dim, "
+                            "action_dim")
+    net, ints = arch["net_arch"], lambda v: isinstance(v, int) and not isinstance(v, bool)
+    if (not isinstance(net, list) or not 1 <= len(net) <= MAX_LAYERS
+            or not all(ints(w) and 1 <= w <= MAX_LAYER_WIDTH for w in net)):
+        raise _refuse(path, f"net_arch {net!r}: 1 to MAX_LAYERS = {MAX_LAYERS} layers of 1 to MAX_LAYER_WIDTH = "
+                            f"{MAX_LAYER_WIDTH} units")
+    if arch["activation"] not in ACTIVATIONS:
+        raise _refuse(path, f"activation {arch['activation']!r} is not one of {sorted(ACTIVATIONS)}")
+    for key, bound in (("obs_dim", MAX_OBS_DIM), ("action_dim", MAX_ACTION_DIM)):
+        if not ints(arch[key]) or not 1 <= arch[key] <= bound:
+            raise _refuse(path, f"{key} {arch[key]!r} must be an integer from 1 to {bound}")
+    return arch
+
+
+def read_policy_weights(path: str | Path) -> dict[str, torch.Tensor]:
+    """The state dict in a stable-baselines3 policy zip, read without unpickling anything but tensors: only the
+    ``policy.pth`` entry, sizes checked from the zip's directory first, ``torch.load(weights_only=True)``, every
+    value a finite floating tensor. :class:`PolicyError` naming the file otherwise."""
+    path = Path(path)
+    try:
+        with zipfile.ZipFile(path) as z:
+            entries = z.infolist()
+            if len(entries) > MAX_POLICY_ZIP_ENTRIES:
+                raise _refuse(path, f"{len(entries)} zip entries; at most MAX_POLICY_ZIP_ENTRIES = "
+                                    f"{MAX_POLICY_ZIP_ENTRIES} are allowed")
+            info = next((e for e in entries if e.filename == WEIGHTS_ENTRY), None)
+            if info is None:
+                raise _refuse(path, f"no {WEIGHTS_ENTRY} entry: not a stable-baselines3 policy zip")
+            if info.file_size > MAX_POLICY_WEIGHTS_BYTES:
+                raise _refuse(path, f"{WEIGHTS_ENTRY} of {info.file_size} bytes; at most MAX_POLICY_WEIGHTS_BYTES = "
+                                    f"{MAX_POLICY_WEIGHTS_BYTES} are allowed")
+            raw = z.read(info)  # zipfile stops at the declared size (and checks the CRC)
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
+        if isinstance(exc, PolicyError):
+            raise
+        raise _refuse(path, f"not a readable policy zip ({type(exc).__name__}: {exc})") from None
+    try:
+        state = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
+    except Exception as exc:
+        text = str(exc).splitlines()[-1] if str(exc) else ""
+        raise _refuse(path, f"{WEIGHTS_ENTRY} holds more than tensors and cannot be loaded without running code "
+                            f"from the file ({type(exc).__name__}: {text[:300]}); re-train the policy with "
+                            "`gendex train`") from None
+    if not isinstance(state, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
+                                              for k, v in state.items()):
+        raise _refuse(path, f"{WEIGHTS_ENTRY} must hold a mapping of names to tensors")
+    for k, v in state.items():
+        if not v.is_floating_point() or not bool(torch.isfinite(v).all()):
+            raise _refuse(path, f"weight {k!r} must be finite floating-point numbers")
+    return state
+
+
+def build_policy_network(arch: dict, state: dict[str, torch.Tensor], path: str | Path = "<policy>"):
+    """A stable-baselines3 ``ActorCriticPolicy`` of architecture ``arch`` (checked and bounded) with the weights
+    ``state`` loaded strictly (every name and shape must match); :class:`PolicyError` otherwise."""
+    import gymnasium as gym
+    from stable_baselines3.common.policies import ActorCriticPolicy
+
+    arch = _check_architecture(arch, path)
+    obs_space = gym.spaces.Box(-np.inf, np.inf, (arch["obs_dim"],), np.float32)
+    action_space = gym.spaces.Box(-1.0, 1.0, (arch["action_dim"],), np.float32)
+    net = ActorCriticPolicy(obs_space, action_space, lambda _: 0.0, net_arch=list(arch["net_arch"]),
+                            activation_fn=ACTIVATIONS[arch["activation"]])
+    try:
+        net.load_state_dict(state, strict=True)
+    except RuntimeError as exc:
+        raise _refuse(path, f"its weights do not fit the recorded architecture {arch} ({exc})") from None
+    net.set_training_mode(False)
+    return net
+
+
+def load_policy_network(files: PolicyFiles) -> tuple[object, dict]:
+    """(network, record) of a trained policy, loaded safely (module doc)."""
+    meta = read_policy_record(files.record)
+    arch = policy_architecture(meta)
+    return build_policy_network(arch, read_policy_weights(files.model), files.model), meta
+
+
 @dataclass
 class StagePolicy:
     """A trained PPO policy of one stage, with what it needs to run on another env of the task."""
@@ -53,7 +226,8 @@ class StagePolicy:
     judge: Judge
     """The stage's judge: its reward module's extras feed the observation; it tells when the stage is done."""
     model: object
-    """stable-baselines3 policy (``model.policy`` of the saved PPO)."""
+    """Anything with stable-baselines3's ``predict(obs, deterministic)``: the policy network
+    (:func:`load_policy_network`), or the PPO being trained."""
     obs_mean: np.ndarray
     obs_var: np.ndarray
     clip_obs: float
@@ -69,16 +243,10 @@ class StagePolicy:
     def load(cls, version: TaskVersion, files: PolicyFiles) -> StagePolicy:
         """Load a trained policy of one of ``version``'s stages (``files``: its model and record, from the version
         or from a training run of it); :class:`StageError` when a file is missing."""
-        from stable_baselines3 import PPO
-
         if not files.model.is_file() or not files.record.is_file():
             raise StageError(f"no trained policy for stage {files.stage!r}: need {files.model} and {files.record} "
                              "(`gendex train` writes both)")
-        meta = json.loads(files.record.read_text())
-        if meta.get("format") != POLICY_FORMAT:
-            raise PolicyError(f"{files.record}: policy format {meta.get('format')!r}, this GenDex reads "
-                              f"{POLICY_FORMAT}")
-        model = PPO.load(str(files.model), device="cpu")
+        model, meta = load_policy_network(files)
         norm = meta["obs_norm"]
         judge = version.judge(None if files.stage == WHOLE_TASK else files.stage)
         return cls(stage=files.stage, control_joint=meta["control_joint"], judge=judge,

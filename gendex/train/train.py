@@ -11,8 +11,9 @@ Stage K > 0 starts from the version's start states of that stage when it has the
 collected with the stage executor (earlier stages by motion planning, scripted primitives, or the run's and the
 version's trained policies) and saved in the run folder.
 
-Training can start from an earlier policy of the same stage (``init``, :func:`warm_start`): its weights and its
-observation normalization are loaded, and its exploration noise is reset to the preset's ``log_std_init``, so a
+Training can start from an earlier policy of the same stage (``init``, :func:`warm_start`): its weights (only the
+tensors of its ``policy.pth``, never the zip's pickled ``data``: :func:`~gendex.solve.policy.read_policy_weights`)
+and its observation normalization are loaded, and its exploration noise is reset to the preset's ``log_std_init``, so a
 policy trained under much noise can be refined under less (what its deterministic actions, the ones the executor
 runs, need). Its evaluation before training is then the "untrained" one in the record.
 """
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gendex.solve.policy import POLICY_FORMAT, StagePolicy
+from gendex.solve.policy import POLICY_FORMAT, StagePolicy, architecture_of, read_policy_record, read_policy_weights
 from gendex.train.envs import TASK_STAGE, make_gpu_vec_env, make_vec_env
 from gendex.train.evaluate import EvalResult, evaluate_stage
 from gendex.train.presets import PPOPreset, TrainingError, get_preset
@@ -115,20 +116,17 @@ def warm_start(model, venv, init: PolicyFiles, control_joint: str, log_std_init:
     """Load the policy ``init`` (model weights, observation normalization) into a fresh PPO ``model`` and its
     ``VecNormalize`` ``venv``, then set the policy's log standard deviation to ``log_std_init``; returns what the
     record says about it. :class:`TrainingError` when ``init`` does not fit (other joints, observation or network)."""
-    import json
-
     import torch
-    from stable_baselines3 import PPO
 
-    meta = json.loads(init.record.read_text())
+    meta = read_policy_record(init.record)
     norm = meta["obs_norm"]
     if meta.get("control_joint") != control_joint or len(norm["mean"]) != venv.observation_space.shape[0]:
         raise TrainingError(f"{init.model} drives {meta.get('control_joint')!r} from {len(norm['mean'])} "
                             f"observations; this stage drives {control_joint!r} from "
                             f"{venv.observation_space.shape[0]}: it cannot start from it")
-    source = PPO.load(str(init.model), device="cpu")
+    weights = read_policy_weights(init.model)  # weights only: the zip's pickled `data` is never read
     try:
-        model.policy.load_state_dict(source.policy.state_dict())
+        model.policy.load_state_dict(weights, strict=True)
     except RuntimeError as exc:
         raise TrainingError(f"{init.model}: its network does not match the preset's ({exc})") from None
     with torch.no_grad():
@@ -211,7 +209,8 @@ def train_stage(version: TaskVersion, stage: str | int | None, *, steps: int, ru
                 control_joint=cj, control_mode="pd_joint_delta_pos", preset=dataclasses.asdict(p),
                 steps=trained_steps, seed=seed, obs_norm=norm, obs_dim=len(norm["mean"]),
                 start_states=len(start_states) if start_states else 0, start_state_steps=state_steps,
-                command=command, init=started)
+                command=command, init=started,
+                architecture=architecture_of(p.net_arch, len(norm["mean"]), model.action_space.shape[0]))
     with atomic_path(files.model) as tmp:
         model.save(str(tmp))
     write_json(files.record, meta, indent=2, sort_keys=True)
