@@ -13,7 +13,11 @@ def _states(m=3, d=7):
     rng = np.random.default_rng(0)
     return StartStates(stage="grasp_bottle", source="executor", state=rng.normal(size=(m, d)).astype(np.float32),
                        obj_reset_pos={"bottle": rng.normal(size=(m, 3)).astype(np.float32)},
-                       obj_reset_quat={"bottle": rng.normal(size=(m, 4)).astype(np.float32)})
+                       obj_reset_quat={"bottle": _unit(rng.normal(size=(m, 4))).astype(np.float32)})
+
+
+def _unit(q):
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def test_round_trip_and_no_leftovers(tmp_path):
