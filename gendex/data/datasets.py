@@ -19,6 +19,13 @@ dataset. From it,
 
 Checksums cover every file of each task's ``lerobot/`` folder (data, meta, videos, card) and ``gendex_dataset.json``;
 the collector's bookkeeping (``collect_state.json``, which holds wall-clock time) is left out.
+
+A pulled repo is untrusted data. Before anything reaches ``out``, :func:`pull` refuses (:class:`DatasetError` naming
+the entry) a symbolic link or any other non-regular file anywhere in the download, a build record over
+``MAX_BUILD_RECORD_BYTES`` (checked before parsing; parsed with the bounded JSON loader), and a task that is not a
+versioned GenDex id ``GenDex/<Name>-v<N>`` (so its folder is a plain name: no ``/``, ``..``, absolute path or
+newline); every joined path must resolve inside its folder. The copy is assembled in a hidden folder beside
+``out`` and moved in only when complete, so a refused pull leaves ``out`` as it was.
 """
 
 from __future__ import annotations
@@ -26,7 +33,11 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import os
+import re
 import shutil
+import stat
+import tempfile
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -37,13 +48,19 @@ import yaml
 
 from gendex.data.episode import EpisodeError
 from gendex.fanout import Backend, session
-from gendex_envs.typed_yaml import load_yaml_bounded
+from gendex_envs.typed_yaml import load_yaml_bounded, parse_json_bounded, quote
 
 log = logging.getLogger(__name__)
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 DATASETS_DIR = REPO_ROOT / "datasets"
 BUILD_RECORD = "gendex_dataset.json"
+MAX_BUILD_RECORD_BYTES = 1_000_000
+"""A build record (``gendex-smoke``'s is 1 KB; 10 tasks of 1 000 episodes about 100 KB)."""
+MAX_BUILD_RECORD_NODES = 200_000
+"""Values in a build record (each kept seed is one)."""
+TASK_ID = re.compile(r"GenDex/([A-Z][A-Za-z0-9]{0,99}-v[0-9]{1,9})")
+"""A versioned task id as a build record names it; group 1 is the task's folder in a build (used with fullmatch)."""
 SKIPPED = ("collect_state.json",)
 """Files a build writes that are not part of the dataset (bookkeeping with wall-clock times)."""
 
@@ -295,7 +312,8 @@ class FolderRemote:
         src = self._repo(repo_id)
         if not src.is_dir():
             raise DatasetError(f"{repo_id} is not on the remote {self.folder}")
-        shutil.copytree(src, out, ignore=shutil.ignore_patterns(".tags"), dirs_exist_ok=True)
+        regular_files_only(src)  # a link is not followed, a pipe not read
+        shutil.copytree(src, out, ignore=shutil.ignore_patterns(".tags"), dirs_exist_ok=True, symlinks=True)
         return Path(out)
 
 
@@ -303,11 +321,58 @@ REPO_TAGS = ("v3.0",)
 """Git tags of a pushed repo: lerobot finds a dataset's format version by its tag (the v3.0 codebase version)."""
 
 
+def regular_files_only(root: Path) -> None:
+    """Refuse (:class:`DatasetError` naming the entry) a symbolic link or a non-regular file anywhere under ``root``;
+    links are not followed."""
+    root = Path(root)
+    for dirpath, dirnames, filenames in os.walk(root):
+        for name in dirnames + filenames:
+            path = Path(dirpath) / name
+            mode = os.lstat(path).st_mode
+            if stat.S_ISLNK(mode):
+                raise DatasetError(f"{path.relative_to(root)} is a symbolic link: a dataset may hold only regular "
+                                   "files and folders")
+            if not (stat.S_ISDIR(mode) or stat.S_ISREG(mode)):
+                raise DatasetError(f"{path.relative_to(root)} is not a regular file or folder: a dataset may hold "
+                                   "only regular files and folders")
+
+
+def _inside(root: Path, *parts: str) -> Path:
+    """``root / parts``, refused unless it resolves inside ``root``."""
+    path = Path(root).joinpath(*parts)
+    if not path.resolve().is_relative_to(Path(root).resolve()):
+        raise DatasetError(f"{quote('/'.join(parts))} leads outside {root}")
+    return path
+
+
 def _tasks_of(root: Path) -> list[str]:
+    """The task folders a build record names: each a versioned GenDex id's name part (checked; module doc)."""
     rec = Path(root) / BUILD_RECORD
-    if not rec.is_file():
+    if rec.is_symlink() or not rec.is_file():
         raise DatasetError(f"{root} holds no {BUILD_RECORD}: build it with `gendex dataset build` first")
-    return [t["task"].split("/", 1)[-1] for t in json.loads(rec.read_text())["tasks"]]
+    size = rec.stat().st_size
+    if size > MAX_BUILD_RECORD_BYTES:
+        raise DatasetError(f"{BUILD_RECORD}: {size} bytes; at most MAX_BUILD_RECORD_BYTES = {MAX_BUILD_RECORD_BYTES} "
+                           "are allowed")
+    try:
+        record = parse_json_bounded(rec.read_bytes(), BUILD_RECORD, max_bytes=MAX_BUILD_RECORD_BYTES,
+                                    max_nodes=MAX_BUILD_RECORD_NODES)
+    except ValueError as exc:
+        raise DatasetError(f"{BUILD_RECORD}: not a readable build record ({exc})") from None
+    tasks = record.get("tasks") if isinstance(record, dict) else None
+    if not isinstance(tasks, list) or not tasks:
+        raise DatasetError(f"{BUILD_RECORD}: `tasks` must be a non-empty list")
+    names: list[str] = []
+    for i, t in enumerate(tasks):
+        task = t.get("task") if isinstance(t, dict) else None
+        m = TASK_ID.fullmatch(task) if isinstance(task, str) else None
+        if m is None:
+            raise DatasetError(f"{BUILD_RECORD}: tasks[{i}].task {quote(task)} is not a versioned GenDex task id "
+                               "(GenDex/<Name>-v<N>, Name CamelCase letters and digits)")
+        if m.group(1) in names:
+            raise DatasetError(f"{BUILD_RECORD}: tasks[{i}].task {quote(task)} is listed twice")
+        names.append(m.group(1))
+    return names
 
 
 def _to_repo(root: Path, staging: Path) -> None:
@@ -324,22 +389,39 @@ def _to_repo(root: Path, staging: Path) -> None:
 
 
 def _from_repo(staging: Path, out: Path) -> None:
-    """Back from the repo's layout (:func:`_to_repo`) to a build's, so the copy verifies against the manifest."""
+    """Back from the repo's layout (:func:`_to_repo`) to a build's, so the copy verifies against the manifest.
+    ``staging`` must have passed :func:`regular_files_only`; every task name is checked by :func:`_tasks_of`."""
     tasks = _tasks_of(staging)
     out.mkdir(parents=True, exist_ok=True)
     if len(tasks) == 1:
-        dest = out / tasks[0] / "lerobot"
+        dest = _inside(out, tasks[0], "lerobot")
         shutil.copytree(staging, dest, ignore=shutil.ignore_patterns(BUILD_RECORD, ".*"), dirs_exist_ok=True)
     else:
         for t in tasks:
-            shutil.copytree(staging / t, out / t, dirs_exist_ok=True)
+            src = _inside(staging, t)
+            if not src.is_dir():
+                raise DatasetError(f"the repo has no folder {t}/ for a task its {BUILD_RECORD} names")
+            shutil.copytree(src, _inside(out, t), dirs_exist_ok=True)
     shutil.copy2(staging / BUILD_RECORD, out / BUILD_RECORD)
+
+
+def _move_into(work: Path, out: Path) -> None:
+    """Move the complete copy ``work`` to ``out`` (renamed when ``out`` does not exist; else file by file, next to
+    what ``out`` holds already)."""
+    if not out.exists():
+        work.rename(out)
+        return
+    if not out.is_dir() or out.is_symlink():
+        raise DatasetError(f"--out {out} exists and is not a folder")
+    for path in sorted(work.rglob("*")):
+        if path.is_file():
+            target = _inside(out, *path.relative_to(work).parts)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, target)
 
 
 def push(root: Path, repo_id: str, remote: Remote, manifest: DatasetManifest | None = None) -> str:
     """Publish the built dataset at ``root`` as ``repo_id`` (verified against ``manifest`` first, when given)."""
-    import tempfile
-
     if manifest is not None and manifest.checksums:
         v = verify(root, manifest)
         if not v.ok:
@@ -352,14 +434,21 @@ def push(root: Path, repo_id: str, remote: Remote, manifest: DatasetManifest | N
 
 def pull(repo_id: str, out: Path, remote: Remote, manifest: DatasetManifest | None = None) -> Verification | None:
     """Download ``repo_id`` into ``out`` (a build's layout) and verify it against ``manifest`` (when given)."""
-    import tempfile
-
+    out = Path(out)
     with tempfile.TemporaryDirectory(prefix="gendex-pull-") as tmp:
         staging = remote.pull(repo_id, Path(tmp) / "repo")
-        _from_repo(staging, Path(out))
+        regular_files_only(staging)
+        _tasks_of(staging)  # every name checked before anything is written
+        out.parent.mkdir(parents=True, exist_ok=True)
+        work = Path(tempfile.mkdtemp(prefix=f".{out.name}.pull-", dir=out.parent))
+        try:
+            _from_repo(staging, work)
+            _move_into(work, out)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
     return verify(out, manifest) if manifest is not None else None
 
 
-__all__ = ["BUILD_RECORD", "DATASETS_DIR", "DatasetError", "DatasetManifest", "DatasetTask", "FolderRemote",
-           "HubRemote", "Remote", "Verification", "build", "checksums", "load_manifest", "pull", "push",
-           "record_checksums", "save_manifest", "verify"]
+__all__ = ["BUILD_RECORD", "DATASETS_DIR", "MAX_BUILD_RECORD_BYTES", "DatasetError", "DatasetManifest", "DatasetTask",
+           "FolderRemote", "HubRemote", "Remote", "Verification", "build", "checksums", "load_manifest", "pull", "push",
+           "record_checksums", "regular_files_only", "save_manifest", "verify"]
