@@ -95,3 +95,18 @@ def test_object_arrays_are_refused_and_good_files_still_load(tmp_path):
     good = _write(tmp_path / "g.npz", state=np.float32([[0.5, -93.0]]))
     states = StartStates.load(good)
     assert states.state.tolist() == [[0.5, -93.0]] and states.obj_reset_quat["box"].tolist() == [[1, 0, 0, 0]]
+
+
+HOSTILE = Path(__file__).resolve().parents[1] / "data" / "hostile_r2" / "files"
+
+
+@pytest.mark.parametrize("path", sorted(HOSTILE.glob("start_states_*.npz")), ids=lambda p: p.stem)
+def test_the_committed_hostile_start_states_are_refused(path):
+    """``tests/data/hostile_r2/files/start_states_*.npz`` (``make_files.py`` rebuilds them)."""
+    with pytest.raises(StageError, match="only finite numbers|MAX_STATE_ABS|MAX_POSITION_M|QUAT_NORM|unit quat"
+                                         "|only float32 or float64"):
+        StartStates.load(path)
+
+
+def test_the_committed_corpus_is_there():
+    assert len(list(HOSTILE.glob("start_states_*.npz"))) == 6

@@ -229,3 +229,31 @@ def test_a_bc_checkpoint_with_non_finite_or_out_of_bounds_values_is_refused(tmp_
     torch.save(bad, path)
     with pytest.raises(PolicyError, match="config.hidden"):
         BCPolicy(path)
+
+
+# --------------------------------------------------------------------------------------------- committed corpus
+HOSTILE = Path(__file__).resolve().parents[1] / "data" / "hostile_r2" / "files"
+
+
+@pytest.mark.parametrize("folder, refused", [("policy_data_pickle", None),
+                                             ("policy_pth_pickle", "policy.pth holds more than tensors")])
+def test_the_committed_hostile_policies_run_no_payload(tmp_path, monkeypatch, folder, refused):
+    """``tests/data/hostile_r2/files/`` (``make_files.py`` rebuilds them): payloads write $GENDEX_HOSTILE_MARKER."""
+    marker = tmp_path / "marker"
+    monkeypatch.setenv("GENDEX_HOSTILE_MARKER", str(marker))
+    files = PolicyFiles("rotate_ball", HOSTILE / folder / "rotate_ball.zip", HOSTILE / folder / "rotate_ball.json")
+    if refused is None:
+        net, _ = load_policy_network(files)  # the data entry is never read; the weights are fine
+        assert net.predict(np.zeros((2, 4), np.float32), deterministic=True)[0].shape == (2, 20)
+    else:
+        with pytest.raises(PolicyError, match=refused):
+            load_policy_network(files)
+    assert not marker.exists()
+
+
+def test_the_committed_hostile_bc_checkpoint_runs_no_payload(tmp_path, monkeypatch):
+    marker = tmp_path / "marker"
+    monkeypatch.setenv("GENDEX_HOSTILE_MARKER", str(marker))
+    with pytest.raises(PolicyError, match="only pickle can load"):
+        BCPolicy(HOSTILE / "bc_pickle.pt")
+    assert not marker.exists()
