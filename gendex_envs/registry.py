@@ -2,7 +2,11 @@
 
 :func:`register_tasks` runs once when :mod:`gendex_envs` is imported. Task roots are the folders listed in
 ``$GENDEX_TASKS_PATH`` (``os.pathsep``-separated), then the repository's ``generated_tasks/``; the first root that
-has a version wins. Every version is registered, and an unversioned name resolves as Gymnasium resolves it:
+has a version wins, except that a committed id (a version in ``generated_tasks/``) keeps its committed folder: a
+folder elsewhere that would replace it is refused with a warning unless ``GENDEX_ALLOW_OVERRIDE=1`` (or, from code,
+``register_tasks(roots, override=True)``). A folder that cannot be registered (a missing root, a ``task.yaml`` that is
+not a file, a spec that does not load) is reported and skipped; the others register, so one bad folder never hides
+the library. Every version is registered, and an unversioned name resolves as Gymnasium resolves it:
 ``gym.make("GenDex/PutAppleBowl")`` makes the highest version (with Gymnasium's warning), and
 :func:`resolve_task` does the same for GenDex's own commands.
 
@@ -25,33 +29,97 @@ import gymnasium as gym
 from gymnasium.envs.registration import WrapperSpec, find_highest_version, parse_env_id
 
 from gendex_envs.errors import DuplicateTaskError, TaskNotFoundError, TaskSpecError, suggest
+from gendex_envs.spec import TASK_NAME_RE
 from gendex_envs.task_version import NAMESPACE, TaskVersion, versions_in
 
 log = logging.getLogger(__name__)
 
 TASKS_PATH_ENV = "GENDEX_TASKS_PATH"
+ALLOW_OVERRIDE_ENV = "GENDEX_ALLOW_OVERRIDE"
+"""``GENDEX_ALLOW_OVERRIDE=1``: folders on ``$GENDEX_TASKS_PATH`` may replace committed task ids (read as
+``GENDEX_TRUST_REMOTE_CODE`` is: 1, true or yes)."""
 REPO_TASKS_DIR = Path(__file__).resolve().parent.parent / "generated_tasks"
 GYM_API_WRAPPER = WrapperSpec(name="GymApi", entry_point="gendex_envs.wrappers:GymApi", kwargs={})
 
 
+def override_allowed() -> bool:
+    """``GENDEX_ALLOW_OVERRIDE=1``: the user lets task folders replace committed ids."""
+    return os.environ.get(ALLOW_OVERRIDE_ENV, "").strip().lower() in ("1", "true", "yes")
+
+
+def _env_roots() -> list[Path]:
+    return [Path(p) for p in os.environ.get(TASKS_PATH_ENV, "").split(os.pathsep) if p]
+
+
 def task_roots() -> list[Path]:
-    """Folders searched for tasks, in priority order."""
-    roots = [Path(p) for p in os.environ.get(TASKS_PATH_ENV, "").split(os.pathsep) if p]
+    """Folders searched for tasks, in priority order (``$GENDEX_TASKS_PATH`` entries that are not folders left out,
+    with a warning)."""
+    roots = []
+    for root in _env_roots():
+        if root.is_dir():
+            roots.append(root)
+        else:
+            log.warning("ignoring %s=%s entry %s: not a folder", TASKS_PATH_ENV, os.environ.get(TASKS_PATH_ENV), root)
     if REPO_TASKS_DIR.is_dir():
         roots.append(REPO_TASKS_DIR)
     return roots
 
 
-def discover_tasks(roots: list[Path] | None = None) -> dict[str, TaskVersion]:
-    """Every task version in ``roots`` (default :func:`task_roots`): env id -> version; the first root wins."""
+def _is_committed_root(root: Path) -> bool:
+    try:
+        return root.resolve() == REPO_TASKS_DIR.resolve()
+    except OSError:
+        return False
+
+
+def committed_ids() -> set[str]:
+    """Ids of the committed task versions (``generated_tasks/<Name>/v<N>/task.yaml``), by folder names only."""
+    if not REPO_TASKS_DIR.is_dir():
+        return set()
+    return {v.env_id for v in versions_in(REPO_TASKS_DIR)}
+
+
+def committed_version(env_id: str) -> TaskVersion | None:
+    """The committed version (``generated_tasks/<Name>/v<N>``) of ``env_id``, whatever is registered under that id
+    in this process; None when the repository holds no such version."""
+    try:
+        ns, name, version = parse_env_id(env_id)
+    except gym.error.Error:
+        return None
+    if ns != NAMESPACE or version is None or not TASK_NAME_RE.fullmatch(name or ""):
+        return None
+    folder = REPO_TASKS_DIR / name / f"v{version}"
+    try:
+        return TaskVersion.at(folder)
+    except TaskNotFoundError:
+        return None
+
+
+def discover_tasks(roots: list[Path] | None = None, override: bool | None = None) -> dict[str, TaskVersion]:
+    """Every task version in ``roots`` (default :func:`task_roots`): env id -> version; the first root wins.
+
+    A version outside ``generated_tasks/`` whose id is a committed one is refused (logged, skipped: the committed
+    version keeps the id) unless ``override`` (None: ``GENDEX_ALLOW_OVERRIDE``). Roots given explicitly must be
+    folders (:class:`TaskNotFoundError`)."""
+    override = override_allowed() if override is None else override
+    committed: set[str] | None = None
     found: dict[str, TaskVersion] = {}
     for root in task_roots() if roots is None else roots:
         if not root.is_dir():
             raise TaskNotFoundError(f"task root {root} is not a folder (from ${TASKS_PATH_ENV} or the repository)")
+        own = _is_committed_root(root)
         for version in versions_in(root):
             if version.env_id in found:
                 log.info("%s in %s is shadowed by %s", version.env_id, version.root, found[version.env_id].root)
                 continue
+            if not own and not override:
+                committed = committed_ids() if committed is None else committed
+                if version.env_id in committed:
+                    log.warning("refusing %s from %s: it would replace the committed task %s; set %s=1 (or call "
+                                "register_tasks(roots, override=True)) to use it instead", version.env_id,
+                                version.root, REPO_TASKS_DIR / version.name / f"v{version.version}",
+                                ALLOW_OVERRIDE_ENV)
+                    continue
             found[version.env_id] = version
     return found
 
@@ -63,11 +131,13 @@ def register_tasks(roots: list[Path] | None = None, override: bool = False) -> l
     """Register every discovered task version with Gymnasium; returns the new ids.
 
     Re-registering an id that points at the same folder is a no-op; a different folder raises
-    :class:`DuplicateTaskError` unless ``override``. A version whose spec does not parse is logged and skipped (one
-    broken folder must not hide every other task); making it names the problem.
+    :class:`DuplicateTaskError` unless ``override``. A folder that would replace a committed id is refused (logged,
+    skipped) unless ``override`` or ``GENDEX_ALLOW_OVERRIDE=1``. A version that cannot be registered (its spec does
+    not load, whatever the error) is logged and skipped (one broken folder must not hide every other task); making it
+    names the problem.
     """
     new = []
-    for env_id, version in discover_tasks(roots).items():
+    for env_id, version in discover_tasks(roots, override=True if override else None).items():
         if env_id in gym.registry:
             previous = _REGISTERED.get(env_id)
             if previous is not None and previous.root == version.root:
@@ -79,12 +149,16 @@ def register_tasks(roots: list[Path] | None = None, override: bool = False) -> l
             del gym.registry[env_id]
         try:
             steps = version.load_spec_unchecked().max_episode_steps
+            gym.register(id=env_id, entry_point="gendex_envs.registry:make_task_env", max_episode_steps=steps,
+                         kwargs={"task": str(version.root)}, disable_env_checker=True,
+                         additional_wrappers=(GYM_API_WRAPPER,))
         except TaskSpecError as exc:
             log.error("not registering %s: %s", env_id, exc)
             continue
-        gym.register(id=env_id, entry_point="gendex_envs.registry:make_task_env", max_episode_steps=steps,
-                     kwargs={"task": str(version.root)}, disable_env_checker=True,
-                     additional_wrappers=(GYM_API_WRAPPER,))
+        except Exception as exc:  # any failure of one untrusted folder: report it, register the rest
+            log.error("not registering %s from %s: %s: %s", env_id, version.root, type(exc).__name__,
+                      str(exc)[:500])
+            continue
         _REGISTERED[env_id] = version
         new.append(env_id)
     return new

@@ -79,8 +79,25 @@ SCALE_RANGE: tuple[float, float] = (0.3, 2.0)
 QUAT_NORM_TOL = 1e-3
 GOAL_TARGET = "goal"
 """Reserved name: a ``near`` condition with ``target: goal`` refers to the task's goal site."""
-TASK_NAME_RE = re.compile(r"^[A-Z][A-Za-z0-9]*$")
-SNAKE_NAME_RE = re.compile(r"^[a-z][a-z0-9_]*$")
+TASK_NAME_RE = re.compile(r"\A[A-Z][A-Za-z0-9]*\Z")
+"""A task name: ASCII CamelCase, the whole string (``\\Z``: a ``$`` would also match before a final newline)."""
+SNAKE_NAME_RE = re.compile(r"\A[a-z][a-z0-9_]*\Z")
+"""An object or stage name: ASCII snake_case, the whole string."""
+
+MAX_POSITION_M = 5.0
+"""Bound (m) on every position coordinate and length of a spec: objects' ``pos_m``, ``goal.pos_m``,
+``robot.base_pos_m``, the goal's radius and the conditions' distances. A finite but absurd value (1e30) would go into
+PhysX as a pose. The committed library's largest is 0.8 m (the table is 1.6 m x 1.2 m)."""
+MAX_RANDOMIZE_M = 1.0
+"""Bound (m) on a randomization half-range (``randomize.xy_m``); the committed library's largest is 0.13 m."""
+MAX_ANGLE_DEG = 360.0
+"""Bound (degrees) on ``randomize.yaw_deg`` (a half-range; the committed library's largest is 180) and on
+``robot.base_yaw_deg``."""
+MAX_JOINT_POSITION = 10.0
+"""Bound on an initial joint position (``joint_state``, rad or m); the committed library's largest is 1.8. The env
+also checks each one against its joint's limits when it builds the scene (the asset is known only there)."""
+MAX_TABLE_M = 10.0
+"""Bound (m) on the table's size and height; the committed tables are 1.6 m x 1.2 m, 0.76 m high."""
 
 
 def _bounded(limit: int, items: str, why: str, **kwargs: Any) -> Any:
@@ -381,6 +398,10 @@ def _condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
         bad("min_fingers", "between 1 and 4 (fingers other than the thumb)")
     if c.ring_radius_m is not None and c.ring_radius_m < 0:
         bad("ring_radius_m", ">= 0")
+    for f in dataclasses.fields(ConditionSpec):
+        v = getattr(c, f.name)
+        if f.name.endswith("_m") and v is not None and not abs(v) <= MAX_POSITION_M:
+            bad(f.name, f"within +/-{MAX_POSITION_M} m (MAX_POSITION_M)")
     if c.min_dz_m is not None and c.max_dz_m is not None and not c.max_dz_m > c.min_dz_m:
         bad("max_dz_m", f"> min_dz_m ({c.min_dz_m})")
     if c.object is not None:
@@ -400,16 +421,30 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         if not ok:
             p.append(f"{path} = {quote(value)} is not allowed; {allowed}")
 
+    def within(position: tuple[float, ...], path: str) -> None:
+        need(all(abs(x) <= MAX_POSITION_M for x in position), path, list(position),
+             f"each coordinate must be within +/-{MAX_POSITION_M} m (MAX_POSITION_M)")
+
     p += _leaf_problems(spec)
-    need(bool(TASK_NAME_RE.match(spec.name)), "name", spec.name, "must be CamelCase (^[A-Z][A-Za-z0-9]*$)")
+    need(bool(TASK_NAME_RE.fullmatch(spec.name)), "name", spec.name,
+         "must be ASCII CamelCase, the whole name ([A-Z][A-Za-z0-9]*)")
     need(bool(spec.instruction.strip()), "instruction", spec.instruction, "must be a non-empty string")
     need(1 <= spec.max_episode_steps <= MAX_STEPS, "max_episode_steps", spec.max_episode_steps,
          f"must be >= 1 and <= {MAX_STEPS} (MAX_STEPS)")
     need(all(s > 0 for s in spec.table.size_m), "table.size_m", list(spec.table.size_m), "both must be > 0")
     need(spec.table.height_m > 0, "table.height_m", spec.table.height_m, "must be > 0")
+    need(all(s <= MAX_TABLE_M for s in spec.table.size_m), "table.size_m", list(spec.table.size_m),
+         f"each must be <= {MAX_TABLE_M} m (MAX_TABLE_M)")
+    need(spec.table.height_m <= MAX_TABLE_M, "table.height_m", spec.table.height_m,
+         f"must be <= {MAX_TABLE_M} m (MAX_TABLE_M)")
+    within(spec.robot.base_pos_m, "robot.base_pos_m")
+    need(abs(spec.robot.base_yaw_deg) <= MAX_ANGLE_DEG, "robot.base_yaw_deg", spec.robot.base_yaw_deg,
+         f"must be within +/-{MAX_ANGLE_DEG} degrees (MAX_ANGLE_DEG)")
     need(spec.table.friction > 0, "table.friction", spec.table.friction, "must be > 0")
     if spec.goal is not None:
-        need(spec.goal.radius_m > 0, "goal.radius_m", spec.goal.radius_m, "must be > 0")
+        need(0 < spec.goal.radius_m <= MAX_POSITION_M, "goal.radius_m", spec.goal.radius_m,
+             f"must be > 0 and <= {MAX_POSITION_M} m (MAX_POSITION_M)")
+        within(spec.goal.pos_m, "goal.pos_m")
 
     need(len(spec.objects) >= 1, "objects", [], "at least one object is required")
     names = [o.name for o in spec.objects]
@@ -417,7 +452,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
     lo, hi = SCALE_RANGE
     for i, o in enumerate(spec.objects):
         at = f"objects[{i}]"
-        need(bool(SNAKE_NAME_RE.match(o.name)), f"{at}.name", o.name, "must match ^[a-z][a-z0-9_]*$")
+        need(bool(SNAKE_NAME_RE.fullmatch(o.name)), f"{at}.name", o.name,
+             "must be ASCII snake_case, the whole name ([a-z][a-z0-9_]*)")
         need(o.name != GOAL_TARGET, f"{at}.name", o.name, f"{GOAL_TARGET!r} is reserved for the goal site")
         need(o.name not in seen, f"{at}.name", o.name, "object names must be unique (duplicate name)")
         seen.add(o.name)
@@ -427,12 +463,19 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
                      f"Run `gendex assets` to list the available asset ids.")
         need(lo <= o.scale <= hi, f"{at}.scale", o.scale, f"allowed range {lo} <= scale <= {hi}")
         need(o.pos_m[2] >= 0, f"{at}.pos_m", list(o.pos_m), "z is the clearance above the table and must be >= 0")
+        within(o.pos_m, f"{at}.pos_m")
+        for joint, value in o.joint_state.items():
+            need(abs(value) <= MAX_JOINT_POSITION, join_path(f"{at}.joint_state", str(joint)), value,
+                 f"must be within +/-{MAX_JOINT_POSITION} (MAX_JOINT_POSITION, rad or m)")
         norm = math.sqrt(sum(q * q for q in o.quat_wxyz))
         need(abs(norm - 1.0) <= QUAT_NORM_TOL, f"{at}.quat_wxyz", list(o.quat_wxyz),
              f"must be a unit quaternion (norm {norm:.4g}, allowed 1 +/- {QUAT_NORM_TOL}); not normalised on load")
         need(all(r >= 0 for r in o.randomize.xy_m), f"{at}.randomize.xy_m", list(o.randomize.xy_m),
              "half-ranges must be >= 0")
-        need(o.randomize.yaw_deg >= 0, f"{at}.randomize.yaw_deg", o.randomize.yaw_deg, "half-range must be >= 0")
+        need(all(r <= MAX_RANDOMIZE_M for r in o.randomize.xy_m), f"{at}.randomize.xy_m", list(o.randomize.xy_m),
+             f"half-ranges must be <= {MAX_RANDOMIZE_M} m (MAX_RANDOMIZE_M)")
+        need(0 <= o.randomize.yaw_deg <= MAX_ANGLE_DEG, f"{at}.randomize.yaw_deg", o.randomize.yaw_deg,
+             f"half-range must be >= 0 and <= {MAX_ANGLE_DEG} degrees (MAX_ANGLE_DEG)")
         if o.color_rgba is not None:
             need(all(0 <= c <= 1 for c in o.color_rgba), f"{at}.color_rgba", list(o.color_rgba),
                  "each channel must be in [0, 1]")
@@ -456,7 +499,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
     stage_names: set[str] = set()
     for i, s in enumerate(spec.stages):
         at = f"stages[{i}]"
-        need(bool(SNAKE_NAME_RE.match(s.name)), f"{at}.name", s.name, "must be snake_case (^[a-z][a-z0-9_]*$)")
+        need(bool(SNAKE_NAME_RE.fullmatch(s.name)), f"{at}.name", s.name,
+             "must be ASCII snake_case, the whole name ([a-z][a-z0-9_]*)")
         need(s.name not in stage_names, f"{at}.name", s.name, "stage names must be unique (duplicate name)")
         stage_names.add(s.name)
         need(bool(s.instruction.strip()), f"{at}.instruction", s.instruction, "must be a non-empty string")

@@ -53,7 +53,9 @@ NAMESPACE = "GenDex"
 """Gymnasium namespace of every GenDex task id (``GenDex/<Name>-v<N>``)."""
 DRAFTS = ".drafts"
 """Hidden folder of a task root where versions are assembled before they are published (never registered)."""
-VERSION_DIR = re.compile(r"^v(\d+)$")
+VERSION_DIR = re.compile(r"\Av(0|[1-9][0-9]{0,8})\Z")
+"""A version folder's name: ``v`` and the version in ASCII digits, no leading zero, the whole name (``$`` would match
+before a final newline, ``\\d`` any script's digits: ``v1\\n`` and ``v\u0661`` would both be version 1)."""
 RECORDS = ("generation", "proposal", "scene_candidates", "critique", "reward_attempts", "solvability", "promotion",
            "reword", "run")
 """JSON records a folder may hold (how it was generated, promoted, reworded or trained)."""
@@ -215,7 +217,7 @@ class TaskVersion:
     def at(cls, folder: str | Path) -> TaskVersion:
         """The version in ``folder`` (``.../<Name>/v<N>`` holding a spec); :class:`TaskNotFoundError` otherwise."""
         folder = Path(folder)
-        m = VERSION_DIR.match(folder.name)
+        m = VERSION_DIR.fullmatch(folder.name)
         if m is None:
             raise TaskNotFoundError(f"{folder} is not a task version folder: version folders are named v<N> inside "
                                     "a folder named after the task (e.g. generated_tasks/PutAppleBowl/v0)")
@@ -321,16 +323,39 @@ class TaskVersion:
         return out
 
     def file_digest(self) -> str:
-        """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version. The
-        ``solvability`` record is left out: it is a measurement of the version (``gendex gate --write`` may add or
-        renew it), not part of it."""
+        """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version. It covers
+        everything in the folder (spec, reward and stage reward modules, policies and their records, start states,
+        any other file, hidden ones and bytecode caches included), so any change that could alter behaviour changes
+        it; only the ``solvability`` record is left out: it is a measurement of the version (``gendex gate --write``
+        may add or renew it), not part of it.
+
+        Stable across checkouts and machines: files are taken in the order of their relative paths (by parts), and only
+        their bytes count (not times, modes or owners). Files are read in chunks; a symbolic link counts as its
+        target's text (it is never followed, so a link to a device or a huge file outside costs nothing), and any
+        other non-regular entry (a FIFO, a socket) counts as its kind, without being opened."""
         import hashlib
+        import stat
 
         h = hashlib.sha256()
-        skip = self.files.record("solvability")
-        for p in sorted(q for q in self.root.rglob("*") if q.is_file() and q != skip):
-            h.update(p.relative_to(self.root).as_posix().encode() + b"\0")
-            h.update(p.read_bytes())
+        skip = self.files.record("solvability").relative_to(self.root).as_posix()
+        entries: list[tuple[str, Path]] = []
+        for folder, dirs, names in os.walk(self.root, followlinks=False):
+            here = Path(folder)
+            for n in names + [d for d in dirs if (here / d).is_symlink()]:
+                entries.append(((here / n).relative_to(self.root).as_posix(), here / n))
+        for rel, path in sorted(entries, key=lambda e: Path(e[0]).parts):
+            if rel == skip:
+                continue
+            mode = path.lstat().st_mode
+            h.update(rel.encode("utf-8", "surrogateescape") + b"\0")
+            if stat.S_ISLNK(mode):
+                h.update(b"\0symlink\0" + os.fsencode(os.readlink(path)))
+            elif stat.S_ISREG(mode):
+                with path.open("rb") as fh:
+                    for chunk in iter(lambda: fh.read(1 << 20), b""):
+                        h.update(chunk)
+            else:
+                h.update(b"\0special\0" + str(stat.S_IFMT(mode)).encode())
         return h.hexdigest()
 
 
@@ -343,10 +368,14 @@ def versions_in(root: str | Path) -> list[TaskVersion]:
     found = []
     for spec in sorted(root.glob("*/v*/" + TaskLayout(".").spec.name)):
         folder = spec.parent
-        if not VERSION_DIR.match(folder.name) or not TASK_NAME_RE.match(folder.parent.name):
-            log.warning("ignoring %s: a task version folder is <Name>/v<N> with a CamelCase name", folder)
+        if not VERSION_DIR.fullmatch(folder.name) or not TASK_NAME_RE.fullmatch(folder.parent.name):
+            log.warning("ignoring %s (%r): a task version folder is <Name>/v<N>, an ASCII CamelCase name and v with "
+                        "the version in ASCII digits", folder, folder.relative_to(root).as_posix())
             continue
-        found.append(TaskVersion.at(folder))
+        try:
+            found.append(TaskVersion.at(folder))
+        except TaskNotFoundError as exc:  # task.yaml is a folder, a FIFO, a dangling link: skip only this one
+            log.warning("ignoring %s: %s", folder, exc)
     return sorted(found, key=lambda v: (v.name, v.version))
 
 
@@ -354,7 +383,7 @@ def next_version(root: str | Path, name: str) -> int:
     folder = Path(root) / name
     if not folder.is_dir():
         return 0
-    numbers = [int(m.group(1)) for p in folder.iterdir() if (m := VERSION_DIR.match(p.name))]
+    numbers = [int(m.group(1)) for p in folder.iterdir() if (m := VERSION_DIR.fullmatch(p.name))]
     return max(numbers) + 1 if numbers else 0
 
 
@@ -389,8 +418,8 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
     it. ``required``: files (inside ``draft``) that must exist; :class:`PublishError` otherwise, nothing published.
     """
     root = Path(root)
-    if not TASK_NAME_RE.match(name):
-        raise PublishError(f"task name {name!r} is not CamelCase (^[A-Z][A-Za-z0-9]*$)")
+    if not TASK_NAME_RE.fullmatch(name):
+        raise PublishError(f"task name {name!r} is not CamelCase (ASCII, [A-Z][A-Za-z0-9]*)")
     missing = [p.name for p in required if not p.is_file()]
     if missing:
         raise PublishError(f"task {name!r} is incomplete, not publishing it: missing {missing}")
