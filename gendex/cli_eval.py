@@ -32,7 +32,12 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
                  workers: int = typer.Option(1, "--workers", min=1, help="Processes sharing the tasks."),
                  ray: bool = ray_option(), ray_address: str = ray_address_option(),
                  tasks: str = typer.Option(None, "--tasks", help="Comma-separated subset of the suite's tasks."),
-                 videos: int = typer.Option(0, "--videos", min=0, help="Record the first K episodes of each task.")
+                 videos: int = typer.Option(0, "--videos", min=0, help="Record the first K episodes of each task."),
+                 allow_changed_tasks: bool = typer.Option(
+                     False, "--allow-changed-tasks",
+                     help="Run even when a task's files differ from the suite's (the committed version, by digest), "
+                          "e.g. a folder registered over its id with GENDEX_ALLOW_OVERRIDE=1; the leaderboard "
+                          "refuses such a result.")
                  ) -> None:
     """Evaluate a policy on a suite: eval_info.json (LeRobot's fields, per-task success with 95 % Wilson
     intervals, suite hash, GenDex version); episodes whose policy raises or gives a bad action fail with the
@@ -61,7 +66,8 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
 
         info = run_suite(s, policy, policy_factory, out, episodes=episodes,
                          backend=backend_of(workers, ray, ray_address),
-                         training_seeds=trained_on, videos=videos, progress=show)
+                         training_seeds=trained_on, videos=videos, progress=show,
+                         allow_changed_tasks=allow_changed_tasks)
     except (GenDexError, ValueError) as exc:
         die(exc)
     for task, t in info["per_task"].items():
@@ -93,12 +99,16 @@ def leaderboard_add(result: Path = typer.Argument(..., help="A gendex eval resul
     import re
 
     from gendex.eval.leaderboard import LEADERBOARD_DIR, load_entries
+    from gendex.eval.suite import SUITES_DIR
     from gendex_envs.errors import GenDexError
 
     path = result / "eval_info.json" if result.is_dir() else result
     try:
         info = json.loads(path.read_text())
         suite = info["suite"]["name"]
+        if not isinstance(suite, str) or not re.fullmatch(r"[a-z0-9][a-z0-9.-]*", suite) or ".." in suite \
+                or not (SUITES_DIR / f"{suite}.yaml").is_file():
+            raise ValueError(f"{path}: suite {str(suite)[:80]!r} is not a suite in {SUITES_DIR}")
         entry = {"method": method, "authors": authors, "code": code, "policy_kind": kind,
                  "training_data": training_data, "date": date or datetime.date.today().isoformat(),
                  "policy": info["policy"], "notes": notes, "eval_info": info}

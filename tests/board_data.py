@@ -5,20 +5,21 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gendex.eval.suite import load_suite
+from gendex.eval.suite import load_suite, suite_task_digests
 from gendex.eval.suite_run import eval_info
 
 SUITE = "gendex-ref-v1"
 
 
 def synthetic_info(rates: dict[str, int], episodes: int = 10, suite_name: str = SUITE) -> dict:
-    """eval_info of a made-up run: ``rates[task]`` successes of ``episodes`` on every task of the suite."""
+    """eval_info of a made-up run: ``rates[task]`` successes of ``episodes`` on every task of the suite (as
+    committed: with their digests)."""
     suite = load_suite(suite_name)
     seeds = suite.seeds(episodes)
     rows = [{"task": t, "seed": s, "sum_reward": 1.0, "max_reward": 0.5, "success_at_end": k < rates[t],
              "success_once": k < rates[t] + 1, "length": 100 + k, "failure": None}
             for t in suite.tasks for k, s in enumerate(seeds)]
-    return eval_info(suite, "random", rows, seeds, 12.0)
+    return eval_info(suite, "random", rows, seeds, 12.0, task_digests=suite_task_digests(suite))
 
 
 def entry(method: str, info: dict, **changes) -> dict:

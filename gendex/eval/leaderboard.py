@@ -4,7 +4,10 @@ A result file is a JSON object: ``method``, ``authors``, ``code`` (a link), ``po
 :data:`KINDS`), ``training_data`` (what it learned from, or "none"), ``date`` (YYYY-MM-DD), ``policy`` (the
 ``--policy`` spec it was run with) and ``eval_info``: what ``gendex eval`` wrote. :func:`load_entries` refuses a
 file with a missing or unknown field, another suite's result, or numbers that do not add up; a result whose suite
-hash differs from the suite file's is kept but marked stale (the suite changed since).
+hash differs from the suite file's is kept but marked stale (the suite changed since). A result must record the digest
+of each task's files (``eval_info["task_digests"]``, written by ``gendex eval``), and each must equal the suite's
+(the task version as committed, :func:`~gendex.eval.suite.suite_task_digests`): :class:`ResultDigestError` otherwise,
+so a score made on a copy with another reward or spec under a suite's task id is refused.
 
 :func:`build_site` writes ``index.html`` and a page per suite: a table sortable by any column (click its header),
 each method's success with its 95 % Wilson interval, and a per-task breakdown that opens under its row; links to
@@ -23,7 +26,7 @@ from pathlib import Path
 
 import dacite
 
-from gendex.eval.suite import Suite, load_suite
+from gendex.eval.suite import Suite, load_suite, suite_task_digests
 from gendex_envs.errors import GenDexError
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
@@ -33,6 +36,11 @@ KINDS = ("baseline", "oracle", "imitation", "reinforcement", "other")
 
 class LeaderboardError(GenDexError, ValueError):
     """A result file is malformed, or belongs to another suite."""
+
+
+class ResultDigestError(LeaderboardError):
+    """A result was evaluated on task files other than the suite's (or does not say which): its task digests differ
+    from the committed versions'."""
 
 
 @dataclass(frozen=True)
@@ -86,9 +94,22 @@ def _check(e: Entry, suite: Suite, path: Path) -> list[str]:
     return problems
 
 
+def _check_digests(e: Entry, want: dict[str, str], path: Path) -> None:
+    got = e.eval_info.get("task_digests")
+    if not isinstance(got, dict):
+        raise ResultDigestError(f"{path}: eval_info has no 'task_digests': the digest of each task's files, which "
+                                "gendex eval records; without it the result cannot show it ran on the suite's tasks")
+    bad = [f"{task} ran on files with digest {str(got.get(task))[:64]}, the suite's (committed) version has "
+           f"{want[task]}" for task in e.per_task if got.get(task) != want[task]]
+    if bad:
+        raise ResultDigestError(f"{path}: {'; '.join(bad)}. A result on other task files than the suite's (a changed "
+                                "or replaced task folder) is not a result on the suite")
+
+
 def load_entries(suite_name: str, root: Path = LEADERBOARD_DIR) -> list[Entry]:
     """Every result of ``leaderboard/<suite>/`` (sorted best first by the suite's metric), validated."""
     suite = load_suite(suite_name)
+    want = suite_task_digests(suite)
     out = []
     for path in sorted((root / suite_name).glob("*.json")):
         try:
@@ -99,6 +120,7 @@ def load_entries(suite_name: str, root: Path = LEADERBOARD_DIR) -> list[Entry]:
         problems = _check(entry, suite, path)
         if problems:
             raise LeaderboardError(f"{path}: " + "; ".join(problems))
+        _check_digests(entry, want, path)
         if entry.eval_info["suite"]["hash"] != suite.hash:
             entry = replace(entry, stale=True)
         out.append(entry)
@@ -262,5 +284,5 @@ def markdown(root: Path = LEADERBOARD_DIR) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["KINDS", "LEADERBOARD_DIR", "Entry", "LeaderboardError", "build_site", "load_entries", "markdown",
-           "suites_with_results"]
+__all__ = ["KINDS", "LEADERBOARD_DIR", "Entry", "LeaderboardError", "ResultDigestError", "build_site", "load_entries",
+           "markdown", "suites_with_results"]

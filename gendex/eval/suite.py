@@ -5,6 +5,14 @@ A suite fixes what a result on it means: versioned task ids, the evaluation seed
 (default 50, as LIBERO and RoboCasa), the metric that ranks (``success_at_end``, ManiSkill's default;
 ``success_once`` is reported too), ``gym.make`` keyword arguments and an optional step limit. A result carries the
 suite file's SHA-256, so two results are comparable exactly when their hashes agree.
+
+A suite names task *versions*, and a task version is fixed by its files: the suite's tasks are the versions as
+committed in ``generated_tasks/`` (a published version never changes), whose digests
+(:meth:`~gendex_envs.task_version.TaskVersion.file_digest`) :func:`suite_task_digests` gives. ``gendex eval`` records
+the digest of each task it ran and refuses to run a task whose files differ from the committed ones (a folder on
+``GENDEX_TASKS_PATH`` registered over the id with ``GENDEX_ALLOW_OVERRIDE=1``) unless asked; the leaderboard refuses
+a result whose digests differ. The digests are not written into the suite files: they follow from the versioned ids,
+and writing them would change every suite's hash, marking every filed result stale with no task changed.
 """
 
 from __future__ import annotations
@@ -27,6 +35,42 @@ SEED_FLOOR = 1_000_000
 
 class SuiteError(GenDexError, ValueError):
     """A suite file is malformed or unknown."""
+
+
+class TaskDigestError(SuiteError):
+    """The files of a suite's task differ from the suite's (the task version as committed)."""
+
+
+def suite_task_digests(suite: Suite) -> dict[str, str]:
+    """Task id -> digest of the suite's task version as committed (``generated_tasks/<Name>/v<N>``), whatever is
+    registered under the id in this process; :class:`SuiteError` for a task the repository does not hold."""
+    from gendex_envs.registry import committed_version
+
+    out = {}
+    for task in suite.tasks:
+        version = committed_version(task)
+        if version is None:
+            raise SuiteError(f"suite {suite.name}: {task} is not a committed task version (generated_tasks/"
+                             "<Name>/v<N>); a suite's tasks must be, so that their files are fixed")
+        out[task] = version.file_digest()
+    return out
+
+
+def ran_task_digests(tasks: list[str] | tuple[str, ...]) -> dict[str, str]:
+    """Task id -> digest of the folder registered under the id in this process: what ``gym.make(id)`` runs."""
+    from gendex_envs.registry import resolve_task
+
+    return {task: resolve_task(task).file_digest() for task in tasks}
+
+
+def check_task_digests(suite: Suite, ran: dict[str, str], where: str = "") -> None:
+    """:class:`TaskDigestError` naming every task of ``ran`` whose digest differs from the suite's."""
+    want = suite_task_digests(suite)
+    bad = [f"{task}: ran on files with digest {ran[task]}, the suite's (committed) version has {want[task]}"
+           for task in ran if task in want and ran[task] != want[task]]
+    if bad:
+        raise TaskDigestError(f"{where}{'; '.join(bad)}. The task files are not the suite's: a folder on "
+                              "GENDEX_TASKS_PATH replaced the committed version, or the committed files were changed")
 
 
 @dataclass(frozen=True)
@@ -83,4 +127,5 @@ def load_suite(name: str | Path) -> Suite:
     return suite
 
 
-__all__ = ["METRICS", "SEED_FLOOR", "SUITES_DIR", "Suite", "SuiteError", "load_suite", "suite_path"]
+__all__ = ["METRICS", "SEED_FLOOR", "SUITES_DIR", "Suite", "SuiteError", "TaskDigestError", "check_task_digests",
+           "load_suite", "ran_task_digests", "suite_path", "suite_task_digests"]

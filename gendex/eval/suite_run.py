@@ -11,7 +11,10 @@ holds:
   length, env steps, failures;
 - ``aggregated``: LeRobot's ``avg_sum_reward``, ``avg_max_reward``, ``pc_success`` (over all episodes, with its
   interval), ``eval_s``, ``eval_ep_s``; and the mean of the per-task rates;
-- the suite's name, hash and metric, the policy spec, the GenDex version, and the video files if any were written.
+- the suite's name, hash and metric, the policy spec, the GenDex version, and the video files if any were written;
+- ``task_digests``: the digest of each task's files as they ran (:meth:`~gendex_envs.task_version.TaskVersion.
+  file_digest`). A run whose tasks' files differ from the suite's (the committed versions) is refused unless
+  ``allow_changed_tasks``; the leaderboard refuses such a result.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ import numpy as np
 
 from gendex.eval.metrics import wilson
 from gendex.eval.runner import EpisodeResult, evaluate_task
-from gendex.eval.suite import Suite
+from gendex.eval.suite import Suite, check_task_digests, ran_task_digests
 from gendex.fanout import Backend, ordered_map
 from gendex_envs.errors import GenDexError
 
@@ -51,7 +54,7 @@ def _gendex_version() -> str:
         return "0+unknown"
 
 
-def _done(out: Path, suite: Suite, spec: str) -> list[dict]:
+def _done(out: Path, suite: Suite, spec: str, digests: dict[str, str]) -> list[dict]:
     path = out / EPISODES_FILE
     rows = [json.loads(line) for line in path.read_text().splitlines() if line.strip()] if path.is_file() else []
     head = out / RUN_FILE
@@ -60,6 +63,10 @@ def _done(out: Path, suite: Suite, spec: str) -> list[dict]:
         if (prev["suite"], prev["suite_hash"], prev["policy"]) != (suite.name, suite.hash, spec):
             raise EvalError(f"{out} holds an evaluation of {prev['policy']} on {prev['suite']} "
                             f"({prev['suite_hash'][:12]}); use another --out for {spec} on {suite.name}")
+        changed = sorted(t for t, d in prev.get("task_digests", {}).items() if t in digests and digests[t] != d)
+        if changed:
+            raise EvalError(f"{out} holds episodes run on other files of {changed} (task digests differ); use "
+                            "another --out")
     return rows
 
 
@@ -80,8 +87,12 @@ def _task_job(job: tuple) -> list[dict]:
 
 def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episodes: int | None = None,
               workers: int = 1, training_seeds: list[int] | None = None, videos: int = 0,
-              progress: Callable[[EpisodeResult | dict], None] | None = None, backend: Backend | None = None) -> dict:
+              progress: Callable[[EpisodeResult | dict], None] | None = None, backend: Backend | None = None,
+              allow_changed_tasks: bool = False) -> dict:
     """Evaluate the policy ``spec`` (made by ``resolver(spec)()``) on ``suite``; returns and writes eval_info.
+    The tasks registered under the suite's ids must have the suite's files (the committed versions, by digest):
+    :class:`~gendex.eval.suite.TaskDigestError` otherwise, unless ``allow_changed_tasks`` (the digests that ran are
+    recorded either way).
     ``videos``: the first k episodes of each task are also recorded (``<out>/videos/``). ``backend``
     (:class:`gendex.fanout.Backend`; default ``workers`` local processes) shares the tasks among workers; a
     task's episodes are kept when its job returns, so a worker killed on Ray has the task re-run, not doubled."""
@@ -91,9 +102,16 @@ def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episode
     if leaked:
         raise EvalError(f"the policy was trained on seeds {leaked[:5]}{'...' if len(leaked) > 5 else ''} of suite "
                         f"{suite.name}'s; evaluating it there would measure memory, not skill")
+    digests = ran_task_digests(suite.tasks)
+    if allow_changed_tasks:
+        log.warning("not checking the task files against suite %s's (allow_changed_tasks): the leaderboard will "
+                    "refuse this result if they differ", suite.name)
+    else:
+        check_task_digests(suite, digests, f"suite {suite.name}: ")
     out.mkdir(parents=True, exist_ok=True)
-    rows = _done(out, suite, spec)
-    (out / RUN_FILE).write_text(json.dumps({"suite": suite.name, "suite_hash": suite.hash, "policy": spec}) + "\n")
+    rows = _done(out, suite, spec, digests)
+    (out / RUN_FILE).write_text(json.dumps({"suite": suite.name, "suite_hash": suite.hash, "policy": spec,
+                                            "task_digests": digests}) + "\n")
     have = {(r["task"], r["seed"]) for r in rows}
     jobs = [(t, [s for s in seeds if (t, s) not in have], spec, resolver, suite.env_kwargs, suite.max_episode_steps,
              max(0, videos - sum(1 for r in rows if r["task"] == t)), out / "videos") for t in suite.tasks]
@@ -115,13 +133,15 @@ def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episode
             for done in ordered_map(_task_worker, jobs, backend, ahead=len(jobs)):
                 for row in done:
                     keep(row)
-    info = eval_info(suite, spec, rows, seeds, time.perf_counter() - t0)
+    info = eval_info(suite, spec, rows, seeds, time.perf_counter() - t0, task_digests=digests)
     (out / EVAL_INFO).write_text(json.dumps(info, indent=1) + "\n")
     return info
 
 
-def eval_info(suite: Suite, spec: str, rows: list[dict], seeds: list[int], seconds: float) -> dict:
-    """The eval_info.json of ``rows`` (episode dicts), in the suite's task order and seed order."""
+def eval_info(suite: Suite, spec: str, rows: list[dict], seeds: list[int], seconds: float,
+              task_digests: dict[str, str] | None = None) -> dict:
+    """The eval_info.json of ``rows`` (episode dicts), in the suite's task order and seed order; ``task_digests``:
+    the digest of each task's files as they ran (:func:`~gendex.eval.suite.ran_task_digests`)."""
     order = {t: i for i, t in enumerate(suite.tasks)}
     rows = sorted((r for r in rows if r["task"] in order and r["seed"] in set(seeds)),
                   key=lambda r: (order[r["task"]], r["seed"]))
@@ -160,7 +180,9 @@ def eval_info(suite: Suite, spec: str, rows: list[dict], seeds: list[int], secon
     return {"suite": {"name": suite.name, "hash": suite.hash, "metric": metric, "episodes_per_task": len(seeds),
                       "seeds": [seeds[0], seeds[-1]], "complete": complete},
             "policy": spec, "gendex_version": _gendex_version(), "per_episode": per_episode, "per_task": per_task,
-            "aggregated": aggregated, "video_paths": [r["video"] for r in rows if r.get("video")]}
+            "aggregated": aggregated, "video_paths": [r["video"] for r in rows if r.get("video")],
+            **({"task_digests": {t: task_digests[t] for t in suite.tasks if t in task_digests}}
+               if task_digests is not None else {})}
 
 
 __all__ = ["EPISODES_FILE", "EVAL_INFO", "EvalError", "eval_info", "run_suite"]
