@@ -21,9 +21,11 @@ known MLP :func:`_mlp` built from the checkpoint's bounded ``config``, and its w
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import time
+import zipfile
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -55,6 +57,8 @@ CHECKPOINT_FORMAT = 2
 """2: tensors and JSON values only (``weights_only``); 1 (no ``format`` key): numpy arrays, pickled."""
 MAX_CHECKPOINT_BYTES = 512_000_000
 """A checkpoint file (the default 3 x 512 MLP is about 4 MB)."""
+MAX_RECORDS = 10_000
+"""Records in a checkpoint's torch archive (about 30 for the default MLP)."""
 MAX_HIDDEN, MAX_LAYERS, MAX_CHUNK, MAX_FEATURES = 8192, 16, 1000, 100_000
 """Bounds of a checkpoint's ``config`` and input/action sizes, checked before a network is built."""
 STEP_SCALE = 200.0
@@ -216,6 +220,19 @@ def _bad(path, problem: str) -> PolicyError:
     return PolicyError(f"BC checkpoint {path}: {problem}")
 
 
+def _check_archive(raw: bytes, path: Path) -> None:
+    """``torch.save``'s zip format, every record stored uncompressed within the file's bytes (at most
+    ``MAX_RECORDS``): torch's reader would otherwise inflate a record to whatever size the archive declares."""
+    try:
+        infos = zipfile.ZipFile(io.BytesIO(raw)).infolist()
+    except (zipfile.BadZipFile, ValueError, EOFError):
+        raise _bad(path, "not a torch archive (the zip format torch.save writes)") from None
+    if len(infos) > MAX_RECORDS:
+        raise _bad(path, f"{len(infos)} records; at most MAX_RECORDS = {MAX_RECORDS} are allowed")
+    if any(i.compress_type != zipfile.ZIP_STORED for i in infos) or sum(i.file_size for i in infos) > len(raw):
+        raise _bad(path, "compressed or oversized records; torch.save stores every record uncompressed")
+
+
 def load_checkpoint(path: Path | str) -> dict:
     """A checkpoint read with ``torch.load(weights_only=True)`` and checked (module doc): the normalization as
     float32 numpy arrays, the weights as tensors. :class:`PolicyError` naming the file when it needs pickle, is
@@ -226,8 +243,10 @@ def load_checkpoint(path: Path | str) -> dict:
     size = path.stat().st_size
     if size > MAX_CHECKPOINT_BYTES:
         raise _bad(path, f"{size} bytes; at most MAX_CHECKPOINT_BYTES = {MAX_CHECKPOINT_BYTES} are allowed")
+    raw = path.read_bytes()
+    _check_archive(raw, path)
     try:
-        ckpt = torch.load(path, map_location="cpu", weights_only=True)
+        ckpt = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
     except Exception as exc:
         text = str(exc).strip().splitlines()
         raise _bad(path, f"it holds objects that only pickle can load, which can run code from the file "

@@ -56,6 +56,9 @@ MAX_POLICY_ZIP_ENTRIES = 64
 MAX_POLICY_WEIGHTS_BYTES = 256_000_000
 """Uncompressed size of ``policy.pth`` (0.8 MB for the cpu preset; about 30 MB for the paper's [1024, 1024, 512]
 at 1000 observations)."""
+MAX_TORCH_RECORDS = 10_000
+"""Records in the torch archive inside ``policy.pth`` (19 for the cpu preset); each must be stored uncompressed,
+as ``torch.save`` writes them, so nothing in it inflates past the bytes already bounded."""
 MAX_OBS_DIM = 10_000
 MAX_ACTION_DIM = 64
 MAX_LAYERS = 8
@@ -153,6 +156,21 @@ def _check_architecture(arch, path) -> dict:
     return arch
 
 
+def check_torch_archive(raw: bytes, path, error: type[Exception], max_records: int) -> None:
+    """Refuse (``error`` naming ``path``) bytes that are not ``torch.save``'s zip format with at most
+    ``max_records`` records, each stored uncompressed and within the bytes given: torch's reader would otherwise
+    inflate records to whatever size the archive declares."""
+    try:
+        infos = zipfile.ZipFile(io.BytesIO(raw)).infolist()
+    except (zipfile.BadZipFile, ValueError, EOFError):
+        raise error(f"{path}: not a torch archive (the zip format torch.save writes)") from None
+    if len(infos) > max_records:
+        raise error(f"{path}: {len(infos)} records in its torch archive; at most {max_records} are allowed")
+    if any(i.compress_type != zipfile.ZIP_STORED for i in infos) or sum(i.file_size for i in infos) > len(raw):
+        raise error(f"{path}: its torch archive has compressed or oversized records; torch.save stores every "
+                    "record uncompressed")
+
+
 def read_policy_weights(path: str | Path) -> dict[str, torch.Tensor]:
     """The state dict in a stable-baselines3 policy zip, read without unpickling anything but tensors: only the
     ``policy.pth`` entry, sizes checked from the zip's directory first, ``torch.load(weights_only=True)``, every
@@ -175,6 +193,7 @@ def read_policy_weights(path: str | Path) -> dict[str, torch.Tensor]:
         if isinstance(exc, PolicyError):
             raise
         raise _refuse(path, f"not a readable policy zip ({type(exc).__name__}: {exc})") from None
+    check_torch_archive(raw, f"{path}: {WEIGHTS_ENTRY}", PolicyError, MAX_TORCH_RECORDS)
     try:
         state = torch.load(io.BytesIO(raw), map_location="cpu", weights_only=True)
     except Exception as exc:

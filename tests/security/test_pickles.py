@@ -257,3 +257,32 @@ def test_the_committed_hostile_bc_checkpoint_runs_no_payload(tmp_path, monkeypat
     with pytest.raises(PolicyError, match="only pickle can load"):
         BCPolicy(HOSTILE / "bc_pickle.pt")
     assert not marker.exists()
+
+
+def _deflated(raw: bytes) -> bytes:
+    """The torch archive ``raw`` with every record deflated (torch's reader inflates them to their declared size)."""
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(raw)) as zin, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            zout.writestr(item.filename, zin.read(item))
+    return out.getvalue()
+
+
+def test_a_compressed_torch_archive_is_refused_before_it_is_inflated(tmp_path):
+    """64 MB of weights in 70 kB: torch.load would inflate them; the archive's directory refuses them first."""
+    buf = io.BytesIO()
+    torch.save({"action_net.weight": torch.zeros(16_000_000)}, buf)
+    bomb = _deflated(buf.getvalue())
+    assert len(bomb) < 200_000
+    src = _committed("v0")
+    files = PolicyFiles("rotate_ball", tmp_path / "rotate_ball.zip", tmp_path / "rotate_ball.json")
+    shutil.copy(src.record, files.record)
+    with zipfile.ZipFile(src.model) as zin, zipfile.ZipFile(files.model, "w") as zout:
+        for item in zin.infolist():
+            zout.writestr(item.filename, bomb if item.filename == "policy.pth" else zin.read(item))
+    with pytest.raises(PolicyError, match="compressed or oversized records"):
+        read_policy_weights(files.model)
+    path = tmp_path / "bc.pt"
+    path.write_bytes(bomb)
+    with pytest.raises(PolicyError, match=r"bc\.pt: compressed or oversized records"):
+        load_checkpoint(path)
