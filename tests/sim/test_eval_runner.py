@@ -67,6 +67,11 @@ def test_a_suite_run_resumes_where_it_stopped_and_refuses_seeds_a_policy_learned
     first = run_suite(suite, "hold", resolve_policy, out)
     assert [e["seed"] for e in first["per_episode"]] == [3_000_000, 3_000_001]
     assert first["suite"]["complete"] and first["per_task"]["GenDex/PutAppleBowl-v1"]["episodes"] == 2
+    from gendex_envs.registry import committed_version
+
+    digest = committed_version("GenDex/PutAppleBowl-v1").file_digest()
+    assert first["task_digests"] == {"GenDex/PutAppleBowl-v1": digest}
+    assert json.loads((out / "eval_run.json").read_text())["task_digests"] == first["task_digests"]
     lines = (out / EPISODES_FILE).read_text().splitlines()
     (out / EPISODES_FILE).write_text(lines[0] + "\n")  # as if stopped after the first episode
     seen = []
