@@ -20,13 +20,15 @@ env and the module sees only the view.
 
 Modules written by a language model are validated by the generator before they are committed. A module from a
 folder that is not trusted (anything but the repository's committed tasks, unless the user trusts it) is checked
-again here, statically, before it is imported, and runs under the runtime guard (:mod:`gendex_envs.guard`).
+again here, statically, before it runs, and runs under the runtime guard (:mod:`gendex_envs.guard`). Every module,
+trusted or not, is read once as UTF-8 and that exact text is checked and run: nothing is imported from the task
+folder, so a ``coding:`` declaration, a byte-order mark or a ``__pycache__`` shipped with it cannot change what
+runs, and files the task layout does not name are ignored.
 """
 
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import logging
 import sys
 from collections.abc import Callable
@@ -35,7 +37,8 @@ from pathlib import Path
 from types import ModuleType
 
 from gendex_envs import guard
-from gendex_envs.code_check import check_reward_file
+from gendex_envs.code_check import check_reward_source
+from gendex_envs.code_check.source import compile_reward_source, read_reward_source
 from gendex_envs.errors import RewardCodeError, RewardModuleError
 from gendex_envs.reward_view import view_args, view_of
 
@@ -57,11 +60,18 @@ class RewardModule:
 
 
 def load_reward_module(path: str | Path, trusted: bool | None = None, static_check: bool = True) -> RewardModule:
-    """Import ``path`` as a private module and check its interface; raises :class:`RewardModuleError`.
+    """Run ``path`` as a private module and check its interface; raises :class:`RewardModuleError`.
+
+    The file is read once, strictly as UTF-8 (:func:`~gendex_envs.code_check.source.read_reward_source`: a
+    ``coding:`` declaration or byte-order mark naming another encoding is refused), and that exact text is
+    checked, compiled and executed in a fresh module namespace. Nothing is imported from the folder's path, so no
+    ``__pycache__`` is read or written and no other file of the folder (extra ``.py``, ``.pyc``, ``.so``) is looked
+    at. This is one code path for trusted and untrusted modules; the code objects name the real path, by which the
+    runtime guard's audit hook recognises untrusted frames.
 
     ``trusted`` defaults to the folder's trust (:func:`gendex_envs.guard.is_trusted`: the repository's committed
     tasks, or ``trust_remote_code``). An untrusted module is first statically checked
-    (:func:`gendex_envs.code_check.check_reward_file`; a rejection is a :class:`RewardModuleError` listing every
+    (:func:`gendex_envs.code_check.check_reward_source`; a rejection is a :class:`RewardModuleError` listing every
     problem, raised before any of its code runs), then its folder goes under the
     runtime guard's audit hook and it runs with restricted builtins and read-only copies of its modules
     (:mod:`gendex_envs.guard`). ``static_check=False`` skips the static check of an untrusted module (the probe's
@@ -70,10 +80,14 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
     if not path.is_file():
         raise RewardModuleError(f"reward module {path} does not exist; every task version needs a task reward module")
     trusted = guard.is_trusted(path) if trusted is None else trusted
+    try:
+        source = read_reward_source(path, str(path))
+    except RewardCodeError as exc:
+        raise RewardModuleError(f"reward module {path} was refused before any of it ran: {exc}") from exc
     if not trusted:
         if static_check:
             try:
-                check_reward_file(path, str(path))
+                check_reward_source(source, str(path))
             except RewardCodeError as exc:
                 raise RewardModuleError(
                     f"reward module {path} is not trusted (not a committed task of this repository) and the static "
@@ -82,14 +96,16 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
         guard.untrust(path.parent)
     digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
     name = f"gendex_reward_{path.parent.parent.name}_{path.parent.name}_{digest}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    module: ModuleType = importlib.util.module_from_spec(spec)
+    module = ModuleType(name)
+    module.__file__ = str(path)
     if not trusted:
         module.__dict__["__builtins__"] = guard.restricted_builtins()
     try:
-        spec.loader.exec_module(module)
+        code = compile_reward_source(source, path)
+        exec(code, module.__dict__)  # the checked text, compiled here: never the folder's own bytecode
     except Exception as exc:
         raise RewardModuleError(f"reward module {path} failed to import: {type(exc).__name__}: {exc}") from exc
+    # registered like an imported module, so pickle, inspect and warnings can find its functions by __module__
     sys.modules.setdefault(name, module)
     missing = [f for f in REQUIRED_FUNCTIONS if not callable(getattr(module, f, None))]
     if missing:

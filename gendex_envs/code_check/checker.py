@@ -94,6 +94,7 @@ from gendex_envs.code_check.rules import (
     REJECTED_NODE_REASONS,
     REQUIRED_FUNCTIONS,
 )
+from gendex_envs.code_check.source import read_reward_source
 from gendex_envs.errors import RewardCodeError, UnsafeCodeError
 
 
@@ -463,14 +464,11 @@ def check_reward_source(source: str, filename: str = "<reward module>") -> None:
     raise error("\n".join([head, *lines]))
 
 
-def check_reward_file(path: str | Path, filename: str | None = None) -> None:
-    """:func:`check_reward_source` on a file (``filename`` defaults to the file's name)."""
+def check_reward_file(path: str | Path, filename: str | None = None) -> str:
+    """:func:`check_reward_source` on a file (``filename`` defaults to the file's name), read once and strictly as
+    UTF-8 by :func:`~gendex_envs.code_check.source.read_reward_source`; returns the text that was checked, which
+    is the text to run."""
     path = Path(path)
-    name = filename or path.name
-    if not path.is_file():
-        raise FileNotFoundError(f"reward module {path} does not exist")
-    try:
-        source = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise RewardCodeError(f"{name}: not valid UTF-8 text ({exc})") from None
-    check_reward_source(source, name)
+    source = read_reward_source(path, filename or path.name)
+    check_reward_source(source, filename or path.name)
+    return source

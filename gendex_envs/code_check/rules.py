@@ -132,6 +132,9 @@ MAX_REPEAT = 10_000
 
 MAX_SOURCE_CHARS = 100_000
 """Longer sources are rejected unparsed (reward modules are a few dozen lines)."""
+MAX_SOURCE_BYTES = 4 * MAX_SOURCE_CHARS + 3
+"""A reward module file is never read past this many bytes (the most :data:`MAX_SOURCE_CHARS` characters of UTF-8
+take, plus a byte-order mark)."""
 MAX_LISTED_PROBLEMS = 20
 
 _FEEDBACK_HINT = ("reward code is pure tensor arithmetic on env state: import only torch, math and "

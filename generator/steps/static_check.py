@@ -12,9 +12,9 @@ from gendex_envs import errors as runtime_errors
 from generator.errors import RewardCodeError, UnsafeCodeError
 
 
-def _translated(check, *args) -> None:
+def _translated(check, *args):
     try:
-        check(*args)
+        return check(*args)
     except runtime_errors.UnsafeCodeError as exc:
         if isinstance(exc, UnsafeCodeError):
             raise
@@ -30,6 +30,7 @@ def check_reward_source(source: str, filename: str = "<reward module>") -> None:
     _translated(code_check.check_reward_source, source, filename)
 
 
-def check_reward_file(path: str | Path, filename: str | None = None) -> None:
-    """:func:`gendex_envs.code_check.check_reward_file`, raising the generator's error types."""
-    _translated(code_check.check_reward_file, path, filename)
+def check_reward_file(path: str | Path, filename: str | None = None) -> str:
+    """:func:`gendex_envs.code_check.check_reward_file` (the file read once, strictly as UTF-8; returns the checked
+    text), raising the generator's error types."""
+    return _translated(code_check.check_reward_file, path, filename)

@@ -56,7 +56,7 @@ import gendex_envs.reward_module
 from gendex_envs.task_env import TaskEnv
 from gendex_envs import guard
 if sys.argv[4] == "skip-static-check":  # to reach the runtime fences, as code that got past the check would
-    gendex_envs.reward_module.check_reward_file = lambda *args: None
+    gendex_envs.reward_module.check_reward_source = lambda *args: None
 out = {"steps": 0, "error": None}
 try:
     env = TaskEnv(task=sys.argv[1], obs_mode="state", control_mode="pd_joint_delta_pos", render_backend="none",
