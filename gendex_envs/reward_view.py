@@ -18,7 +18,9 @@ environment-API prompt (``prompts/env_api.txt``) documents, under the same names
 
 ``info``, ``obs`` and ``action`` passed to reward functions are copies as well (a read-only :class:`TensorsView`
 that copies each entry read, or :func:`copy_tensors`), so writing into ``info["success"]`` cannot change what the
-env reports.
+env reports. The ``info`` reward code receives also lacks the env's per-episode bookkeeping
+(:data:`HIDDEN_INFO_KEYS`, :func:`reward_info`): a reward that knew the step count could behave during the reward
+probe's first steps and misbehave after them without keeping any state of its own.
 """
 
 from __future__ import annotations
@@ -65,6 +67,19 @@ def copy_tensors(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return type(value)(copy_tensors(v) for v in value)
     return value
+
+
+HIDDEN_INFO_KEYS = frozenset({"elapsed_steps"})
+"""Keys of the env's ``info`` that reward code does not see: ManiSkill's per-episode step count. ``evaluate`` may
+not return them or any other bookkeeping key (:data:`gendex_envs.reward_checks.RESERVED_INFO_KEYS`), so the info
+reward code reads holds ``success``, ``fail`` and the module's own diagnostics only."""
+
+
+def reward_info(info: Any) -> Any:
+    """``info`` as reward code may see it: without :data:`HIDDEN_INFO_KEYS` (a new dict, only when one is there)."""
+    if isinstance(info, Mapping) and not HIDDEN_INFO_KEYS.isdisjoint(info.keys()):
+        return {k: v for k, v in info.items() if k not in HIDDEN_INFO_KEYS}
+    return info
 
 
 class TensorsView(Mapping):

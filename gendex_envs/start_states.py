@@ -19,6 +19,7 @@ import json
 import logging
 import math
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -150,7 +151,8 @@ class StartStates:
                        obj_reset_quat={k: z[f"quat/{k}"] for k in meta["objects"] if f"quat/{k}" in z})
         except StageError as e:
             raise StageError(f"{path}: {e}") from None
-        except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile) as e:
+        except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError,
+                RuntimeError) as e:  # corrupt deflate data, unknown compression, encrypted entries
             raise StageError(f"{path} is not a GenDex start-state file: {type(e).__name__}: {e}") from e
 
     @classmethod

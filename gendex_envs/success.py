@@ -24,8 +24,9 @@ from typing import TYPE_CHECKING
 
 import torch
 
-from gendex_envs.errors import RewardModuleError, TaskSpecError
+from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import box_rest_point, xy_distance, z_twist
+from gendex_envs.reward_checks import check_evaluate
 from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, TaskSpec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -156,23 +157,16 @@ class Judge:
         return cls(f"stage {stage.name} of {spec.name}", spec.stage_conditions(stage), module, stage.name)
 
     def evaluate(self, env: TaskEnv) -> dict[str, torch.Tensor]:
-        """The module's diagnostics with ``success`` and ``fail`` ([N] bool) decided as the module doc says."""
-        info = self.module.evaluate(env)
+        """The module's diagnostics with ``success`` and ``fail`` ([N] bool) decided as the module doc says. What
+        the module returns is checked on every call (:func:`gendex_envs.reward_checks.check_evaluate`: no
+        ``success`` or other reserved key, [N] tensors, finite values); a broken rule raises
+        :class:`~gendex_envs.reward_checks.RewardOutputError`."""
         n = env.num_envs
-        if not isinstance(info, dict):
-            raise RewardModuleError(f"{self.module.path}: evaluate() must return a dict of [num_envs] tensors, got "
-                                    f"{type(info).__name__}")
-        if "success" in info:
-            raise RewardModuleError(f"{self.module.path}: evaluate() returned 'success', but success is declared in "
-                                    "the task spec (success.conditions, stages[].success); evaluate returns 'fail' "
-                                    "and diagnostics only")
-        info = dict(info)
+        info = check_evaluate(self.module.evaluate(env), n, env.device, path=self.module.path,
+                              step=getattr(env, "elapsed_steps", None))
         fail = info.get("fail")
         if fail is None:
             fail = torch.zeros(n, dtype=torch.bool, device=env.device)
-        elif not isinstance(fail, torch.Tensor) or fail.shape != (n,) or fail.dtype != torch.bool:
-            raise RewardModuleError(f"{self.module.path}: evaluate()['fail'] must be a bool tensor of shape [{n}], got "
-                                    f"{getattr(fail, 'dtype', type(fail))} {tuple(getattr(fail, 'shape', ()))}")
         info["success"] = conditions_hold(env, self.conditions) & ~fail
         info["fail"] = fail
         return info

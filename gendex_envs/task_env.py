@@ -57,7 +57,9 @@ from gendex_envs.heap import freeze_long_lived
 from gendex_envs.observation import flat_float_state
 from gendex_envs.physx import read_pose
 from gendex_envs.placement import Footprint, Item, place
+from gendex_envs.reward_checks import RESERVED_OBS_KEYS, check_obs_extra, check_reward
 from gendex_envs.reward_module import RewardModule, load_reward_module
+from gendex_envs.reward_view import reward_info
 from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
 from gendex_envs.start_states import StartStates
 from gendex_envs.success import Judge, conditions_hold
@@ -605,12 +607,14 @@ class TaskEnv(BaseEnv):
         return common.flatten_state_dict(state, use_torch=True, device=self.device)
 
     def own_obs_keys(self) -> frozenset[str]:
-        """Names of the state observations the env provides itself (a reward module's extras may not reuse them)."""
+        """Names of the state observations the env provides itself, its extras and the agent's, and the
+        observation's top-level names (:data:`~gendex_envs.reward_checks.RESERVED_OBS_KEYS`): a reward module's
+        extras may not reuse them."""
         keys = {"palm_pose", "tip_pos", *(f"{n}_pose" for n in self.objects),
                 *(f"{n}_qpos" for n in self.articulations)}
         if self.goal_site is not None:
             keys.add("goal_pos")
-        return frozenset(keys)
+        return frozenset(keys) | RESERVED_OBS_KEYS
 
     def _get_obs_extra(self, info: dict) -> dict:
         extra = dict(palm_pose=self.palm_pose.raw_pose, tip_pos=self.tip_positions.flatten(1))
@@ -620,8 +624,10 @@ class TaskEnv(BaseEnv):
                 extra[f"{name}_qpos"] = self.articulations[name].get_qpos()
         if self.goal_site is not None:
             extra["goal_pos"] = read_pose(self.goal_site).p
-        if self.reward.get_obs_extra is not None:
-            extra.update(self.reward.get_obs_extra(self, info))
+        module = self.reward
+        if module.get_obs_extra is not None:  # checked on every call: no key of the env's own, finite [N, k]
+            extra.update(check_obs_extra(module.get_obs_extra(self, reward_info(info)), self.num_envs, self.device,
+                                         extra, path=module.path, step=self.elapsed_steps))
         return extra
 
     def _flatten_raw_obs(self, obs):
@@ -629,7 +635,11 @@ class TaskEnv(BaseEnv):
         return flat if flat is not None else super()._flatten_raw_obs(obs)
 
     def compute_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
-        return self.reward.compute_dense_reward(self, obs, action, info)
+        """The reward module's reward, checked on every call (finite float [N]); its ``info`` lacks the env's
+        bookkeeping (:func:`~gendex_envs.reward_view.reward_info`)."""
+        module = self.reward
+        return check_reward(module.compute_dense_reward(self, obs, action, reward_info(info)), self.num_envs,
+                            self.device, path=module.path, step=self.elapsed_steps)
 
     def compute_normalized_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
         return self.compute_dense_reward(obs, action, info) / self.reward.reward_max

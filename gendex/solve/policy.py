@@ -24,6 +24,7 @@ import io
 import logging
 import math
 import zipfile
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -189,9 +190,9 @@ def read_policy_weights(path: str | Path) -> dict[str, torch.Tensor]:
                 raise _refuse(path, f"{WEIGHTS_ENTRY} of {info.file_size} bytes; at most MAX_POLICY_WEIGHTS_BYTES = "
                                     f"{MAX_POLICY_WEIGHTS_BYTES} are allowed")
             raw = z.read(info)  # zipfile stops at the declared size (and checks the CRC)
-    except (zipfile.BadZipFile, OSError, EOFError, ValueError) as exc:
-        if isinstance(exc, PolicyError):
-            raise
+    except PolicyError:
+        raise
+    except (zipfile.BadZipFile, OSError, EOFError, ValueError, zlib.error, NotImplementedError, RuntimeError) as exc:
         raise _refuse(path, f"not a readable policy zip ({type(exc).__name__}: {exc})") from None
     check_torch_archive(raw, f"{path}: {WEIGHTS_ENTRY}", PolicyError, MAX_TORCH_RECORDS)
     try:

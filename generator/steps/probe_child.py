@@ -92,19 +92,6 @@ def _when(step: int) -> str:
     return "right after reset (step 0)" if step == 0 else f"at step {step}"
 
 
-def _describe(value) -> str:
-    """Short description of a returned value for error messages: type, dtype, shape, device."""
-    import torch
-
-    if isinstance(value, torch.Tensor):
-        return f"a {value.dtype} tensor of shape {tuple(value.shape)} on {value.device}"
-    if isinstance(value, bool | int | float):
-        return f"a Python {type(value).__name__} ({value!r})"
-    if value is None:
-        return "None"
-    return f"a {type(value).__module__}.{type(value).__qualname__}"
-
-
 def _exception_text(exc: BaseException, module_path: Path, fn: str | None = None) -> str:
     """``Type: message at line N (`code`)``; the line is the deepest frame inside the reward module."""
     text = f"{type(exc).__name__}: {exc}".strip()
@@ -173,118 +160,46 @@ class _CheckedModule:
     def fail(self, fn_name: str, message: str) -> _Violation:
         return _Violation("violation", fn_name, self.step, f"{_when(self.step)}, {fn_name} {message}")
 
-    # -------------------------------------------------------------- checks (batched; no per-env loops)
-    def _check_device(self, fn: str, what: str, value) -> None:
-        dev = value.device
-        if dev.type != self.device.type or (self.device.index is not None and dev.index != self.device.index):
-            raise self.fail(fn, f"returned {what} on {dev}; expected the env's device {self.device} "
-                            "(create tensors with device=env.device)")
+    # -------------------------------------------------------------- checks
+    # The rules on what each function returns are the env's own (gendex_envs.reward_checks, applied on every call
+    # of every env); here their RewardOutputError becomes the probe's violation record. The probe adds two rules of
+    # its own: generated modules return 'fail', and observation shapes stay the same from step to step.
+    def _checked(self, fn: str, check, *args, **kwargs):
+        from gendex_envs.reward_checks import RewardOutputError
 
-    def _check_finite(self, fn: str, what: str, value) -> None:
-        if value.is_floating_point() or value.is_complex():
-            bad = ~self.torch.isfinite(value)
-            if bool(bad.any()):
-                kinds = []
-                if bool(self.torch.isnan(value).any()):
-                    kinds.append("NaN")
-                if bool(self.torch.isinf(value).any()):
-                    kinds.append("inf")
-                envs = bad.reshape(bad.shape[0], -1).any(dim=1).nonzero().flatten()[:8].tolist() \
-                    if bad.dim() else []
-                raise self.fail(fn, f"returned non-finite values ({'/'.join(kinds)}) in {what} for env(s) {envs}; "
-                                "guard divisions, logs and square roots (e.g. clamp denominators with "
-                                ".clamp(min=1e-6))")
-
-    def _check_flag(self, info: dict, key: str) -> None:
-        n = self.n
-        value = info[key]
-        torch = self.torch
-        expected = f"a torch.bool tensor of shape ({n},) on {self.device}"
-        if not isinstance(value, torch.Tensor):
-            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected {expected}")
-        if value.dtype != torch.bool:
-            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected {expected} (use a "
-                            "comparison such as `dist < 0.05`, or `.bool()`)")
-        if tuple(value.shape) != (n,):
-            raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; expected shape ({n},), one "
-                            "flag per env ([num_envs])")
-        self._check_device("evaluate", repr(key), value)
+        try:
+            return check(*args, self.n, self.device, path=self.module.path, step=self.step, **kwargs)
+        except RewardOutputError as exc:
+            raise self.fail(fn, exc.problem) from None
 
     def evaluate(self, env) -> dict:
-        torch = self.torch
-        info = self.call("evaluate", self.module.evaluate, env)
-        if not isinstance(info, dict):
-            raise self.fail("evaluate", f"returned {_describe(info)}; expected a dict with 'fail' ([{self.n}] bool "
-                            "tensor) and diagnostics")
-        bad_keys = [k for k in info if not isinstance(k, str)]
-        if bad_keys:
-            raise self.fail("evaluate", f"returned non-string keys {bad_keys[:5]!r}; info keys must be strings")
-        if "success" in info:
-            raise self.fail("evaluate", "returned 'success', but success is declared in the task spec "
-                            "(success.conditions, stages[].success) and decided by the env; return 'fail' and "
-                            "diagnostics only")
+        from gendex_envs.reward_checks import check_evaluate
+
+        info = self._checked("evaluate", check_evaluate, self.call("evaluate", self.module.evaluate, env))
         if "fail" not in info:
             raise self.fail("evaluate", f"returned keys {sorted(info)} without 'fail'; generated reward modules "
                             "must return 'fail' as a [num_envs] bool tensor (all False when nothing counts as "
                             "failure, e.g. `torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)`)")
-        if "elapsed_steps" in info:
-            raise self.fail("evaluate", "returned the key 'elapsed_steps', which the env sets itself; rename it")
-        self._check_flag(info, "fail")
-        for key, value in info.items():
-            if key == "fail":
-                continue
-            if not isinstance(value, torch.Tensor) or value.dim() == 0 or value.shape[0] != self.n:
-                raise self.fail("evaluate", f"returned {key!r} as {_describe(value)}; every info entry must be a "
-                                f"tensor with leading dimension num_envs={self.n} ([num_envs, ...])")
-            self._check_device("evaluate", repr(key), value)
-            self._check_finite("evaluate", repr(key), value)
         return info
 
     def compute_dense_reward(self, env, obs, action, info):
-        torch = self.torch
+        from gendex_envs.reward_checks import check_reward
+
         self.successes.append(info["success"].detach().clone())  # as the env decided it (conditions, fail)
         self.fails.append(info["fail"].detach().clone())
-        reward = self.call("compute_dense_reward", self.module.compute_dense_reward, env, obs, action, info)
-        expected = f"a float tensor of shape ({self.n},) on {self.device}"
-        if not isinstance(reward, torch.Tensor):
-            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected {expected}, one reward "
-                            "per env")
-        if not reward.is_floating_point():
-            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected {expected} "
-                            "(convert with `.float()`)")
-        if tuple(reward.shape) != (self.n,):
-            hint = " (drop the trailing dimension, e.g. `.squeeze(-1)`)" if reward.dim() == 2 and \
-                reward.shape[0] == self.n and reward.shape[1] == 1 else ""
-            raise self.fail("compute_dense_reward", f"returned {_describe(reward)}; expected shape ({self.n},) "
-                            f"([num_envs]){hint}")
-        self._check_device("compute_dense_reward", "the reward", reward)
-        self._check_finite("compute_dense_reward", "the reward", reward)
+        reward = self._checked("compute_dense_reward", check_reward,
+                               self.call("compute_dense_reward", self.module.compute_dense_reward, env, obs, action,
+                                         info))
         self.rewards.append(reward.detach().float().clone())
         return reward
 
     def get_obs_extra(self, env, info) -> dict:
-        torch = self.torch
+        from gendex_envs.reward_checks import check_obs_extra
+
         fn = "_get_obs_extra"
-        extra = self.call(fn, self.module.get_obs_extra, env, info)
-        if not isinstance(extra, dict):
-            raise self.fail(fn, f"returned {_describe(extra)}; expected a dict of [num_envs, ...] tensors")
+        extra = self._checked(fn, check_obs_extra, self.call(fn, self.module.get_obs_extra, env, info),
+                              taken=self.reserved_obs_keys)
         for key, value in extra.items():
-            if not isinstance(key, str):
-                raise self.fail(fn, f"returned the non-string key {key!r}; observation keys must be strings")
-            if key in self.reserved_obs_keys:
-                raise self.fail(fn, f"returned the key {key!r}, which would replace the env's own observation "
-                                f"of that name (taken: {sorted(self.reserved_obs_keys)}); rename it")
-            if not isinstance(value, torch.Tensor) or value.dim() == 0 or value.shape[0] != self.n:
-                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; expected a tensor with leading "
-                                f"dimension num_envs={self.n} ([num_envs] or [num_envs, k])")
-            if value.dim() > 2:
-                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; state observations are flattened "
-                                "per env, so use at most 2 dimensions (e.g. `.flatten(1)`)")
-            if value.is_complex() or not (value.is_floating_point() or value.dtype in (torch.bool, torch.int32,
-                                                                                        torch.int64)):
-                raise self.fail(fn, f"returned {key!r} as {_describe(value)}; expected a float tensor")
-            self._check_device(fn, repr(key), value)
-            self._check_finite(fn, repr(key), value)
             shape = tuple(value.shape)
             first = self.obs_shapes.setdefault(key, shape)
             if first != shape:

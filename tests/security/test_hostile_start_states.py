@@ -110,3 +110,51 @@ def test_the_committed_hostile_start_states_are_refused(path):
 
 def test_the_committed_corpus_is_there():
     assert len(list(HOSTILE.glob("start_states_*.npz"))) == 6
+
+
+def _reference_bytes() -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    rng = np.random.default_rng(0)
+    q = rng.normal(size=(4, 4))
+    np.savez_compressed(buf, state=rng.normal(size=(4, 6)).astype(np.float32),
+                        meta=np.array(json.dumps({"stage": "s", "source": "x", "objects": ["box"]})),
+                        **{"pos/box": rng.normal(size=(4, 3)).astype(np.float32),
+                           "quat/box": (q / np.linalg.norm(q, axis=1, keepdims=True)).astype(np.float32)})
+    return buf.getvalue()
+
+
+REFERENCE = _reference_bytes()
+
+
+@pytest.fixture(scope="module")
+def fuzz_file(tmp_path_factory) -> Path:
+    """The file each fuzz case is written to (module-scoped: hypothesis runs many cases per test call)."""
+    return tmp_path_factory.mktemp("fuzz") / "s.npz"
+
+
+def test_the_reference_file_loads(fuzz_file):
+    fuzz_file.write_bytes(REFERENCE)
+    assert len(StartStates.load(fuzz_file)) == 4
+
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=300, derandomize=True, database=None, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(edits=st.lists(st.tuples(st.integers(0, len(REFERENCE) - 1), st.integers(0, 255)), min_size=1, max_size=8),
+       cut=st.one_of(st.none(), st.integers(0, len(REFERENCE))))
+def test_fuzz_the_start_state_loader_finds_only_stage_errors(fuzz_file, edits, cut):
+    """Byte edits and truncations of a valid file: it loads with finite, bounded values, or a StageError."""
+    data = bytearray(REFERENCE)
+    for offset, value in edits:
+        data[offset] = value
+    fuzz_file.write_bytes(bytes(data[:cut]))
+    try:
+        states = StartStates.load(fuzz_file)
+    except StageError:
+        return
+    assert np.isfinite(states.state).all() and np.abs(states.state).max() <= 10_000
