@@ -57,6 +57,10 @@ CHECKPOINT_FORMAT = 2
 """2: tensors and JSON values only (``weights_only``); 1 (no ``format`` key): numpy arrays, pickled."""
 MAX_CHECKPOINT_BYTES = 512_000_000
 """A checkpoint file (the default 3 x 512 MLP is about 4 MB)."""
+ENV_KWARGS = {"control_mode": str, "control_joint": str, "obs_mode": str, "sensor_resolution": int,
+              "reconfiguration_freq": int}
+"""The ``gym.make`` keyword arguments a checkpoint may ask for (those a GenDex dataset records), with their types:
+a checkpoint never chooses ``trust_remote_code``, start states or any other argument."""
 MAX_RECORDS = 10_000
 """Records in a checkpoint's torch archive (about 30 for the default MLP)."""
 MAX_HIDDEN, MAX_LAYERS, MAX_CHUNK, MAX_FEATURES = 8192, 16, 1000, 100_000
@@ -288,6 +292,10 @@ def load_checkpoint(path: Path | str) -> dict:
     if not isinstance(ckpt["task_id"], str) or not isinstance(ckpt["env_kwargs"], dict) \
             or not all(type(s) is int for s in ckpt["training_seeds"]):
         raise _bad(path, "task_id must be a string, env_kwargs a mapping and training_seeds integers")
+    for key, value in ckpt["env_kwargs"].items():
+        if key not in ENV_KWARGS or type(value) is not ENV_KWARGS[key]:
+            raise _bad(path, f"env_kwargs {key}={str(value)[:60]!r}: a checkpoint may only set "
+                             f"{', '.join(f'{k} ({t.__name__})' for k, t in ENV_KWARGS.items())}")
     return ckpt
 
 

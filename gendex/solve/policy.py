@@ -234,6 +234,9 @@ def load_policy_network(files: PolicyFiles) -> tuple[object, dict]:
     """(network, record) of a trained policy, loaded safely (module doc)."""
     meta = read_policy_record(files.record)
     arch = policy_architecture(meta)
+    if isinstance(arch, dict) and arch.get("obs_dim") != len(meta["obs_norm"]["mean"]):
+        raise _refuse(files.record, f"architecture obs_dim {arch.get('obs_dim')!r} differs from the "
+                                    f"{len(meta['obs_norm']['mean'])} values of obs_norm")
     return build_policy_network(arch, read_policy_weights(files.model), files.model), meta
 
 

@@ -160,6 +160,13 @@ def test_a_record_whose_architecture_does_not_fit_its_weights_is_refused(tmp_pat
     files.record.write_text(json.dumps(meta))
     with pytest.raises(PolicyError, match="MAX_LAYER_WIDTH"):
         load_policy_network(files)
+    meta["architecture"] = dict(meta["architecture"], net_arch=[256, 256], obs_dim=135)
+    files.record.write_text(json.dumps(meta))
+    with pytest.raises(PolicyError, match="obs_dim 135 differs from the 136 values of obs_norm"):
+        load_policy_network(files)
+    meta["architecture"]["obs_dim"] = 136
+    files.record.write_text(json.dumps(meta))
+    assert load_policy_network(files)[0].action_net.out_features == 20  # the recorded architecture loads
 
 
 # --------------------------------------------------------------------------------------------- BC checkpoints
@@ -286,3 +293,15 @@ def test_a_compressed_torch_archive_is_refused_before_it_is_inflated(tmp_path):
     path.write_bytes(bomb)
     with pytest.raises(PolicyError, match=r"bc\.pt: compressed or oversized records"):
         load_checkpoint(path)
+
+
+@pytest.mark.parametrize("key, value", [("trust_remote_code", True), ("start_states", "/etc/passwd"),
+                                        ("control_mode", 3)])
+def test_a_bc_checkpoint_cannot_choose_gym_make_arguments_beyond_what_a_dataset_records(tmp_path, key, value):
+    """``gendex bc eval`` builds the env with the checkpoint's env_kwargs: a checkpoint must not turn on
+    trust_remote_code for the task it is evaluated on, nor hand the env a file."""
+    path = _toy_checkpoint(tmp_path / "bc.pt")
+    ckpt = torch.load(path, weights_only=True)
+    torch.save(dict(ckpt, env_kwargs={"control_mode": "pd_joint_pos", key: value}), path)
+    with pytest.raises(PolicyError, match=f"env_kwargs {key}="):
+        BCPolicy(path)
