@@ -33,6 +33,15 @@ class RewardModuleError(GenDexError, ImportError):
     """A task's reward module is missing, fails to import or lacks a required function."""
 
 
+class RewardSandboxError(GenDexError, RuntimeError):
+    """Untrusted reward code could not run in the sandbox's confined worker: the system cannot confine one, the
+    worker died or hit a limit, or its reply broke the wire format (:mod:`gendex_envs.sandbox`)."""
+
+
+class RewardTimeoutError(RewardSandboxError, TimeoutError):
+    """A call of untrusted reward code ran past the sandbox's wall-clock limit (the worker was stopped)."""
+
+
 class RewardCodeError(GenDexError, ValueError):
     """Reward code does not parse or lacks its interface (the static check, :mod:`gendex_envs.code_check`)."""
 

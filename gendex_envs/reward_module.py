@@ -94,6 +94,10 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
                     f"check rejected it before any of it ran; trust_remote_code=True runs a folder you wrote as it "
                     f"is.\n{exc}") from exc
         guard.untrust(path.parent)
+        from gendex_envs import sandbox  # here: the sandbox builds RewardModules of this module
+
+        if sandbox.enabled():  # the second wall: a confined worker process runs it (gendex_envs.sandbox)
+            return sandbox.load(path, source)
     digest = hashlib.sha1(str(path).encode()).hexdigest()[:10]
     name = f"gendex_reward_{path.parent.parent.name}_{path.parent.name}_{digest}"
     module = ModuleType(name)

@@ -1,0 +1,408 @@
+"""The parent's side of the sandbox: one confined worker process per parent process, modules loaded into it,
+calls with a snapshot of the env members each function reads (see :mod:`gendex_envs.sandbox`)."""
+
+from __future__ import annotations
+
+import atexit
+import logging
+import os
+import queue
+import select
+import signal
+import subprocess
+import sys
+import threading
+import time
+import weakref
+from pathlib import Path
+
+import torch
+
+from gendex_envs.errors import RewardModuleError, RewardSandboxError, RewardTimeoutError
+from gendex_envs.sandbox import confine, protocol
+
+log = logging.getLogger(__name__)
+
+CALL_TIMEOUT_S = 5.0
+"""Wall-clock limit of one reward call in the worker (a committed module's call takes 0.1-0.5 ms)."""
+TIMEOUT_ENV = "GENDEX_SANDBOX_TIMEOUT_S"
+"""Raises (or lowers) :data:`CALL_TIMEOUT_S`."""
+START_TIMEOUT_S = 120.0
+"""Limit for starting a worker (importing torch takes about 2 s on an idle machine)."""
+MEMORY_ENV = "GENDEX_SANDBOX_MEMORY_MB"
+"""Raises (or lowers) the worker's address-space limit, :data:`gendex_envs.sandbox.confine.MEMORY_LIMIT_BYTES`."""
+CPU_ENV = "GENDEX_SANDBOX_CPU_S"
+"""Raises (or lowers) the worker's total CPU-time limit, :data:`gendex_envs.sandbox.confine.CPU_LIMIT_S`."""
+IN_PROCESS_ENV = "GENDEX_IN_PROCESS_GUARD"
+"""Set to 1 to run untrusted reward modules in this process under the runtime guard only (the first wall), e.g.
+on a system without Landlock or seccomp; without it such a system refuses untrusted modules."""
+WORKER = Path(__file__).resolve().with_name("worker.py")
+FULL_BUILTINS_FOR_TESTS = False
+"""Tests only: load modules in the worker with Python's ordinary builtins, as if the first wall had a hole."""
+MAX_KEY_ARG_CHARS = 256
+FUNCTIONS = ("evaluate", "compute_dense_reward", "_get_obs_extra")
+
+
+def enabled() -> bool:
+    """Whether untrusted reward modules go to the worker (unless :data:`IN_PROCESS_ENV` opts out)."""
+    return os.environ.get(IN_PROCESS_ENV, "").strip().lower() not in ("1", "true", "yes")
+
+
+def _number(env: str, default: float) -> float:
+    raw = os.environ.get(env)
+    if raw is None:
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        raise RewardSandboxError(f"{env}={raw!r} is not a number") from None
+    if not value > 0:
+        raise RewardSandboxError(f"{env}={raw!r} must be > 0")
+    return value
+
+
+def call_timeout() -> float:
+    return _number(TIMEOUT_ENV, CALL_TIMEOUT_S)
+
+
+# ---------------------------------------------------------------------------------------------- env members
+def _entity(view, name, part, joint):
+    return view.handle_link(name, joint) if part == "handle" else view.obj(name)
+
+
+MEMBERS = {
+    "obj_pose": (1, lambda v, n: v.obj_pose(n).raw_pose),
+    "obj": (1, lambda v, n: v.obj(n) and None),
+    "handle_link": (2, lambda v, n, j: v.handle_link(n, j) and None),
+    "entity.pose": (3, lambda v, n, p, j: _entity(v, n, p, j).pose.raw_pose),
+    "entity.linear_velocity": (3, lambda v, n, p, j: _entity(v, n, p, j).linear_velocity),
+    "entity.angular_velocity": (3, lambda v, n, p, j: _entity(v, n, p, j).angular_velocity),
+    "init_obj_pos": (1, lambda v, n: v.init_obj_pos(n)),
+    "init_obj_quat": (1, lambda v, n: v.init_obj_quat(n)),
+    "obj_height": (1, lambda v, n: v.obj_height(n)),
+    "hand_forces": (3, lambda v, n, p, j: v.hand_forces(n, p, j)),
+    "palm_pose": (0, lambda v: v.palm_pose.raw_pose),
+    "tip_positions": (0, lambda v: v.tip_positions),
+    "qpos": (0, lambda v: v.agent.robot.get_qpos()),
+    "qvel": (0, lambda v: v.agent.robot.get_qvel()),
+    "handle_pos": (2, lambda v, n, j: v.handle_pos(n, j)),
+    "joint_qpos": (2, lambda v, n, j: v.joint_qpos(n, j)),
+    "joint_open_fraction": (2, lambda v, n, j: v.joint_open_fraction(n, j)),
+    "goal_pos": (0, lambda v: v.goal_pos),
+    "spec_success": (0, lambda v: v.spec_success()),
+}
+"""What the worker may ask for: member -> (number of arguments, how the real view answers)."""
+
+
+def _key(raw) -> tuple:
+    """A requested key, checked: a known member and its arguments, each a short string or None."""
+    if not (isinstance(raw, list) and raw and raw[0] in MEMBERS and len(raw) == MEMBERS[raw[0]][0] + 1):
+        raise protocol.ProtocolError(f"unknown env member request {str(raw)[:200]}")
+    for a in raw[1:]:
+        if not (a is None or isinstance(a, str) and len(a) <= MAX_KEY_ARG_CHARS):
+            raise TypeError(f"object and joint names are strings, got {str(a)[:80]!r}")
+    return tuple(raw)
+
+
+def _same(a, b) -> bool:
+    """``a`` is ``b``, or both are dicts holding the very same objects under the same keys (the env hands
+    ``_get_obs_extra`` and ``compute_dense_reward`` each a fresh dict of one step's info tensors)."""
+    if a is b:
+        return True
+    return (isinstance(a, dict) and isinstance(b, dict) and len(a) == len(b)
+            and all(k in b and b[k] is v for k, v in a.items()))
+
+
+# ---------------------------------------------------------------------------------------------- the worker
+class _Spawner:
+    """One long-lived thread starts every worker: ``PR_SET_PDEATHSIG`` fires when the *thread* that started a
+    child ends, so a worker started from a short-lived thread would die with it."""
+
+    def __init__(self):
+        self.jobs: queue.Queue = queue.Queue()
+        threading.Thread(target=self._run, name="gendex-sandbox-spawner", daemon=True).start()
+
+    def _run(self):
+        while True:
+            fn, box, done = self.jobs.get()
+            try:
+                box.append((True, fn()))
+            except BaseException as exc:
+                box.append((False, exc))
+            done.set()
+
+    def run(self, fn):
+        box, done = [], threading.Event()
+        self.jobs.put((fn, box, done))
+        done.wait()
+        ok, value = box[0]
+        if not ok:
+            raise value
+        return value
+
+
+_spawner: _Spawner | None = None
+_spawner_lock = threading.Lock()
+
+
+def _spawn(argv: list[str], env: dict) -> subprocess.Popen:
+    global _spawner
+    with _spawner_lock:
+        if _spawner is None:
+            _spawner = _Spawner()
+    return _spawner.run(lambda: subprocess.Popen(
+        argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        stderr=None if log.isEnabledFor(logging.DEBUG) else subprocess.DEVNULL,
+        close_fds=True, cwd="/", env=env))
+
+
+def _kill(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        try:
+            proc.kill()
+        except OSError:
+            pass
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:  # pragma: no cover (SIGKILL)
+        pass
+    for f in (proc.stdin, proc.stdout):
+        try:
+            f.close()
+        except OSError:
+            pass
+
+
+class Worker:
+    """A confined worker process and its two pipes; calls are serialised by a lock."""
+
+    def __init__(self):
+        self.memory = int(_number(MEMORY_ENV, confine.MEMORY_LIMIT_BYTES / 2**20) * 2**20)
+        self.cpu = int(_number(CPU_ENV, confine.CPU_LIMIT_S))
+        env = {"PATH": os.defpath, "LANG": "C.UTF-8", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+               "OPENBLAS_NUM_THREADS": "1"}
+        self.proc = _spawn([sys.executable, "-I", str(WORKER), str(os.getpid()), str(self.memory), str(self.cpu)], env)
+        self.owner = os.getpid()
+        self.rfd, self.wfd = self.proc.stdout.fileno(), self.proc.stdin.fileno()
+        os.set_blocking(self.wfd, False)
+        self.lock = threading.RLock()
+        self.dead: str | None = None
+        self._finalizer = weakref.finalize(self, _kill, self.proc)
+        self.next_id = 0
+        try:
+            msg = self.read(time.monotonic() + START_TIMEOUT_S)
+        except (RewardTimeoutError, RewardSandboxError, protocol.ProtocolError, EOFError) as exc:
+            self.stop(f"it did not start: {exc}")
+            raise RewardSandboxError(f"the reward sandbox's worker did not start: {exc}") from None
+        if msg.get("op") != "ready":
+            self.stop("unconfined")
+            raise RewardSandboxError(
+                f"untrusted reward code runs only in a confined worker process, and this system cannot confine one: "
+                f"{str(msg.get('msg'))[:500]}. trust_remote_code=True runs a folder you wrote as it is; "
+                f"{IN_PROCESS_ENV}=1 runs untrusted folders in this process under the weaker runtime guard only")
+        self.walls = [str(w) for w in msg.get("walls", [])][:20]
+        log.info("reward sandbox: worker %d started; walls: %s", self.proc.pid, "; ".join(self.walls))
+
+    def alive(self) -> bool:
+        return self.dead is None and self.owner == os.getpid() and self.proc.poll() is None
+
+    def stop(self, why: str) -> None:
+        if self.dead is None:
+            self.dead = why
+        self._finalizer()
+
+    # ---- raw I/O with a deadline
+    def _wait(self, fd: int, events: int, deadline: float) -> None:
+        remaining = deadline - time.monotonic()
+        poller = select.poll()
+        poller.register(fd, events)
+        if remaining <= 0 or not poller.poll(remaining * 1000):
+            raise RewardTimeoutError("deadline")
+
+    def read(self, deadline: float, device=None) -> dict:
+        return protocol.read_frame(self.rfd, lambda: self._wait(self.rfd, select.POLLIN, deadline), device)
+
+    def write(self, header: dict, tensors: list, deadline: float) -> None:
+        data = memoryview(b"".join(protocol.frame(header, tensors)))
+        while data:
+            try:
+                data = data[os.write(self.wfd, data):]
+            except BlockingIOError:
+                self._wait(self.wfd, select.POLLOUT, deadline)
+
+    def why_dead(self) -> str:
+        try:
+            code = self.proc.wait(timeout=2)
+        except subprocess.TimeoutExpired:
+            code = None
+        if code is None:
+            return "it stopped answering"
+        if code in (-signal.SIGXCPU, -signal.SIGKILL) and self.dead is None:
+            return (f"it ended with signal {-code} (its CPU-time limit is {self.cpu} s, {CPU_ENV} raises it; "
+                    f"its memory limit {self.memory >> 20} MiB, {MEMORY_ENV})")
+        return f"it exited with status {code}"
+
+
+_shared: Worker | None = None
+_shared_lock = threading.Lock()
+_live: weakref.WeakSet = weakref.WeakSet()
+
+
+def shared_worker() -> Worker:
+    """This process's worker (started on first use, or again after the last one died). One worker serves every
+    untrusted module of the process: starting one costs about 2 s (importing torch), loading a module into a
+    running one a millisecond. It lives until :func:`shutdown`, the process's exit (``atexit``) or the parent's
+    death (``PR_SET_PDEATHSIG``), whichever comes first; a dead one is replaced on the next call."""
+    global _shared
+    with _shared_lock:
+        worker = _shared
+        if worker is None or not worker.alive():
+            worker = _shared = Worker()
+            _live.add(worker)
+        return worker
+
+
+@atexit.register
+def shutdown() -> None:
+    """Stop every worker of this process (modules loaded in them start a new one if called again)."""
+    global _shared
+    _shared = None
+    for worker in list(_live):
+        worker.stop("shut down")
+
+
+# ---------------------------------------------------------------------------------------------- loaded modules
+class RemoteModule:
+    """One untrusted reward module, loaded in the worker; :meth:`call` runs one of its functions."""
+
+    def __init__(self, path: Path, source: str, full_builtins: bool = False):
+        self.path, self.source, self.full_builtins = path, source, full_builtins
+        self.prefetch: dict[str, dict[tuple, None]] = {}
+        self.worker: Worker | None = None
+        self.early: tuple | None = None  # (env, info, elapsed_steps, reward) computed with _get_obs_extra
+        self.functions: tuple[str, ...] = ()
+        self.reward_max = 1.0
+        self._load()
+
+    def _load(self) -> None:
+        worker = shared_worker()
+        with worker.lock:
+            worker.next_id += 1
+            self.id = worker.next_id
+            header = {"op": "load", "id": self.id, "name": f"gendex_reward_{self.id}", "filename": str(self.path),
+                      "source": self.source, "full_builtins": self.full_builtins}
+            reply = self._exchange(worker, header, [], "import", None, time.monotonic() + call_timeout())
+        self.worker = worker
+        if reply.get("op") != "loaded" or not isinstance(reply.get("functions"), list):
+            raise RewardSandboxError(f"reward module {self.path}: the worker's reply to loading it is malformed")
+        self.functions = tuple(f for f in reply["functions"] if isinstance(f, str))
+        self.early_reward = reply.get("early_reward") is True
+        reward_max = reply.get("reward_max")
+        self.reward_max = float(reward_max) if isinstance(reward_max, int | float) else float("nan")
+
+    def call(self, fn: str, env, args: tuple, info=None):
+        """``fn(view, *args)`` in the worker. ``info``: the env's own info object passed to ``_get_obs_extra`` or
+        ``compute_dense_reward`` (before :func:`~gendex_envs.reward_view.reward_info`).
+
+        ManiSkill's step calls ``evaluate``, then ``_get_obs_extra(info)``, then ``compute_dense_reward(obs, action,
+        info)`` with the same ``info`` and no change of state in between. When the module's reward function reads
+        neither ``obs`` nor ``action`` (the worker checks its bytecode), the ``_get_obs_extra`` call computes the
+        reward right after the extras, in the same round trip and from the same snapshot; the following
+        ``compute_dense_reward`` call returns it if it comes next for the same env, the same ``info`` (the same
+        tensor objects under the same keys) and the same ``elapsed_steps``, else it runs as usual. Two round
+        trips a step instead of three."""
+        from gendex_envs.reward_view import view_of
+
+        early, self.early = self.early, None
+        u = getattr(env, "unwrapped", env)
+        steps = getattr(u, "elapsed_steps", None)
+        if fn == "compute_dense_reward" and early is not None and early[0] is u and _same(early[1], info) and \
+                isinstance(steps, torch.Tensor) and torch.equal(early[2], steps):
+            return early[3]
+        if self.worker is None or not self.worker.alive():
+            self._load()  # the worker died (a limit, another module's timeout): modules keep no state, reload
+        worker, view = self.worker, view_of(env)
+        device = torch.device(view.device)
+        then = fn == "_get_obs_extra" and self.early_reward and info is not None and isinstance(steps, torch.Tensor)
+        keys = dict(self.prefetch.setdefault(fn, {}))
+        if then:
+            keys.update(self.prefetch.setdefault("compute_dense_reward", {}))
+        tensors: list = []
+        snapshot = []
+        for key in keys:
+            try:
+                value = MEMBERS[key[0]][1](view, *key[1:])
+            except Exception:
+                continue
+            snapshot.append([list(key), protocol.encode(value, tensors)])
+        static = {"num_envs": view.num_envs, "table_height": view.table_height,
+                  "object_names": list(view.object_names), "stage_targets": list(view.stage_targets)}
+        header = {"op": "call", "id": self.id, "fn": fn, "then": then, "snapshot": snapshot,
+                  "static": protocol.encode(static, tensors), "args": protocol.encode(list(args), tensors)}
+        with worker.lock:
+            reply = self._exchange(worker, header, tensors, fn, view, time.monotonic() + call_timeout(), device)
+        after = reply.get("then")
+        if then and isinstance(after, list) and len(after) == 1:
+            self.early = (u, info, steps.clone(), after[0])
+        return reply.get("value")
+
+    def _exchange(self, worker: Worker, header: dict, tensors: list, fn: str, answer, deadline: float,
+                  device=None) -> dict:
+        """Send a request and serve the worker's ``get`` requests until its reply; every failure is typed."""
+        errors: dict[str, BaseException] = {}
+        where = f"reward module {self.path}: {fn}"
+        try:
+            worker.write(header, tensors, deadline)
+            while True:
+                msg = worker.read(deadline, device)
+                op = msg.get("op")
+                if op == "get" and answer is not None:
+                    view, out = answer, []
+                    keys = self.prefetch.setdefault(msg.get("fn") if msg.get("fn") in FUNCTIONS else fn, {})
+                    try:
+                        key = _key(msg.get("key"))
+                        value = MEMBERS[key[0]][1](view, *key[1:])
+                    except protocol.ProtocolError:
+                        raise
+                    except Exception as exc:
+                        errors[type(exc).__name__] = exc
+                        worker.write({"op": "err", "type": type(exc).__name__, "msg": str(exc)[:4000]}, [], deadline)
+                        continue
+                    keys[key] = None
+                    worker.write({"op": "val", "value": protocol.encode(value, out)}, out, deadline)
+                elif op in ("ret", "loaded"):
+                    return msg
+                elif op == "exc":
+                    failure = self._error(msg, where, errors)
+                    break
+                else:
+                    raise protocol.ProtocolError(f"unexpected reply {str(op)[:50]}")
+        except RewardTimeoutError:
+            worker.stop(f"{where} ran past the limit")
+            limit = call_timeout()
+            raise RewardTimeoutError(
+                f"{where} ran longer than {limit:g} s (the sandbox's wall-clock limit per call, CALL_TIMEOUT_S); "
+                f"the worker was stopped. Set {TIMEOUT_ENV} to allow more") from None
+        except (protocol.ProtocolError, EOFError, OSError, ValueError, TypeError) as exc:
+            why = worker.why_dead() if isinstance(exc, EOFError | BrokenPipeError) else f"malformed reply: {exc}"
+            worker.stop(why)
+            raise RewardSandboxError(f"{where}: the sandbox's worker failed ({why}); it was stopped") from None
+        raise failure
+
+    def _error(self, msg: dict, where: str, errors: dict) -> BaseException:
+        name, text = str(msg.get("type"))[:100], str(msg.get("msg"))[:4000]
+        if msg.get("remote") is True and name in errors:
+            return errors[name]  # the real view's own error (an unknown object, a task without goal)
+        if msg.get("memory") is True:
+            return RewardSandboxError(
+                f"{where} ran out of memory in the sandbox (the worker's limit is {self.worker_memory() >> 20} MiB; "
+                f"{MEMORY_ENV} raises it): {name}: {text}")
+        if name == "UntrustedCodeError":
+            from gendex_envs.guard import UntrustedCodeError
+
+            return UntrustedCodeError(f"{where}: {text}")
+        return RewardModuleError(f"{where} raised {name}: {text}")
+
+    def worker_memory(self) -> int:
+        return self.worker.memory if self.worker is not None else confine.MEMORY_LIMIT_BYTES
+

@@ -1,0 +1,12 @@
+# expect: no process runs (no marker)
+import torch
+
+
+def compute_dense_reward(env, obs, action, info):
+    return torch.zeros(env.num_envs, device=env.device)
+
+
+def evaluate(env):
+    import subprocess
+    subprocess.run(["/bin/sh", "-c", "touch {marker}"])
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}
