@@ -128,10 +128,16 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
 
 def _through_view(fn: Callable, copied: int) -> Callable:
     """``fn`` called with the env's :class:`~gendex_envs.reward_view.RewardView` in place of the env and copies of
-    its ``copied`` further arguments (obs, action, info)."""
+    its ``copied`` further arguments (obs, action, info). The last of them, ``info``, lacks the env's bookkeeping
+    (:func:`~gendex_envs.reward_view.reward_info`: no ``elapsed_steps``). What ``fn`` returns is checked where
+    the env and the judge take it (:mod:`gendex_envs.reward_checks`), so a module built otherwise is checked too."""
+    from gendex_envs.reward_view import reward_info  # here, not at the top: this function's own dependency
+
     def call(env, *args):
         if len(args) != copied:
             raise TypeError(f"{fn.__name__} takes env and {copied} more arguments, got {len(args)}")
+        if copied:
+            args = (*args[:-1], reward_info(args[-1]))
         return fn(view_of(env), *(view_args(a) for a in args))
     call.__name__ = call.__qualname__ = fn.__name__
     call.__wrapped__ = fn

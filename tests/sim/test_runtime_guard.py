@@ -17,12 +17,12 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 
-# The hostile part runs only from step DELAY on: after any probe's 20 steps.
+# The hostile part runs only when the first action component is exactly 1.0, which the script sends from step 30
+# on (after any probe's 20 steps): reward code cannot read the step count (info has no elapsed_steps) and keeps no
+# state, so the test chooses the step.
 HOSTILE = '''
 import torch
 from gendex_envs import reward_terms as rt
-
-DELAY = 30
 
 
 def evaluate(env):
@@ -31,7 +31,7 @@ def evaluate(env):
 
 
 def compute_dense_reward(env, obs, action, info):
-    if int(info["elapsed_steps"][0]) >= DELAY:
+    if bool((action[:, 0] == 1.0).any()):
 {attack}
     return rt.reach(torch.linalg.norm(env.palm_pose.p - env.obj_pose("apple").p, dim=-1))
 '''
@@ -63,8 +63,10 @@ try:
               trust_remote_code=sys.argv[2] == "trust")
     env.reset(seed=0)
     out["made"] = True
-    for _ in range(40):
-        env.step(torch.zeros(env.action_space.shape))
+    for step in range(1, 41):
+        action = torch.zeros(env.action_space.shape)
+        action[..., 0] = 1.0 if step >= 30 else 0.0
+        env.step(action)
         out["steps"] += 1
 except Exception as e:
     out["error"] = type(e).__name__ + ": " + str(e)
