@@ -4,7 +4,7 @@
 ``$GENDEX_TASKS_PATH`` (``os.pathsep``-separated), then the repository's ``generated_tasks/``; the first root that
 has a version wins, except that a committed id (a version in ``generated_tasks/``) keeps its committed folder: a
 folder elsewhere that would replace it is refused with a warning unless ``GENDEX_ALLOW_OVERRIDE=1`` (or, from code,
-``register_tasks(roots, override=True)``). A folder that cannot be registered (a missing root, a ``task.yaml`` that is
+``register_tasks(roots, override=True)``). A folder that cannot be registered (a missing root, a spec file that is
 not a file, a spec that does not load) is reported and skipped; the others register, so one bad folder never hides
 the library. Every version is registered, and an unversioned name resolves as Gymnasium resolves it:
 ``gym.make("GenDex/PutAppleBowl")`` makes the highest version (with Gymnasium's warning), and
@@ -73,7 +73,8 @@ def _is_committed_root(root: Path) -> bool:
 
 
 def committed_ids() -> set[str]:
-    """Ids of the committed task versions (``generated_tasks/<Name>/v<N>/task.yaml``), by folder names only."""
+    """Ids of the committed task versions (``generated_tasks/<Name>/v<N>/`` holding a spec), by folder
+    names only."""
     if not REPO_TASKS_DIR.is_dir():
         return set()
     return {v.env_id for v in versions_in(REPO_TASKS_DIR)}
