@@ -128,3 +128,22 @@ def test_file_digest_covers_every_file_and_never_follows_links(tmp_path):
     (copy.root / "zero").unlink()
     (copy.root / "zero").symlink_to("/dev/null")
     assert copy.file_digest() != linked
+
+
+def test_gendex_eval_refuses_a_suite_task_a_tasks_path_folder_replaced(tmp_path):
+    """End to end: a user who lets a downloaded folder take PutAppleBowl-v1's id (GENDEX_ALLOW_OVERRIDE=1) cannot
+    evaluate on the reference suite with it unless --allow-changed-tasks; nothing is written."""
+    import subprocess
+    import sys
+
+    copy = _shadow(tmp_path / "tasks")
+    repo = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "GENDEX_TASKS_PATH": str(copy.tasks_root), "GENDEX_ALLOW_OVERRIDE": "1",
+           "PYTHONPATH": str(repo)}
+    out = tmp_path / "eval"
+    done = subprocess.run([sys.executable, "-m", "gendex.cli", "eval", "--suite", "gendex-ref-v1", "--policy", "hold",
+                           "--episodes", "1", "--out", str(out)], cwd=repo, env=env, capture_output=True, text=True,
+                          timeout=240)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert "GenDex/PutAppleBowl-v1" in done.stderr and copy.file_digest() in done.stderr
+    assert not out.exists()
