@@ -13,6 +13,11 @@ Measures, in one process and one run:
 (c) the ratio (a) / (b); the project's goal is >= 0.5.
 
 Run: ``.venv/bin/python benchmarks/step_rate.py [--steps 1000] [--repeats 3] [--task GenDex/PutAppleBowl-v0]``.
+
+``--untrusted`` measures instead, in one run, ``env.step`` per second of the task as committed (trusted: its
+reward module runs in this process) and of an untrusted copy of the same folder under a temporary task root (its
+reward module runs in the sandbox's confined worker, :mod:`gendex_envs.sandbox`), interleaved, and their ratio
+(issue 43's goal: >= 0.85). Episode resets are not timed on either side.
 """
 
 from __future__ import annotations
@@ -215,6 +220,56 @@ def timed_rate(sample, step, reset, steps: int) -> tuple[float, int]:
     return steps / busy, resets
 
 
+def untrusted_comparison(args) -> None:
+    """``--untrusted``: the committed task and an untrusted copy of its folder, interleaved (see the module doc)."""
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    from gendex_envs import guard
+    from gendex_envs.registry import make_env, resolve_task
+
+    version = resolve_task(args.task)
+    with tempfile.TemporaryDirectory(prefix="gendex_step_rate_") as tmp:
+        copy = Path(tmp) / "tasks" / version.name / version.root.name
+        shutil.copytree(version.root, copy, ignore=shutil.ignore_patterns("__pycache__"))
+        assert guard.is_trusted(version.root / "task.yaml") and not guard.is_trusted(copy / "task.yaml")
+        envs = {"trusted": make_env(version, control_mode="pd_joint_delta_pos"),
+                "untrusted": make_env(copy, control_mode="pd_joint_delta_pos")}
+        try:
+            print(f"task {args.task} ({version.root})  untrusted copy {copy}")
+            print(f"machine: {platform.processor() or platform.machine()}  os.cpu_count()={os.cpu_count()}  "
+                  f"affinity={len(os.sched_getaffinity(0))}  torch threads={torch.get_num_threads()}  "
+                  f"torch {torch.__version__}")
+            sides = {}
+            for name, env in envs.items():
+                env.reset(seed=args.seed)
+                env.action_space.seed(args.seed)
+
+                def step(action, env=env) -> bool:
+                    _, _, terminated, truncated, _ = env.step(action)
+                    return bool(terminated or truncated)
+
+                sides[name] = (env.action_space.sample, step, env.reset)
+            rates = {name: [] for name in sides}
+            for sample, step, reset in sides.values():
+                timed_rate(sample, step, reset, args.warmup)
+            for r in range(args.repeats):  # interleaved, so slow drifts of the machine hit both sides
+                for name, (sample, step, reset) in sides.items():
+                    reset()
+                    rates[name].append(timed_rate(sample, step, reset, args.steps)[0])
+                print(f"  repeat {r + 1}: trusted {rates['trusted'][-1]:8.1f} /s   untrusted "
+                      f"{rates['untrusted'][-1]:8.1f} /s   ratio {rates['untrusted'][-1] / rates['trusted'][-1]:.3f}")
+            trusted, untrusted = statistics.median(rates["trusted"]), statistics.median(rates["untrusted"])
+            print(f"\nmedian of {args.repeats} x {args.steps} steps")
+            print(f"  {'trusted env.step/s':28s} {trusted:10.1f}   ({1e3 / trusted:.3f} ms/step)")
+            print(f"  {'untrusted env.step/s':28s} {untrusted:10.1f}   ({1e3 / untrusted:.3f} ms/step)")
+            print(f"  {'ratio untrusted / trusted':28s} {untrusted / trusted:10.3f}   (goal >= 0.85)")
+        finally:
+            for env in envs.values():
+                env.close()
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--task", default="GenDex/PutAppleBowl-v0")
@@ -223,9 +278,14 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--torch-threads", type=int, default=None, help="torch.set_num_threads(N) (default: leave)")
+    ap.add_argument("--untrusted", action="store_true",
+                    help="compare the committed task with an untrusted copy of it (sandboxed reward code)")
     args = ap.parse_args()
     if args.torch_threads is not None:
         torch.set_num_threads(args.torch_threads)
+    if args.untrusted:
+        untrusted_comparison(args)
+        return
 
     env = gym.make(args.task, control_mode="pd_joint_delta_pos")
     env.reset(seed=args.seed)

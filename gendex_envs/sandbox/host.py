@@ -213,9 +213,9 @@ class Worker:
 
     # ---- raw I/O with a deadline
     def _wait(self, fd: int, events: int, deadline: float) -> None:
-        remaining = deadline - time.monotonic()
         poller = select.poll()
         poller.register(fd, events)
+        remaining = deadline - time.monotonic()
         if remaining <= 0 or not poller.poll(remaining * 1000):
             raise RewardTimeoutError("deadline")
 

@@ -33,6 +33,7 @@ if __name__ == "__main__":
 
 import builtins  # noqa: E402
 import dis  # noqa: E402
+import importlib  # noqa: E402
 import inspect  # noqa: E402
 
 import torch  # noqa: E402
@@ -213,6 +214,8 @@ class RemoteView:
 # ---------------------------------------------------------------------------------------------- serving
 def _prepare() -> None:
     """Everything reward code may import, loaded before the walls go up (after them, nothing new can be read)."""
+    for name in guard.ALLOWED_IMPORTS:
+        importlib.import_module(name)  # the real modules first: a package's copy reads its submodules
     importer = guard.restricted_builtins()["__import__"]
     for name in guard.ALLOWED_IMPORTS:
         importer(name, None, None, (), 0)
