@@ -6,9 +6,11 @@ Two fences, in addition to the static check (:mod:`gendex_envs.code_check`) and 
 
 1. **Restricted builtins and module copies** (untrusted modules). :func:`restricted_builtins` is the
    ``__builtins__`` such a module executes with: only :data:`SAFE_BUILTINS` (no ``open``, ``exec``, ``eval``,
-   ``compile``, ``vars``, ``globals``, no ``__build_class__``; ``getattr``/``hasattr`` refuse ``_`` names) and an
-   ``__import__`` that admits only :data:`ALLOWED_IMPORTS` and hands out read-only copies of them (:func:`_proxy`:
-   no ``torch.save``, ``torch.load``, ``torch.hub``, ``torch.os``, no ``set_*``). Python looks ``__import__`` up in
+   ``compile``, ``vars``, ``globals``, no ``__build_class__``; ``getattr``/``hasattr`` refuse ``_`` names and names
+   outside the allow-list) and an ``__import__`` that admits only :data:`ALLOWED_IMPORTS` and hands out read-only
+   copies of them holding exactly the allow-listed names (:func:`_proxy`,
+   :data:`~gendex_envs.code_check.rules.MODULE_MEMBERS`; any other name raises :class:`UntrustedCodeError` naming
+   the module and the attribute). Python looks ``__import__`` up in
    the running frame's builtins, so an ``import os`` inside a reward function fails even when ``os`` is already
    loaded, which no audit hook sees; C code that imports on the module's behalf is refused the same way.
 
@@ -23,8 +25,10 @@ Two fences, in addition to the static check (:mod:`gendex_envs.code_check`) and 
    user's own code (writing a dataset after ``gym.make`` of a downloaded task works), which a process-wide ban
    could not offer.
 
-C extensions that write files themselves (``numpy``'s ``tofile``, torch's serialization) raise no audit event: the
-static check refuses those names and the module copies do not offer them. Python has no in-process isolation, so
+C extensions that write files themselves (``numpy``'s ``tofile``, torch's serialization and archive classes) raise
+no audit event: the module copies do not offer them and the static check refuses those names. Tensor methods cannot
+be withheld in-process, so :data:`~gendex_envs.code_check.rules.TENSOR_METHODS` is enforced by the static check,
+with the confined worker process as the wall behind it. Python has no in-process isolation, so
 these fences hold together, not one by one; a process boundary (the probe's child) is the stronger one.
 
 Trust: the repository's own committed tasks (``generated_tasks/``) and the package's preview module are trusted;
@@ -36,14 +40,23 @@ says so: ``gym.make(id, trust_remote_code=True)``, ``TaskEnv(..., trust_remote_c
 from __future__ import annotations
 
 import builtins
+import difflib
 import logging
 import os
 import sys
 import threading
+import types
 from pathlib import Path
 from types import FrameType
 
-from gendex_envs.code_check.rules import ALLOWED_BUILTINS, ALLOWED_MODULES, ALLOWED_PACKAGES
+from gendex_envs.code_check.rules import (
+    ALLOWED_ATTRIBUTE_NAMES,
+    ALLOWED_BUILTINS,
+    ALLOWED_MODULES,
+    ALLOWED_PACKAGES,
+    ALTERNATIVES,
+    MODULE_MEMBERS,
+)
 from gendex_envs.errors import GenDexError
 
 log = logging.getLogger(__name__)
@@ -90,42 +103,52 @@ class UntrustedCodeError(GenDexError, PermissionError):
 
 
 # ---------------------------------------------------------------------------------------------- restricted builtins
-_SUBMODULES = {name: tuple(sorted(m.rpartition(".")[2] for m in ALLOWED_MODULES if m.rpartition(".")[0] == name))
-               for name in [*ALLOWED_MODULES, *ALLOWED_PACKAGES] if name != "math"}
-"""The modules reward code gets, as read-only copies: module -> the allowed submodules reachable from it."""
-_WITHHELD = frozenset({"save", "load", "from_file", "compile", "manual_seed", "seed", "initial_seed", "get_rng_state",
-                       "use_deterministic_algorithms", "fork_rng", "cond", "while_loop", "vmap", "export"})
+class ModuleView(types.ModuleType):
+    """A reward-code copy of a module: its allow-listed names only. A name it lacks is refused with
+    :class:`UntrustedCodeError` naming the module and the attribute and listing what is allowed, not a bare
+    ``AttributeError`` (dunder probes by Python's own machinery still get ``AttributeError``)."""
+
+    def __getattr__(self, name: str):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        module = self.__name__
+        allowed = MODULE_MEMBERS.get(module, frozenset())
+        close = [n for n in ALTERNATIVES.get(name, ()) if n in allowed]
+        close += [n for n in difflib.get_close_matches(str(name), sorted(allowed), n=5, cutoff=0.6) if n not in close]
+        raise UntrustedCodeError(
+            f"reward code may not use {module}.{str(name)[:80]}: only the allow-listed pure functions of {module} "
+            f"are available to it ({len(allowed)} names, gendex_envs.code_check.rules.MODULE_MEMBERS)"
+            + (f"; nearest allowed: {', '.join(close)}" if close else ""))
+
+    def __setattr__(self, name: str, value) -> None:
+        raise UntrustedCodeError(f"reward code may not change the module {self.__name__} (setting {name!s:.80})")
+
+    def __delattr__(self, name: str) -> None:
+        raise UntrustedCodeError(f"reward code may not change the module {self.__name__} (deleting {name!s:.80})")
 
 
-def _withheld(name: str, value) -> bool:
-    return (name.startswith(("_", "set_")) or name in _WITHHELD or "Storage" in name
-            or isinstance(value, type(builtins)) or (name.startswith("is_") and name.endswith("_enabled")))
+_proxies: dict[str, ModuleView] = {}
 
 
-_proxies: dict[str, object] = {}
-
-
-def _proxy(name: str):
-    """A copy of module ``name`` holding its public functions, types and constants (no submodules but the allowed
-    ones, themselves copies; nothing that saves, loads, compiles or sets global state). Reward code's ``torch``
-    is this copy, so ``torch.save``, ``torch.hub`` or ``torch.os`` do not exist for it even if the static check
-    were bypassed. (A determined attacker with a dunder could still reach the real module: Python has no
-    in-process isolation, which is why the static check refuses every dunder and the audit hook watches.)"""
+def _proxy(name: str) -> ModuleView:
+    """The copy of module ``name`` reward code gets: exactly the names
+    :data:`~gendex_envs.code_check.rules.MODULE_MEMBERS` allows for it (an allow-list: torch's functions that
+    compute on tensors, ``math``'s pure functions, ``reward_terms``), allowed submodules as copies themselves.
+    ``torch.frombuffer``, ``torch.empty``, ``torch.as_strided``, ``torch.get_file_path``, ``torch.save`` or
+    ``torch.os`` do not exist for it, even if the static check were bypassed. Tensor *methods* cannot be withheld
+    in-process (every tensor carries them), so :data:`~gendex_envs.code_check.rules.TENSOR_METHODS` is enforced by
+    the static check, and the confined worker process is the wall behind it. (A dunder could still reach the real
+    module: Python has no in-process isolation, which is why the static check refuses every dunder and the audit
+    hook watches.)"""
     if name not in _proxies:
         import importlib
-        import types
 
         real = importlib.import_module(name)
-        copy = types.ModuleType(name, f"reward-code view of {name}")
-        if name == "gendex_envs.reward_terms":
-            public = {k: v for k, v in vars(real).items() if not k.startswith("_") and callable(v)
-                      and getattr(v, "__module__", None) == name}
-        elif name == "gendex_envs":
-            public = {}
-        else:
-            public = {k: v for k, v in vars(real).items() if not _withheld(k, v)}
-        for sub in _SUBMODULES[name]:
-            public[sub] = _proxy(f"{name}.{sub}")
+        copy = ModuleView(name, f"reward-code view of {name}")
+        public = {}
+        for member in MODULE_MEMBERS[name]:
+            value = getattr(real, member)
+            public[member] = _proxy(value.__name__) if isinstance(value, types.ModuleType) else value
         copy.__dict__.update(public)
         _proxies[name] = copy
     return _proxies[name]
@@ -140,7 +163,7 @@ def _guarded_import(name: str, globals=None, locals=None, fromlist=(), level: in
     extra = sorted(set(fromlist or ()) - allowed) if allowed is not None else []
     if extra:
         raise UntrustedCodeError(f"reward code may not import {extra} from {name!r}; allowed: {sorted(allowed)}")
-    if name in ("__future__", "math"):
+    if name == "__future__":
         return builtins.__import__(name, globals, locals, fromlist, level)
     # `import a.b.c` binds the top package; `from a.b import c` gets a.b itself
     return _proxy(name if fromlist else name.split(".")[0])
@@ -149,6 +172,9 @@ def _guarded_import(name: str, globals=None, locals=None, fromlist=(), level: in
 def _public(name) -> str:
     if not isinstance(name, str) or name.startswith("_"):
         raise UntrustedCodeError(f"reward code may read public attributes only, not {str(name)[:80]!r}")
+    if name not in ALLOWED_ATTRIBUTE_NAMES:
+        raise UntrustedCodeError(f"reward code may not read the attribute {name[:80]!r}: only the allow-listed tensor "
+                                 "methods, env view members and module functions (gendex_envs.code_check.rules)")
     return name
 
 

@@ -25,11 +25,16 @@ listing tricks.
   are followed in the real modules, so ``torch.os``, ``torch.load``, ``torch.hub``, ``torch.jit``, ``torch.ops``,
   ``torch.classes``, ``torch.utils`` or ``rt.torch.random`` are rejected wherever they appear; a module may only be
   used as ``module.<name>``. ``numpy`` is not allowed (file I/O, ctypes, GPU->host copies).
-* **Attributes**: no ``_private`` names, no setters (``set_*``), no in-place methods (any public name ending in
-  ``_``: ``add_``, ``copy_``, ``fill_``, ``zero_``, ``index_put_``, ``scatter_``, ``resize_``, ``requires_grad_``,
-  ``share_memory_``...), no simulator handles or mutators (``scene``, ``controller``, ``unwrapped``, ``step``,
-  ``reset``, ``apply_*``, ``add_*``...), no file/process/module names, no frame introspection
-  (:data:`~gendex_envs.code_check.rules.FORBIDDEN_ATTRIBUTES`).
+* **Attributes: an allow-list** (:mod:`gendex_envs.code_check.rules`, shared with the runtime guard's module
+  copies): a name on a module must be in :data:`~gendex_envs.code_check.rules.MODULE_MEMBERS` (torch's pure
+  tensor functions, ``math``'s pure functions, ``reward_terms``), a name on any other value in
+  :data:`~gendex_envs.code_check.rules.VALUE_ATTRIBUTES` (tensor methods that compute, the env view's members,
+  fields of results, reading methods of containers); a rejection names the nearest allowed names. The deny rules
+  stay in front for their clearer messages: no ``_private`` names, no setters (``set_*``), no in-place methods
+  (any public name ending in ``_``: ``add_``, ``copy_``, ``fill_``, ``zero_``, ``index_put_``, ``scatter_``,
+  ``resize_``, ``requires_grad_``, ``share_memory_``...), no simulator handles or mutators (``scene``,
+  ``controller``, ``unwrapped``, ``step``, ``reset``, ``apply_*``, ``add_*``...), no file/process/module names, no
+  frame introspection (:data:`~gendex_envs.code_check.rules.FORBIDDEN_ATTRIBUTES`).
 * **No mutation of anything the function did not create.** Attribute stores are rejected; a subscript store
   ``x[i] = v`` is allowed only when every binding of the local ``x`` in that function is a new object
   (``torch.zeros_like(...)``, arithmetic, a literal list/dict, ``.clone()``...), never a parameter, a loop variable

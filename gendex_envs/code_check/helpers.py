@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import ast
+import difflib
 import importlib
 from dataclasses import dataclass
 
 from gendex_envs.code_check.rules import (
     _FORBIDDEN_ATTR_REASONS,
     ALLOWED_NODE_TYPES,
+    ALTERNATIVES,
 )
 
 _OP_SYMBOLS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.FloorDiv: "//", ast.Mod: "%",
@@ -90,6 +92,14 @@ def _literal_number(node: ast.AST) -> float | None:
     except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
         return None
     return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+
+def _nearest(name: str, allowed: frozenset[str] | set[str]) -> str:
+    """The allowed names closest to ``name`` (for a rejection message)."""
+    instead = [n for n in ALTERNATIVES.get(name, ()) if n in allowed]
+    close = instead + [n for n in difflib.get_close_matches(name, sorted(allowed), n=5, cutoff=0.6)
+                       if n not in instead]
+    return ", ".join(f"`{n}`" for n in close) if close else "none is close to it"
 
 
 def _allowed_modules_text() -> str:

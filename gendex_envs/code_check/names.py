@@ -20,6 +20,7 @@ from gendex_envs.code_check.helpers import (
     _attribute_problem,
     _follow,
     _is_dunder,
+    _nearest,
     _snippet,
 )
 from gendex_envs.code_check.rules import (
@@ -32,6 +33,8 @@ from gendex_envs.code_check.rules import (
     FRESH_BUILTINS,
     FRESH_METHODS,
     FRESH_TORCH_FUNCTIONS,
+    MODULE_MEMBERS,
+    VALUE_ATTRIBUTES,
 )
 
 
@@ -211,6 +214,8 @@ class NameRules:
             if why:
                 self.add(stmt, f"`from {mod} import {a.name}` is not allowed: {why}")
                 continue
+            if not self.check_member(stmt, mod, a.name, f"from {mod} import {a.name}"):
+                continue
             obj = self.resolve_chain(stmt, mod, [a.name])
             if isinstance(obj, types.ModuleType):  # e.g. `from gendex_envs.reward_terms import torch`
                 self.module_aliases[a.asname or a.name] = obj.__name__
@@ -295,15 +300,47 @@ class NameRules:
                 self.add(node, f"`{_snippet(self.source, shown)}`: `.{node.attr}()` changes "
                          f"`{_snippet(self.source, node.value, 40)}`, which this function did not create (it may be "
                          "the env's data or an argument such as `info`); build a new list/dict/tensor instead")
+        root, names = self.attr_chain(node)
+        if root is None:  # an attribute of a value (a tensor, a view, a dict...), not of a module
+            base = node.value
+            while isinstance(base, ast.Attribute):
+                base = base.value
+            undefined = isinstance(base, ast.Name) and base.id not in self.bound_anywhere and not hasattr(
+                builtins, base.id)  # reported as undefined already; it would never run
+            if not undefined:
+                self.check_value_attribute(node, node.attr, f"`{_snippet(self.source, node)}`")
+            return
         if isinstance(self.parent.get(node), ast.Attribute):
             return  # the outermost attribute of a chain resolves the whole chain
-        root, names = self.attr_chain(node)
         if root is not None and not any(_attribute_problem(n) for n in names):
             obj = self.resolve_chain(node, self.module_aliases[root], names, shown=root)
             if isinstance(obj, types.ModuleType):  # `t = F.torch` would alias a module into a variable
                 path = ".".join([root, *names])
                 self.add(node, f"the module `{path}` may only be used as `{path}.<name>` (line {node.lineno}: "
                          f"`{_snippet(self.source, self.parent.get(node, node))}`), not passed around or stored")
+
+    def check_member(self, node: ast.AST, module: str, name: str, shown: str) -> bool:
+        """``module.name`` is on the allow-list (:data:`~gendex_envs.code_check.rules.MODULE_MEMBERS`); else a
+        problem naming the nearest allowed names."""
+        allowed = MODULE_MEMBERS.get(module)
+        if allowed is None or name in allowed:
+            return True
+        what = f"`{shown}`" if shown.startswith("from ") else f"`{shown}.{name}`"
+        self.add(node, f"{what} is not allowed: reward code may use only the pure tensor and math functions on the "
+                 f"allow-list from `{module}`, nothing that reads or writes files, exposes memory or changes global "
+                 f"state; nearest allowed in `{module}`: {_nearest(name, allowed)}")
+        return False
+
+    def check_value_attribute(self, node: ast.AST, name: str, shown: str) -> bool:
+        """Attribute ``name`` of a value (not a module) is on the allow-list
+        (:data:`~gendex_envs.code_check.rules.VALUE_ATTRIBUTES`: tensor methods, the env view's members, fields of
+        results, reading methods of containers); else a problem naming the nearest allowed names."""
+        if name in VALUE_ATTRIBUTES:
+            return True
+        self.add(node, f"attribute `.{name}` in {shown} is not allowed: reward code may use only the allow-listed "
+                 "tensor methods (computations that return new tensors), the env view's members and reading methods "
+                 f"of its own dicts and lists; nearest allowed: {_nearest(name, VALUE_ATTRIBUTES)}")
+        return False
 
     def resolve_chain(self, node: ast.AST, module: str, names: list[str], shown: str | None = None) -> object:
         """Follow ``module.names...`` in the real (trusted) modules; reject other modules and unknown attributes.
@@ -315,15 +352,18 @@ class NameRules:
             obj = importlib.import_module(module)
         except ImportError:  # pragma: no cover - allowed modules are installed
             return None
-        path = shown
+        path, refused = shown, False
         for n in names:
-            path = f"{path}.{n}"
+            if not isinstance(obj, types.ModuleType) and not self.check_value_attribute(node, n, f"`{path}.{n}`"):
+                return None
+            parent, path = path, f"{path}.{n}"
             try:
                 nxt = getattr(obj, n)
             except AttributeError:
                 if isinstance(obj, types.ModuleType):
-                    self.add(node, f"`{path}` does not exist (module `{obj.__name__}` has no attribute `{n}`)",
-                             unsafe=False)
+                    allowed = MODULE_MEMBERS.get(obj.__name__, frozenset())
+                    self.add(node, f"`{path}` does not exist (module `{obj.__name__}` has no attribute `{n}`); "
+                             f"nearest allowed: {_nearest(n, allowed)}", unsafe=False)
                 return None
             except Exception:
                 return None
@@ -331,8 +371,10 @@ class NameRules:
                 self.add(node, f"`{path}` is the module `{nxt.__name__}`, which reward code may not use; allowed "
                          f"modules: {_allowed_modules_text()}")
                 return None
+            if isinstance(obj, types.ModuleType) and not self.check_member(node, obj.__name__, n, parent):
+                refused = True  # walk on: a module further along the chain is named as well
             obj = nxt
-        return obj
+        return None if refused else obj
 
     def check_call(self, node: ast.Call) -> None:
         func = node.func
@@ -357,6 +399,8 @@ class NameRules:
             if fn == "getattr" and isinstance(obj, types.ModuleType):
                 self.add(node, f"`{_snippet(self.source, node)}` returns the module `{obj.__name__}`; use "
                          f"`{first.id}.{name}.<name>` directly")
+        else:
+            self.check_value_attribute(node, name, f"`{_snippet(self.source, node)}`")
 
     def check_positional_inplace(self, node: ast.Call) -> None:
         """``F.relu(t, True)``, ``F.dropout(t, 0.5, True, True)``, ``torch.nn.ReLU(True)``: a torch callable with an

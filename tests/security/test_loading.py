@@ -145,8 +145,8 @@ def results(tmp_path_factory) -> dict:
         "REWARD_MAX = 1.0", "REWARD_MAX = 7.0"))
     add("fresh-folder", BENIGN_BYTES, False, True, None)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONPYCACHEPREFIX")}
-    proc = subprocess.run([sys.executable, "-c", SCRIPT, json.dumps(cases), str(root / "watched")], capture_output=True, text=True,
-                          timeout=300, cwd=REPO, env=env)
+    proc = subprocess.run([sys.executable, "-c", SCRIPT, json.dumps(cases), str(root / "watched")],
+                          capture_output=True, text=True, timeout=300, cwd=REPO, env=env)
     line = next((x for x in proc.stdout.splitlines() if x.startswith("RESULT ")), None)
     assert line, proc.stdout[-2000:] + proc.stderr[-3000:]
     out = json.loads(line[7:])

@@ -42,12 +42,12 @@ ATTACKS = {
     "import_os": ("import os\nos.system('touch {marker}')", "may not import 'os'"),
     "getattr_dunder": ("getattr(env, '__class__')", "public attributes only"),
     # reward code's torch is a copy without what saves, loads or downloads
-    "torch_save": ("torch.save(env.palm_pose.p, '{marker}')", "has no attribute 'save'"),
-    "torch_load": ("torch.load('/etc/hostname')", "has no attribute 'load'"),
+    "torch_save": ("torch.save(env.palm_pose.p, '{marker}')", "may not use torch.save"),
+    "torch_load": ("torch.load('/etc/hostname')", "may not use torch.load"),
     # what reaches a file through a library call the copy keeps: the audit hook
     "numpy_dump": ("env.palm_pose.p.numpy().dump('{marker}')", "may not import 'numpy"),
-    "torch_hub": ("torch.hub.list('pytorch/vision')", "has no attribute 'hub'"),
-    "rt_torch": ("rt.torch.save(env.palm_pose.p, '{marker}')", "has no attribute 'torch'"),
+    "torch_hub": ("torch.hub.list('pytorch/vision')", "may not use torch.hub"),
+    "rt_torch": ("rt.torch.save(env.palm_pose.p, '{marker}')", "may not use gendex_envs.reward_terms.torch"),
 }
 
 SCRIPT = '''

@@ -1,4 +1,4 @@
-# expect: returns the module `torch`
+# expect: `rt.torch` is not allowed: reward code may use only
 # class: modules
 # ruff: noqa (deliberately hostile code: it only has to fail the static check)
 """Hostile reward module: getattr hands out a module, whose attributes are then not followed."""

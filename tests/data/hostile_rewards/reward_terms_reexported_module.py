@@ -1,4 +1,4 @@
-# expect: is the module `torch.random`
+# expect: `rt.torch` is not allowed: reward code may use only
 # class: modules
 # ruff: noqa (deliberately hostile code: it only has to fail the static check)
 """Hostile reward module: a module reached through the helpers' own imports."""

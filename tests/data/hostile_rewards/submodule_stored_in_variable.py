@@ -1,4 +1,4 @@
-# expect: the module `F.torch` may only be used as
+# expect: `F.torch` is not allowed: reward code may use only
 # class: modules
 # ruff: noqa (deliberately hostile code: it only has to fail the static check)
 """Hostile reward module: a module reached through another module's attribute, stored in a variable."""

@@ -1,0 +1,18 @@
+# expect: `.data_ptr` in
+# runtime: static only
+"""Hostile: a raw pointer into the process's memory."""
+import math
+
+import torch
+import torch.nn.functional as F
+
+from gendex_envs import reward_terms as rt
+
+
+def evaluate(env):
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.tip_positions.data_ptr()
+    return rt.fraction(torch.zeros(env.num_envs, device=env.device)) * math.pi * F.relu(torch.zeros(1))

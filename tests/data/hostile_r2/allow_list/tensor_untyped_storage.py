@@ -1,0 +1,18 @@
+# expect: `.untyped_storage` in
+# runtime: static only
+"""Hostile: the storage of an env tensor exposes raw memory."""
+import math
+
+import torch
+import torch.nn.functional as F
+
+from gendex_envs import reward_terms as rt
+
+
+def evaluate(env):
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}
+
+
+def compute_dense_reward(env, obs, action, info):
+    s = env.tip_positions.untyped_storage()
+    return rt.fraction(torch.zeros(env.num_envs, device=env.device)) * math.pi * F.relu(torch.zeros(1))

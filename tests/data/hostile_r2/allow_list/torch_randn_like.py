@@ -1,0 +1,18 @@
+# expect: `torch.randn_like` is not allowed
+# runtime: may not use torch.randn_like
+"""Hostile: random draws advance the global generator."""
+import math
+
+import torch
+import torch.nn.functional as F
+
+from gendex_envs import reward_terms as rt
+
+
+def evaluate(env):
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}
+
+
+def compute_dense_reward(env, obs, action, info):
+    noise = torch.randn_like(env.tip_positions)
+    return rt.fraction(torch.zeros(env.num_envs, device=env.device)) * math.pi * F.relu(torch.zeros(1))
