@@ -607,9 +607,8 @@ class TaskEnv(BaseEnv):
         return common.flatten_state_dict(state, use_torch=True, device=self.device)
 
     def own_obs_keys(self) -> frozenset[str]:
-        """Names of the state observations the env provides itself, its extras and the agent's, and the
-        observation's top-level names (:data:`~gendex_envs.reward_checks.RESERVED_OBS_KEYS`): a reward module's
-        extras may not reuse them."""
+        """Names a reward module's extras may not reuse: the env's own state observations, the agent's and the
+        observation's top-level names (:data:`~gendex_envs.reward_checks.RESERVED_OBS_KEYS`)."""
         keys = {"palm_pose", "tip_pos", *(f"{n}_pose" for n in self.objects),
                 *(f"{n}_qpos" for n in self.articulations)}
         if self.goal_site is not None:
@@ -635,11 +634,9 @@ class TaskEnv(BaseEnv):
         return flat if flat is not None else super()._flatten_raw_obs(obs)
 
     def compute_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
-        """The reward module's reward, checked on every call (finite float [N]); its ``info`` lacks the env's
-        bookkeeping (:func:`~gendex_envs.reward_view.reward_info`)."""
-        module = self.reward
-        return check_reward(module.compute_dense_reward(self, obs, action, reward_info(info)), self.num_envs,
-                            self.device, path=module.path, step=self.elapsed_steps)
+        """The module's reward, checked on every call; its ``info`` without bookkeeping (``reward_info``)."""
+        return check_reward(self.reward.compute_dense_reward(self, obs, action, reward_info(info)), self.num_envs,
+                            self.device, path=self.reward.path, step=self.elapsed_steps)
 
     def compute_normalized_dense_reward(self, obs, action: torch.Tensor, info: dict) -> torch.Tensor:
         return self.compute_dense_reward(obs, action, info) / self.reward.reward_max
