@@ -4,6 +4,7 @@ calls with a snapshot of the env members each function reads (see :mod:`gendex_e
 from __future__ import annotations
 
 import atexit
+import builtins
 import logging
 import os
 import queue
@@ -104,6 +105,29 @@ def _key(raw) -> tuple:
     return tuple(raw)
 
 
+_LIMIT_ERRORS: dict[type, type] = {}
+
+
+def _limit_error(base: type) -> type:
+    """A :class:`RewardSandboxError` that is also ``base`` and bears its name (``RuntimeError`` for torch's failed
+    allocation), so that a report of the form "raised RuntimeError: ..." reads as it does in-process."""
+    if base not in _LIMIT_ERRORS:
+        _LIMIT_ERRORS[base] = type(base.__name__, (RewardSandboxError, base), {"__module__": __name__})
+    return _LIMIT_ERRORS[base]
+
+
+def _at_line(exc: BaseException, path: Path, line) -> BaseException:
+    """``exc`` with a traceback frame at ``path``:``line`` (where the worker saw it raised), as an in-process
+    call's traceback would have."""
+    if type(line) is not int or not 0 < line <= 1_000_000:
+        return exc
+    try:
+        exec(compile("\n" * (line - 1) + "raise exc", str(path), "exec"), {"exc": exc})
+    except type(exc) as raised:
+        return raised
+    return exc
+
+
 def _same(a, b) -> bool:
     """``a`` is ``b``, or both are dicts holding the very same objects under the same keys (the env hands
     ``_get_obs_extra`` and ``compute_dense_reward`` each a fresh dict of one step's info tensors)."""
@@ -156,10 +180,15 @@ def _spawn(argv: list[str], env: dict) -> subprocess.Popen:
         close_fds=True, cwd="/", env=env))
 
 
-def _kill(proc: subprocess.Popen) -> None:
+def _kill(proc: subprocess.Popen, pidfd: int | None = None) -> None:
+    """SIGKILL and reap; through the pidfd when there is one (``pidfd_send_signal`` raises no audit event, so a
+    hook that refuses ``os.kill`` while reward code runs, as the probe's does, cannot keep the worker alive)."""
     if proc.poll() is None:
         try:
-            proc.kill()
+            if pidfd is not None:
+                signal.pidfd_send_signal(pidfd, signal.SIGKILL)
+            else:
+                proc.kill()
         except OSError:
             pass
     try:
@@ -169,6 +198,11 @@ def _kill(proc: subprocess.Popen) -> None:
     for f in (proc.stdin, proc.stdout):
         try:
             f.close()
+        except OSError:
+            pass
+    if pidfd is not None:
+        try:
+            os.close(pidfd)
         except OSError:
             pass
 
@@ -187,7 +221,11 @@ class Worker:
         os.set_blocking(self.wfd, False)
         self.lock = threading.RLock()
         self.dead: str | None = None
-        self._finalizer = weakref.finalize(self, _kill, self.proc)
+        try:
+            pidfd = os.pidfd_open(self.proc.pid)
+        except (AttributeError, OSError):  # before Linux 5.3
+            pidfd = None
+        self._finalizer = weakref.finalize(self, _kill, self.proc, pidfd)
         self.next_id = 0
         try:
             msg = self.read(time.monotonic() + START_TIMEOUT_S)
@@ -291,7 +329,13 @@ class RemoteModule:
             self.id = worker.next_id
             header = {"op": "load", "id": self.id, "name": f"gendex_reward_{self.id}", "filename": str(self.path),
                       "source": self.source, "full_builtins": self.full_builtins}
-            reply = self._exchange(worker, header, [], "import", None, time.monotonic() + call_timeout())
+            try:
+                reply = self._exchange(worker, header, [], "import", None, time.monotonic() + call_timeout())
+            except RewardSandboxError:
+                raise
+            except Exception as exc:  # the module's own error, as the in-process path reports it
+                raise RewardModuleError(f"reward module {self.path} failed to import: {type(exc).__name__}: "
+                                        f"{exc}") from exc
         self.worker = worker
         if reply.get("op") != "loaded" or not isinstance(reply.get("functions"), list):
             raise RewardSandboxError(f"reward module {self.path}: the worker's reply to loading it is malformed")
@@ -394,13 +438,23 @@ class RemoteModule:
         if msg.get("remote") is True and name in errors:
             return errors[name]  # the real view's own error (an unknown object, a task without goal)
         if msg.get("memory") is True:
-            return RewardSandboxError(
-                f"{where} ran out of memory in the sandbox (the worker's limit is {self.worker_memory() >> 20} MiB; "
-                f"{MEMORY_ENV} raises it): {name}: {text}")
+            base = getattr(builtins, name, None)
+            base = base if base in (MemoryError, RuntimeError) else RuntimeError
+            return _at_line(_limit_error(base)(
+                f"{text} ({where} ran out of memory in the sandbox: the worker's limit is "
+                f"{self.worker_memory() >> 20} MiB; {MEMORY_ENV} raises it)"), self.path, msg.get("line"))
         if name == "UntrustedCodeError":
             from gendex_envs.guard import UntrustedCodeError
 
             return UntrustedCodeError(f"{where}: {text}")
+        cls = getattr(builtins, name, None)
+        if isinstance(cls, type) and issubclass(cls, Exception) and not issubclass(cls, OSError):
+            try:  # what the module raised, as the in-process path raises it (the probe reports type and line)
+                args = msg.get("args")
+                simple = isinstance(args, list) and all(a is None or isinstance(a, str | int | float) for a in args)
+                return _at_line(cls(*args) if simple else cls(text), self.path, msg.get("line"))
+            except Exception:
+                pass
         return RewardModuleError(f"{where} raised {name}: {text}")
 
     def worker_memory(self) -> int:

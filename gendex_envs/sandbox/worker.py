@@ -272,6 +272,16 @@ def _call(msg: dict, modules: dict, channel: Channel):
     return value, [early]
 
 
+def _line(exc: BaseException) -> int | None:
+    """The line of the deepest frame of a reward module in ``exc``'s traceback (the parent names it)."""
+    line, tb = None, exc.__traceback__
+    while tb is not None:
+        if tb.tb_frame.f_globals.get("__name__", "").startswith("gendex_reward_"):
+            line = tb.tb_lineno
+        tb = tb.tb_next
+    return line
+
+
 def serve(rfd: int, wfd: int) -> None:
     channel, modules = Channel(rfd, wfd), {}
     while True:
@@ -297,7 +307,9 @@ def serve(rfd: int, wfd: int) -> None:
                 channel.send({"op": "exc", "type": "ProtocolError", "msg": f"unknown request {str(op)[:50]}"})
         except BaseException as exc:
             try:
-                channel.send({"op": "exc", "type": type(exc).__name__, "msg": str(exc)[:4000],
+                channel.send({"op": "exc", "type": type(exc).__name__, "msg": str(exc)[:4000], "line": _line(exc),
+                              "args": [str(a)[:4000] if isinstance(a, str) else a for a in exc.args[:4]]
+                              if all(a is None or isinstance(a, str | int | float) for a in exc.args) else None,
                               "remote": id(exc) in channel.remote_errors,
                               "memory": isinstance(exc, MemoryError) or "can't allocate memory" in str(exc)})
             except BaseException:

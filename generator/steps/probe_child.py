@@ -444,6 +444,9 @@ def main(argv: list[str]) -> int:
         return reap(argv[1])
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     _die_with_parent(job.get("parent_pid"))  # first: before any simulator, reward code or audit hook
+    # this process is the probe's own boundary (its CPU budgets, memory and file limits, audit hook, reaper): the
+    # candidates run here, in-process, so that those budgets measure them (not gendex_envs.sandbox's worker)
+    os.environ["GENDEX_IN_PROCESS_GUARD"] = "1"
     faulthandler.enable(file=sys.stderr, all_threads=True)
     faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
     _limit_startup(job)
