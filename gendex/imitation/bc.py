@@ -38,6 +38,7 @@ from torch import nn
 from gendex.imitation.frames import DatasetReadError, Frames, lerobot_root, load_frames
 from gendex_envs.errors import GenDexError, PolicyError
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
+from gendex_envs.saved_tensors import check_tensor_sizes
 
 log = logging.getLogger(__name__)
 
@@ -268,8 +269,11 @@ def load_checkpoint(path: Path | str) -> dict:
         raise _bad(path, f"{list(_INFO)} must be JSON values")
     weights = ckpt["model"]
     if not isinstance(weights, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
-                                                and v.is_floating_point() and bool(torch.isfinite(v).all())
                                                 for k, v in weights.items()):
+        raise _bad(path, "model must map names to finite floating-point tensors")
+    tensors = [*weights.items(), *((k, ckpt[k]) for k in _NORMS if isinstance(ckpt[k], torch.Tensor))]
+    check_tensor_sizes(tensors, path, PolicyError, MAX_CHECKPOINT_BYTES)  # before isfinite materialises a view
+    if not all(v.is_floating_point() and bool(torch.isfinite(v).all()) for v in weights.values()):
         raise _bad(path, "model must map names to finite floating-point tensors")
     for k in _NORMS:
         v = ckpt[k]

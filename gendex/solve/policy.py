@@ -33,6 +33,7 @@ import torch
 
 from gendex_envs.agents.ur10e_shadow import delta_limits, free_joints
 from gendex_envs.errors import PolicyError, StageError
+from gendex_envs.saved_tensors import check_tensor_sizes
 from gendex_envs.success import Judge
 from gendex_envs.task_version import PolicyFiles, TaskVersion
 
@@ -205,6 +206,7 @@ def read_policy_weights(path: str | Path) -> dict[str, torch.Tensor]:
     if not isinstance(state, dict) or not all(isinstance(k, str) and isinstance(v, torch.Tensor)
                                               for k, v in state.items()):
         raise _refuse(path, f"{WEIGHTS_ENTRY} must hold a mapping of names to tensors")
+    check_tensor_sizes(state.items(), f"{path}: {WEIGHTS_ENTRY}", PolicyError, MAX_POLICY_WEIGHTS_BYTES)
     for k, v in state.items():
         if not v.is_floating_point() or not bool(torch.isfinite(v).all()):
             raise _refuse(path, f"weight {k!r} must be finite floating-point numbers")
