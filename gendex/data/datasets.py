@@ -321,20 +321,35 @@ REPO_TAGS = ("v3.0",)
 """Git tags of a pushed repo: lerobot finds a dataset's format version by its tag (the v3.0 codebase version)."""
 
 
+MAX_DOWNLOAD_DEPTH = 32
+"""Folder levels a download may nest (a LeRobot dataset's deepest file, ``<task>/lerobot/videos/<key>/chunk-000/
+file-000.mp4``, is 6 levels down). The copy recurses once per level: 500 levels raised a bare ``RecursionError``."""
+
+
 def regular_files_only(root: Path) -> None:
-    """Refuse (:class:`DatasetError` naming the entry) a symbolic link or a non-regular file anywhere under ``root``;
-    links are not followed."""
+    """Refuse (:class:`DatasetError` naming the entry) a symbolic link or a non-regular file anywhere under ``root``,
+    or folders nested deeper than :data:`MAX_DOWNLOAD_DEPTH`; links are not followed. The walk keeps its own stack,
+    so no depth of nesting makes it recurse."""
     root = Path(root)
-    for dirpath, dirnames, filenames in os.walk(root):
-        for name in dirnames + filenames:
-            path = Path(dirpath) / name
-            mode = os.lstat(path).st_mode
-            if stat.S_ISLNK(mode):
-                raise DatasetError(f"{path.relative_to(root)} is a symbolic link: a dataset may hold only regular "
-                                   "files and folders")
-            if not (stat.S_ISDIR(mode) or stat.S_ISREG(mode)):
-                raise DatasetError(f"{path.relative_to(root)} is not a regular file or folder: a dataset may hold "
-                                   "only regular files and folders")
+    stack = [(root, 0)]
+    while stack:
+        folder, depth = stack.pop()
+        with os.scandir(folder) as entries:
+            for entry in entries:
+                path = Path(entry.path)
+                mode = entry.stat(follow_symlinks=False).st_mode
+                if stat.S_ISLNK(mode):
+                    raise DatasetError(f"{path.relative_to(root)} is a symbolic link: a dataset may hold only regular "
+                                       "files and folders")
+                if stat.S_ISDIR(mode):
+                    if depth + 1 > MAX_DOWNLOAD_DEPTH:
+                        raise DatasetError(f"{quote(str(path.relative_to(root)))} is nested more than "
+                                           f"MAX_DOWNLOAD_DEPTH = {MAX_DOWNLOAD_DEPTH} folders deep; a dataset's "
+                                           "files lie a few levels down")
+                    stack.append((path, depth + 1))
+                elif not stat.S_ISREG(mode):
+                    raise DatasetError(f"{path.relative_to(root)} is not a regular file or folder: a dataset may hold "
+                                       "only regular files and folders")
 
 
 def _inside(root: Path, *parts: str) -> Path:
