@@ -32,6 +32,7 @@ import logging
 import os
 import re
 import shutil
+import stat
 import uuid
 from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass
@@ -40,7 +41,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gendex_envs.errors import StageError, TaskNotFoundError, TaskSpecError
-from gendex_envs.spec import TASK_NAME_RE, StageSpec, TaskSpec, load_task_spec, resolve_stage
+from gendex_envs.spec import SNAKE_NAME_RE, TASK_NAME_RE, StageSpec, TaskSpec, load_task_spec, resolve_stage
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.reward_module import RewardModule
@@ -470,26 +471,80 @@ def publish_derived(source: TaskVersion, kind: str, edit: Callable[[TaskLayout],
             shutil.rmtree(draft, ignore_errors=True)
 
 
+MAX_PROMOTED_FILE_BYTES = 600_000_000
+"""Largest file ``gendex promote`` copies out of a run (a policy zip of the paper's network is about 30 MB; the
+policy loader's own bound on its weights is 256 MB)."""
+
+
+def _run_file(root: Path, path: Path) -> Path:
+    """``path`` (under the run folder ``root``), checked before it is copied into a task version: a regular file,
+    no symbolic link on the way from ``root`` (a link would copy a file from anywhere, ``~/.ssh/id_rsa`` or
+    ``/dev/zero``, into the task folder), at most :data:`MAX_PROMOTED_FILE_BYTES`. :class:`StageError` otherwise."""
+    rel = path.relative_to(root)
+    at = root
+    for part in rel.parts:
+        at = at / part
+        try:
+            mode = os.lstat(at).st_mode
+        except OSError as exc:
+            raise StageError(f"cannot promote {path}: {exc.strerror}") from None
+        if stat.S_ISLNK(mode):
+            raise StageError(f"cannot promote {path}: {at} is a symbolic link; a run's policies and start states "
+                             "must be regular files inside it")
+    size = os.lstat(path)
+    if not stat.S_ISREG(size.st_mode):
+        raise StageError(f"cannot promote {path}: not a regular file")
+    if size.st_size > MAX_PROMOTED_FILE_BYTES:
+        raise StageError(f"cannot promote {path}: {size.st_size} bytes; at most MAX_PROMOTED_FILE_BYTES = "
+                         f"{MAX_PROMOTED_FILE_BYTES} are allowed")
+    return path
+
+
+def _copy_run_file(root: Path, src: Path, dst: Path) -> None:
+    """Copy ``src`` (checked by :func:`_run_file`) to ``dst``, opened without following a link (a link put there
+    after the check is refused too)."""
+    _run_file(root, src)
+    fd = os.open(src, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as f, open(dst, "wb") as out:
+        shutil.copyfileobj(f, out)
+    shutil.copystat(src, dst, follow_symlinks=False)
+
+
 def derive_version(source: TaskVersion, overlays: Collection[Artifacts], record: dict) -> TaskVersion:
     """Publish ``v<N+1>`` of ``source``'s task: a copy of ``source`` with the policies and start states of
-    ``overlays`` (later overlays win) and ``record`` saved as ``promotion.json``. ``source`` is left untouched."""
+    ``overlays`` (later overlays win) and ``record`` saved as ``promotion.json``. ``source`` is left untouched.
+
+    A run folder is untrusted data (``gendex promote`` may be given any folder): every file copied must be a regular
+    file reached through no symbolic link and within :data:`MAX_PROMOTED_FILE_BYTES`, stage names must be snake_case
+    names, and start states must load (:meth:`StartStates.load <gendex_envs.start_states.StartStates.load>`:
+    bounded, finite). A refusal is a :class:`StageError` and publishes nothing."""
+    from gendex_envs.start_states import StartStates
+
+    def stage_name(art: Artifacts, stage: str) -> str:
+        if not SNAKE_NAME_RE.fullmatch(stage):
+            raise StageError(f"cannot promote {art.layout.root}: stage {stage[:100]!r} is not a snake_case stage name")
+        return stage
 
     def overlay(out: TaskLayout) -> dict:
         copied: dict[str, list[str]] = {"policies": [], "start_states": []}
         for art in overlays:
+            src = art.layout
+            root = src.root
             for stage in art.policy_stages():
-                src = art.layout
+                stage_name(art, stage)
                 out.policies.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(src.policy(stage), out.policy(stage))
-                shutil.copy2(src.policy_record(stage), out.policy_record(stage))
+                _copy_run_file(root, src.policy(stage), out.policy(stage))
+                _copy_run_file(root, src.policy_record(stage), out.policy_record(stage))
                 curve = src.policy_curves(stage) / "progress.csv"
-                if curve.is_file():
+                if curve.is_file() or curve.is_symlink():
                     out.policy_curves(stage).mkdir(parents=True, exist_ok=True)
-                    shutil.copy2(curve, out.policy_curves(stage) / curve.name)
+                    _copy_run_file(root, curve, out.policy_curves(stage) / curve.name)
                 copied["policies"].append(stage)
             for stage in art.start_state_stages():
+                stage_name(art, stage)
+                StartStates.load(_run_file(root, src.start_states(stage)))  # bounded and finite, or StageError
                 out.start_states_dir.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(art.layout.start_states(stage), out.start_states(stage))
+                _copy_run_file(root, src.start_states(stage), out.start_states(stage))
                 copied["start_states"].append(stage)
         if not any(copied.values()):
             raise StageError(f"nothing to promote: {', '.join(str(a.layout.root) for a in overlays)} hold no "
