@@ -30,6 +30,9 @@ DTYPES = {name: getattr(torch, name) for name in (
     "float32", "float64", "float16", "bfloat16", "int64", "int32", "int16", "int8", "uint8", "bool")}
 """The only tensor types that cross (no complex, no quantized, no sparse)."""
 _NAMES = {dtype: name for name, dtype in DTYPES.items()}
+_SIZES = {name: torch.empty((), dtype=dtype).element_size() for name, dtype in DTYPES.items()}
+_ALIGN = 8
+"""Each tensor starts at a multiple of 8 bytes of the payload, so that it can be read in place."""
 _PREFIX = struct.Struct("<IQ")
 assert sys.byteorder == "little", "the wire format is little-endian"
 
@@ -41,12 +44,17 @@ class ProtocolError(ValueError):
 # ---------------------------------------------------------------------------------------------- encoding
 def encode(value, tensors: list, depth: int = 0):
     """``value`` as JSON-ready data; its tensors (moved to the CPU, contiguous) are appended to ``tensors``."""
+    kind = type(value)
+    if kind is str or kind is int or kind is bool or value is None:
+        return value
     if depth > MAX_DEPTH:
         raise ProtocolError(f"value nested deeper than {MAX_DEPTH} levels")
     if isinstance(value, torch.Tensor):
         if value.dtype not in _NAMES:
             raise ProtocolError(f"tensor of dtype {value.dtype}; allowed: {sorted(DTYPES)}")
-        tensors.append(value.detach().to("cpu").contiguous())
+        if value.device.type != "cpu" or value.requires_grad or not value.is_contiguous():
+            value = value.detach().to("cpu").contiguous()
+        tensors.append(value)
         return {"$t": len(tensors) - 1}
     if value is None or isinstance(value, bool | int | str):
         return value
@@ -66,10 +74,15 @@ def frame(header: dict, tensors: list) -> list:
     """The byte strings of one frame (header already holds encoded values; ``tensors`` from :func:`encode`)."""
     specs, chunks, offset = [], [], 0
     for t in tensors:
-        n = t.numel() * t.element_size()
-        specs.append([_NAMES[t.dtype], list(t.shape), offset])
+        name = _NAMES[t.dtype]
+        n = t.numel() * _SIZES[name]
+        pad = -offset % _ALIGN
+        if pad:
+            chunks.append(bytes(pad))
+            offset += pad
+        specs.append([name, list(t.shape), offset])
         if n:
-            chunks.append(memoryview(t.reshape(-1).view(torch.uint8).numpy()))
+            chunks.append((t.view(torch.int16) if name == "bfloat16" else t).numpy().tobytes())
         offset += n
     header = dict(header, tensors=specs)
     text = json.dumps(header, separators=(",", ":")).encode()
@@ -129,11 +142,12 @@ def _tensors(specs: list, payload: bytearray, device) -> list:
             raise ProtocolError(f"bad tensor description {str(spec)[:200]}; expected [dtype, shape, offset] with "
                                 f"dtype in {sorted(DTYPES)}")
         dtype, shape, offset = DTYPES[spec[0]], spec[1], spec[2]
-        n = math.prod(shape) * torch.empty((), dtype=dtype).element_size()
-        if offset != end or offset + n > len(payload):
+        count = math.prod(shape)
+        n = count * _SIZES[spec[0]]
+        if offset != end + (-end % _ALIGN) or offset + n > len(payload):
             raise ProtocolError(f"tensor bytes {offset}..{offset + n} outside the payload of {len(payload)} bytes")
         end = offset + n
-        t = (torch.frombuffer(payload, dtype=torch.uint8, count=n, offset=offset).view(dtype).reshape(shape)
+        t = (torch.frombuffer(payload, dtype=dtype, count=count, offset=offset).view(shape)
              if n else torch.empty(shape, dtype=dtype))
         out.append(t if device is None or torch.device(device).type == "cpu" else t.to(device))
     if end != len(payload):
@@ -141,10 +155,18 @@ def _tensors(specs: list, payload: bytearray, device) -> list:
     return out
 
 
+_SCALARS = frozenset({str, int, float, bool, type(None)})
+
+
 def _decode(value, tensors: list, depth: int):
+    kind = type(value)
+    if kind in _SCALARS:
+        return value
     if depth > MAX_DEPTH:
         raise ProtocolError(f"value nested deeper than {MAX_DEPTH} levels")
-    if isinstance(value, dict):
+    if kind is list:
+        return [v if type(v) in _SCALARS else _decode(v, tensors, depth + 1) for v in value]
+    if kind is dict:
         if len(value) == 1 and "$t" in value:
             i = value["$t"]
             if type(i) is not int or not 0 <= i < len(tensors):
@@ -155,13 +177,9 @@ def _decode(value, tensors: list, depth: int):
         if len(value) == 1 and isinstance(value.get("$d"), list):
             out = {}
             for item in value["$d"]:
-                if not (isinstance(item, list) and len(item) == 2 and isinstance(item[0], str)):
+                if not (type(item) is list and len(item) == 2 and type(item[0]) is str):
                     raise ProtocolError("bad dict entry")
                 out[item[0]] = _decode(item[1], tensors, depth + 1)
             return out
         raise ProtocolError(f"untagged object {str(value)[:100]}")
-    if isinstance(value, list):
-        return [_decode(v, tensors, depth + 1) for v in value]
-    if value is None or isinstance(value, bool | int | float | str):
-        return value
     raise ProtocolError(f"unexpected value {str(value)[:100]}")

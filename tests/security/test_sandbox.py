@@ -357,3 +357,27 @@ def test_errors_of_the_real_view_are_raised_as_they_are(env, tmp_path):
     with pytest.raises(GenDexError) as direct:
         env.obj_height("no_such_object")
     assert type(sandboxed.value) is type(direct.value) and str(sandboxed.value) == str(direct.value)
+
+
+def test_the_wire_format_round_trips_every_allowed_dtype_and_refuses_others():
+    from gendex_envs.sandbox import protocol
+
+    value = {"f32": torch.randn(2, 3), "bf16": torch.randn(3).to(torch.bfloat16), "b": torch.tensor([True, False]),
+             "i64": torch.arange(5), "u8": torch.arange(3, dtype=torch.uint8), "empty": torch.zeros(0, 3),
+             "scalar": torch.tensor(2.5, dtype=torch.float64), "nan": float("nan"), "nested": [1, "x", None, (2.5,)],
+             "strided": torch.arange(12.0).reshape(3, 4)[:, 1]}
+    read, write = os.pipe()
+    try:
+        tensors: list = []
+        protocol.write_frame(write, {"op": "ret", "value": protocol.encode(value, tensors)}, tensors)
+        out = protocol.read_frame(read)["value"]
+    finally:
+        os.close(read)
+        os.close(write)
+    for key, expected in value.items():
+        if isinstance(expected, torch.Tensor):
+            assert out[key].dtype == expected.dtype and torch.equal(out[key], expected), key
+    assert out["nested"] == [1, "x", None, [2.5]] and out["nan"] != out["nan"]
+    for bad in (torch.zeros(2, dtype=torch.complex64), object(), {1: torch.zeros(1)}):
+        with pytest.raises(protocol.ProtocolError):
+            protocol.encode(bad, [])
