@@ -227,6 +227,19 @@ def test_an_overlong_part_name_is_a_gendex_error_naming_the_module(env, tmp_path
         loaded.compute_dense_reward(env, None, None, {})
 
 
+@pytest.mark.parametrize("path", sorted((PAYLOADS / "resources").glob("*.py")), ids=lambda p: p.stem)
+def test_unbounded_work_through_allowed_names_is_a_typed_error_within_the_limit(env, tmp_path, monkeypatch, path):
+    """Memory (2**62 zeros, a 2**31 expand made contiguous, one_hot of 1e11, a 2**28-element list), CPU (a sum over
+    2**40 broadcast elements) and recursion, through allow-listed names only."""
+    monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", str(CALL_LIMIT_S))
+    loaded = load_reward_module(_untrusted(tmp_path, path.read_text()), trusted=False)
+    start = time.monotonic()
+    with pytest.raises(GenDexError, match="reward.py"):
+        loaded.evaluate(env)
+    assert time.monotonic() - start < CALL_LIMIT_S + 3
+    _honest_still_runs(env, tmp_path)
+
+
 # ---------------------------------------------------------------------------------------------- per-step outputs
 @pytest.mark.parametrize("key", ["Success", "success ", "s\u0443ccess", "is_success\n", "_final_info",
                                  "TimeLimit.truncated", "episode", "final_info", "terminal_observation", "reward"])
@@ -242,6 +255,16 @@ def test_task_observations_cannot_take_the_envs_names_in_any_spelling(key):
     taken = {"palm_pose": None, "tip_pos": None, "apple_pose": None, "bowl_pose": None, "goal_pos": None}
     with pytest.raises(GenDexError):
         check_obs_extra({key: torch.zeros(1, 3)}, 1, "cpu", taken, path="r.py", step=30)
+
+
+@pytest.mark.parametrize("dtype, value", [(torch.int64, 2**62), (torch.int64, -2**63), (torch.int32, 2**31 - 1)])
+@pytest.mark.xfail(strict=True, reason="escape: check_obs_extra bounds only floating values, so an integer task "
+                   "observation of 2**62 passes and the flat state observation (float32) carries 4.6e18, far past "
+                   "MAX_ABS_VALUE = 1e9 that the rule sets to keep normalised observations from overflowing "
+                   "(gendex_envs/reward_checks.py: bound integer values too, or refuse integer observations)")
+def test_an_integer_task_observation_is_bounded_like_a_float_one(dtype, value):
+    with pytest.raises(GenDexError):
+        check_obs_extra({"count": torch.full((1, 3), value, dtype=dtype)}, 1, "cpu", {}, path="r.py", step=30)
 
 
 def test_a_float_fail_is_refused():
@@ -291,6 +314,25 @@ def test_an_object_name_cannot_replace_the_palm_observation(task_copy):
     except GenDexError:
         return
     assert torch.equal(obs["extra"]["palm_pose"], e.palm_pose.raw_pose), "palm_pose is not the palm's pose"
+
+
+@pytest.mark.xfail(strict=True, reason="escape (smaller class): start states of the wrong width (5 values; the "
+                   "task's flat state has about 120) load, and reset raises a bare TypeError from SAPIEN instead of "
+                   "a GenDex error naming the file (gendex_envs/task_env.py _load_start_states: check the width "
+                   "against the env's flat state)")
+def test_start_states_of_the_wrong_width_are_a_typed_error(tmp_path):
+    from gendex_envs.registry import resolve_task
+    from gendex_envs.start_states import StartStates
+    from gendex_envs.task_env import TaskEnv
+
+    unit = np.tile(np.array([1, 0, 0, 0], np.float32), (2, 1))
+    states = StartStates(stage="reach_apple", state=np.zeros((2, 5), np.float32),
+                         obj_reset_pos={"apple": np.zeros((2, 3), np.float32), "bowl": np.zeros((2, 3), np.float32)},
+                         obj_reset_quat={"apple": unit, "bowl": unit}).save(tmp_path / "narrow.npz")
+    with pytest.raises(GenDexError):
+        e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
+                    render_backend="none", start_states=states)
+        e.reset(seed=0)
 
 
 # ---------------------------------------------------------------------------------------------- identity

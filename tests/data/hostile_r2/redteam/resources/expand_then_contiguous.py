@@ -1,0 +1,16 @@
+# expect: a typed error within the call's limit, the env and later modules unharmed
+# Only allow-listed names, but unbounded work: `x = torch.ones(1).expand(2**31).contiguous().sum()`.
+import torch
+
+
+def _deeper(n):
+    return _deeper(n + 1)
+
+
+def evaluate(env):
+    x = torch.ones(1).expand(2**31).contiguous().sum()
+    return {"fail": torch.zeros(env.num_envs, dtype=torch.bool, device=env.device) | (x == 0).any()}
+
+
+def compute_dense_reward(env, obs, action, info):
+    return torch.zeros(env.num_envs, device=env.device)
