@@ -19,7 +19,7 @@ from pathlib import Path
 
 import torch
 
-from gendex_envs.errors import RewardModuleError, RewardSandboxError, RewardTimeoutError
+from gendex_envs.errors import GenDexError, RewardModuleError, RewardSandboxError, RewardTimeoutError
 from gendex_envs.sandbox import confine, protocol
 
 log = logging.getLogger(__name__)
@@ -40,7 +40,7 @@ on a system without Landlock or seccomp; without it such a system refuses untrus
 WORKER = Path(__file__).resolve().with_name("worker.py")
 FULL_BUILTINS_FOR_TESTS = False
 """Tests only: load modules in the worker with Python's ordinary builtins, as if the first wall had a hole."""
-MAX_KEY_ARG_CHARS = 256
+MAX_KEY_ARG_CHARS = 4096
 FUNCTIONS = ("evaluate", "compute_dense_reward", "_get_obs_extra")
 
 
@@ -114,6 +114,20 @@ def _limit_error(base: type) -> type:
     if base not in _LIMIT_ERRORS:
         _LIMIT_ERRORS[base] = type(base.__name__, (RewardSandboxError, base), {"__module__": __name__})
     return _LIMIT_ERRORS[base]
+
+
+_CODE_ERRORS: dict[type, type] = {}
+
+
+def _code_error(base: type) -> type:
+    """A :class:`~gendex_envs.errors.GenDexError` that is also ``base`` (a builtin exception reward code raised in
+    the worker) and bears its name: callers that catch ``IndexError`` still do, and the error names the module."""
+    if base not in _CODE_ERRORS:
+        try:
+            _CODE_ERRORS[base] = type(base.__name__, (GenDexError, base), {"__module__": __name__})
+        except TypeError:  # a base whose instance layout does not mix
+            _CODE_ERRORS[base] = RewardModuleError
+    return _CODE_ERRORS[base]
 
 
 def _at_line(exc: BaseException, path: Path, line) -> BaseException:
@@ -405,10 +419,14 @@ class RemoteModule:
                     keys = self.prefetch.setdefault(msg.get("fn") if msg.get("fn") in FUNCTIONS else fn, {})
                     try:
                         key = _key(msg.get("key"))
+                    except TypeError as exc:  # our own refusal of the request, not the real view's
+                        exc = RewardModuleError(f"{where}: {exc}")
+                        worker.write({"op": "err", "type": "TypeError", "msg": str(exc)[:4000]}, [], deadline)
+                        errors["TypeError"] = exc
+                        continue
+                    try:
                         value = MEMBERS[key[0]][1](view, *key[1:])
-                    except protocol.ProtocolError:
-                        raise
-                    except Exception as exc:
+                    except Exception as exc:  # the real view's error, raised in the worker as is
                         errors[type(exc).__name__] = exc
                         worker.write({"op": "err", "type": type(exc).__name__, "msg": str(exc)[:4000]}, [], deadline)
                         continue
@@ -449,10 +467,8 @@ class RemoteModule:
             return UntrustedCodeError(f"{where}: {text}")
         cls = getattr(builtins, name, None)
         if isinstance(cls, type) and issubclass(cls, Exception) and not issubclass(cls, OSError):
-            try:  # what the module raised, as the in-process path raises it (the probe reports type and line)
-                args = msg.get("args")
-                simple = isinstance(args, list) and all(a is None or isinstance(a, str | int | float) for a in args)
-                return _at_line(cls(*args) if simple else cls(text), self.path, msg.get("line"))
+            try:  # a GenDex error that is also what the module raised, at the module's line (as in-process)
+                return _at_line(_code_error(cls)(f"{where} raised {name}: {text}"), self.path, msg.get("line"))
             except Exception:
                 pass
         return RewardModuleError(f"{where} raised {name}: {text}")
