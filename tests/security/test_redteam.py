@@ -240,6 +240,93 @@ def test_unbounded_work_through_allowed_names_is_a_typed_error_within_the_limit(
     _honest_still_runs(env, tmp_path)
 
 
+@pytest.fixture
+def first_wall_down(monkeypatch):
+    """As if the static check and the restricted builtins had a hole: the worker runs the module with Python's
+    ordinary builtins (only the OS confinement is left)."""
+    import builtins
+
+    from gendex_envs import guard
+
+    monkeypatch.setattr(guard, "restricted_builtins", lambda: dict(vars(builtins)))
+    monkeypatch.setattr(guard, "untrust", lambda folder: None)
+    monkeypatch.setattr("gendex_envs.sandbox.host.FULL_BUILTINS_FOR_TESTS", True)
+    monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", str(CALL_LIMIT_S))
+
+
+@pytest.fixture
+def victim():
+    """Another process of this user, holding a secret in its environment."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"],
+                            env={**os.environ, "GENDEX_REDTEAM_TOKEN": "hf_redteam_secret_token"})
+    yield proc
+    proc.kill()
+    proc.wait()
+
+
+def _first_wall_down_evaluate(env, tmp_path: Path, name: str, **values):
+    text = (PAYLOADS / "sandbox" / f"{name}.py").read_text()
+    for key, value in values.items():
+        text = text.replace("{" + key + "}", str(value))
+    loaded = load_reward_module(_untrusted(tmp_path, text), trusted=False, static_check=False)
+    try:
+        loaded.evaluate(env)
+    except GenDexError as exc:
+        return exc
+    return None
+
+
+def test_the_worker_cannot_renice_or_pin_another_process(env, tmp_path, first_wall_down, victim):
+    before = os.getpriority(os.PRIO_PROCESS, victim.pid), os.sched_getaffinity(victim.pid)
+    error = _first_wall_down_evaluate(env, tmp_path, "renice_and_pin_victim", victim=victim.pid)
+    after = os.getpriority(os.PRIO_PROCESS, victim.pid), os.sched_getaffinity(victim.pid)
+    assert after == before, f"the worker changed another process's scheduling: {before} -> {after}"
+    assert error is not None
+
+
+def test_no_signal_by_rt_sigqueueinfo_reaches_another_process(env, tmp_path, first_wall_down, victim):
+    error = _first_wall_down_evaluate(env, tmp_path, "sigqueue_victim", victim=victim.pid)
+    time.sleep(0.2)
+    assert victim.poll() is None, "the victim was signalled"
+    assert error is not None and "PermissionError" in str(error), error
+
+
+@pytest.mark.xfail(strict=True, reason="escape on kernels before 6.12 (Landlock ABI < 6, no signal scope; the "
+                   "sandbox accepts any ABI from 1): the seccomp filter denies kill/tkill/tgkill/pidfd_send_signal to "
+                   "other processes but not rt_sigqueueinfo or rt_tgsigqueueinfo, so a worker whose first wall fell "
+                   "can SIGKILL its parent (here a victim got SIGTERM); gendex_envs/sandbox/confine.py seccomp(): "
+                   "allow both only with arg0 == own pid")
+def test_seccomp_alone_stops_rt_sigqueueinfo_to_another_process(tmp_path, victim):
+    """Landlock's signal scope needs ABI 6 (Linux 6.12); the sandbox also runs on older kernels (any ABI from 1),
+    where only the seccomp filter stands between the worker and its parent's pid."""
+    import subprocess
+    import sys
+
+    confine = REPO / "gendex_envs" / "sandbox" / "confine.py"
+    payload = (PAYLOADS / "sandbox" / "sigqueue_victim.py").read_text().replace("{victim}", str(victim.pid))
+    script = (f"import importlib.util, types\n"
+              f"spec = importlib.util.spec_from_file_location('confine', {str(confine)!r})\n"
+              "confine = importlib.util.module_from_spec(spec); spec.loader.exec_module(confine)\n"
+              "confine.seccomp(confine.load_seccomp())\n"
+              "ns = {}\n"
+              f"exec({payload!r}.replace('import torch', 'torch = None'), ns)\n"
+              "try:\n    ns['evaluate'](None)\nexcept PermissionError as exc:\n    print('refused', exc)\n")
+    done = subprocess.run([sys.executable, "-I", "-c", script], capture_output=True, text=True, timeout=60)
+    time.sleep(0.2)
+    assert victim.poll() is None, f"seccomp let rt_sigqueueinfo through: {done.stdout} {done.stderr[-500:]}"
+    assert "refused" in done.stdout, done.stderr[-2000:]
+
+
+def test_the_worker_reads_no_other_process_the_repository_or_home(env, tmp_path, first_wall_down, victim):
+    error = _first_wall_down_evaluate(env, tmp_path, "read_proc_and_repo", victim=victim.pid, repo=REPO)
+    assert error is not None
+    assert "LEAKED" not in str(error) and "hf_redteam_secret_token" not in str(error), str(error)[:2000]
+    assert "every read was refused" in str(error)
+
+
 # ---------------------------------------------------------------------------------------------- per-step outputs
 @pytest.mark.parametrize("key", ["Success", "success ", "s\u0443ccess", "is_success\n", "_final_info",
                                  "TimeLimit.truncated", "episode", "final_info", "terminal_observation", "reward"])
