@@ -189,9 +189,26 @@ def _hasattr(obj, name) -> bool:
 def restricted_builtins() -> dict:
     """A fresh ``__builtins__`` mapping for one reward module (see the module doc): ``getattr``/``hasattr`` refuse
     private and dunder names."""
+    _warm_torch()
     table = {name: getattr(builtins, name) for name in SAFE_BUILTINS}
     table.update(__import__=_guarded_import, getattr=_getattr, hasattr=_hasattr)
     return table
+
+
+_warmed = False
+
+
+def _warm_torch() -> None:
+    """Let torch's C++ side make, from trusted code, the one import it makes lazily: the first tensor built from
+    Python data with a ``device`` imports ``torch.storage`` through the *calling frame's* ``__import__``, which in
+    reward code is :func:`_guarded_import`; refused there, torch fails with an INTERNAL ASSERT instead of building
+    ``torch.tensor([...], device=env.device)`` (PickUpBottle's reward does that)."""
+    global _warmed
+    if not _warmed:
+        import torch
+
+        torch.tensor([0.0], device="cpu")
+        _warmed = True
 
 
 # ---------------------------------------------------------------------------------------------- trust

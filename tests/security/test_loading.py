@@ -257,3 +257,30 @@ def test_the_corpus_payload_hides_code_from_a_utf8_reader():
     data = (REPO / "tests/data/hostile_r2/loading/cookie_utf7_hidden_code.py").read_bytes()
     assert "getattr.__globals__" not in textwrap.dedent(data.decode("utf-8")).split("\n# note")[0]
     assert "\ng = getattr.__globals__\n" in data.decode("utf-7")
+
+
+_TENSOR_FROM_DATA = '''
+import json, os, sys, tempfile
+from pathlib import Path
+os.environ["GENDEX_IN_PROCESS_GUARD"] = "1"  # the probe child's mode: untrusted code in this process
+from gendex_envs.reward_module import load_reward_module
+folder = Path(tempfile.mkdtemp()) / "Scratch" / "v0"
+folder.mkdir(parents=True)
+(folder / "reward.py").write_text(
+    "import torch\\n"
+    "def evaluate(env):\\n"
+    "    return {'x': torch.tensor([0.5, 0.25], device=torch.device('cpu'))}\\n"
+    "def compute_dense_reward(env, obs, action, info):\\n"
+    "    return torch.zeros(1)\\n")
+module = load_reward_module(folder / "reward.py", trusted=False)
+print(json.dumps(module.evaluate.__wrapped__(None)["x"].tolist()))
+'''
+
+
+def test_untrusted_code_in_process_builds_tensors_from_data_with_a_device():
+    """torch's C++ side imports torch.storage lazily through the calling frame's __import__; the first tensor built
+    from Python data with a device inside guarded reward code must not hit torch's INTERNAL ASSERT (fresh process:
+    the lazy import happens once per process)."""
+    out = subprocess.run([sys.executable, "-c", _TENSOR_FROM_DATA], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [0.5, 0.25]
