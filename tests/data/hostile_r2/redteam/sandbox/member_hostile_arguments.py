@@ -1,6 +1,6 @@
 # expect: a typed error naming the module, the worker and the env unharmed
 # Env members asked for with hostile arguments: a 2 MB object name (a request frame over the header limit), a part
-# string past the parent's 256-character bound, and an unknown object.
+# string past the parent's bound on names (256, then 4096 characters), and an unknown object.
 import torch
 
 
@@ -13,6 +13,6 @@ def evaluate(env):
 
 
 def compute_dense_reward(env, obs, action, info):
-    env.hand_forces("apple", "p" * 300)
+    env.hand_forces("apple", "p" * 5000)
     env.obj_pose("no_such_object")
     return torch.zeros(env.num_envs, device=env.device)
