@@ -192,17 +192,27 @@ _INFO = ("config", "names", "task_id", "env_kwargs", "training_seeds", "demos", 
          "seconds")
 
 
+MAX_METADATA_DEPTH = 32
+"""Nesting of a checkpoint's JSON metadata (what ``gendex bc train`` writes nests 3 levels)."""
+
+
 def _json_safe(value) -> bool:
-    """Only str/int/float/bool/None and lists/dicts (str keys) of them: what ``weights_only`` needs no pickle for."""
-    stack = [value]
+    """Only str/int/float/bool/None and lists/dicts (str keys) of them: what ``weights_only`` needs no pickle for.
+    A tree, as JSON is: a pickle's memo can make a list that holds itself (the walk would never end) or share one
+    list along 2**N paths, so a container met twice is refused, and so is nesting past :data:`MAX_METADATA_DEPTH`."""
+    stack, seen = [(value, 0)], set()
     while stack:
-        v = stack.pop()
+        v, depth = stack.pop()
+        if isinstance(v, dict | list | tuple):
+            if depth >= MAX_METADATA_DEPTH or (v and id(v) in seen):  # (empty ones may be one shared object)
+                return False
+            seen.add(id(v))
         if isinstance(v, dict):
             if not all(isinstance(k, str) for k in v):
                 return False
-            stack.extend(v.values())
+            stack.extend((x, depth + 1) for x in v.values())
         elif isinstance(v, (list, tuple)):
-            stack.extend(v)
+            stack.extend((x, depth + 1) for x in v)
         elif not (v is None or type(v) in (str, int, float, bool)):
             return False
     return True
