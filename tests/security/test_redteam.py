@@ -659,17 +659,59 @@ def test_a_policy_weight_that_is_a_strided_view_of_one_value_is_refused_at_once(
     assert time.monotonic() - start < 2
 
 
-def test_a_bc_checkpoint_weight_that_is_a_strided_view_is_refused_at_once(tmp_path):
-    from gendex.imitation.bc import load_checkpoint
-
+def _toy_bc(tmp_path: Path, weights: dict | None = None, **changes) -> Path:
+    """A tiny BC checkpoint of format 2 (``torch.save``, as ``save_checkpoint`` writes it), with ``changes``."""
     info = {"config": {"chunk": 2, "hidden": 8, "layers": 2, "steps": 1, "batch": 1, "lr": 1e-3,
                        "weight_decay": 0.0, "obs_noise": 0.0, "ensemble_decay": 0.1, "seed": 0},
             "names": {"observation.state": ["s0"]}, "task_id": "GenDex/Toy-v0",
             "env_kwargs": {"control_mode": "pd_joint_pos"}, "training_seeds": [1], "demos": 1, "frames": 10,
-            "dataset": "toy", "final_loss": 0.5, "seconds": 1.0}
+            "dataset": "toy", "final_loss": 0.5, "seconds": 1.0, **changes}
     norm = {k: torch.as_tensor(np.ones(2), dtype=torch.float32) for k in ("x_mean", "x_std", "a_mean", "a_std")}
     path = tmp_path / "bc.pt"
-    torch.save({"format": 2, "model": {"0.weight": _stride_bomb(2**40)}, **norm, **info}, path)
+    torch.save({"format": 2, "model": weights if weights is not None else {"0.weight": torch.zeros(2, 2)},
+                **norm, **info}, path)
+    return path
+
+
+def _cycle() -> list:
+    loop: list = []
+    loop.append(loop)
+    return loop
+
+
+def _shared_along_2_to_the_60_paths() -> list:
+    node: list = ["leaf"]
+    for _ in range(60):
+        node = [node, node]
+    return node
+
+
+def _nested(depth: int) -> list:
+    node: list = []
+    for _ in range(depth):
+        node = [node]
+    return node
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("value", [_cycle, _shared_along_2_to_the_60_paths, lambda: _nested(200)],
+                         ids=["list_holding_itself", "shared_2_to_the_60_paths", "nested_200"])
+def test_bc_checkpoint_metadata_that_is_no_json_tree_is_refused_at_once(tmp_path, value):
+    """A pickle's memo makes a list that holds itself: the metadata check walked it forever (``gendex eval --policy
+    bc:PATH`` hung), and one list shared along 2**60 paths would take as long."""
+    from gendex.imitation.bc import load_checkpoint
+
+    path = _toy_bc(tmp_path, names={"observation.state": value()})
+    start = time.monotonic()
+    with pytest.raises(PolicyError, match="JSON values"):
+        load_checkpoint(path)
+    assert time.monotonic() - start < 2
+
+
+def test_a_bc_checkpoint_weight_that_is_a_strided_view_is_refused_at_once(tmp_path):
+    from gendex.imitation.bc import load_checkpoint
+
+    path = _toy_bc(tmp_path, weights={"0.weight": _stride_bomb(2**40)})
     start = time.monotonic()
     with pytest.raises(PolicyError, match="strided view"):
         load_checkpoint(path)
