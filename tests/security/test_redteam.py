@@ -16,6 +16,7 @@ import json
 import os
 import re
 import shutil
+import subprocess
 import time
 import zipfile
 from pathlib import Path
@@ -35,7 +36,7 @@ from gendex_envs.task_version import Artifacts, TaskLayout, TaskVersion, derive_
 REPO = Path(__file__).resolve().parents[2]
 PAYLOADS = REPO / "tests" / "data" / "hostile_r2" / "redteam"
 LOADING = PAYLOADS / "loading"
-CALL_LIMIT_S = 3.0
+CALL_LIMIT_S = 2.0
 
 
 def _untrusted(tmp_path: Path, text: str, name: str = "RedTeam") -> Path:
@@ -46,9 +47,11 @@ def _untrusted(tmp_path: Path, text: str, name: str = "RedTeam") -> Path:
     return path
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="module", autouse=True)
 def env():
-    """A committed task's env (its own, trusted reward module); hostile modules are called against it."""
+    """A committed task's env (its own, trusted reward module); hostile modules are called against it. Built before
+    any test loads an untrusted module: the runtime guard's audit hook, installed then for the rest of the process,
+    makes building a scene four times slower."""
     from gendex_envs.registry import resolve_task
     from gendex_envs.task_env import TaskEnv
 
@@ -183,7 +186,7 @@ def test_a_flood_of_distinct_env_reads_ends_each_call_within_the_limit(env, tmp_
     module = _untrusted(tmp_path, (PAYLOADS / "sandbox" / "hand_forces_key_flood.py").read_text())
     loaded = load_reward_module(module, trusted=False)
     reads = _env_reads(monkeypatch)
-    for _ in range(5):
+    for _ in range(3):
         reads.clear()
         start = time.monotonic()
         try:
@@ -224,7 +227,7 @@ def test_an_overlong_part_name_is_a_gendex_error(env, tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("path", sorted((PAYLOADS / "resources").glob("*.py")), ids=lambda p: p.stem)
 def test_unbounded_work_through_allowed_names_is_a_typed_error_within_the_limit(env, tmp_path, monkeypatch, path):
-    """Memory (2**62 zeros, a 2**31 expand made contiguous, one_hot of 1e11, a 2**28-element list), CPU (a sum over
+    """Memory (2**62 zeros, a 2**31 expand made contiguous, one_hot of 1e11), CPU (a sum over
     2**40 broadcast elements) and recursion, through allow-listed names only."""
     monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", str(CALL_LIMIT_S))
     loaded = load_reward_module(_untrusted(tmp_path, path.read_text()), trusted=False)
@@ -630,8 +633,8 @@ def test_a_deeply_nested_download_is_a_typed_error_and_leaves_nothing(tmp_path):
             pull("org/deep", work / "out", _Download(download))
         assert time.monotonic() - start < 5
         assert list(work.iterdir()) == []
-    finally:
-        shutil.rmtree(download / "a")
+    finally:  # rm, not shutil.rmtree: its recursion would pass the audit hook's stack walk 500 levels deep
+        subprocess.run(["rm", "-rf", str(download / "a")], check=True)
 
 
 # ---------------------------------------------------------------------------------------------- saved tensors
