@@ -49,7 +49,10 @@ def decode_reward_source(data: bytes, filename: str) -> str:
         line = data[: exc.start].count(b"\n") + 1
         raise UnsafeCodeError(f"{filename}: line {line}: byte {exc.start} ({data[exc.start:exc.start + 1]!r}) is not "
                               f"valid UTF-8 ({exc.reason}); {_ONLY}") from None
-    for number, line in enumerate(text.splitlines()[:2], start=1):
+    # the first two lines as the importer may cut them: at "\n" (the tokenizer), at "\r" too, and as str.splitlines
+    # cuts them (which also breaks at \v, \f, \x1c-\x1e: a cookie hidden behind one of those is still a cookie)
+    cuts = (text.split("\n")[:2], re.split(r"\r\n|\r|\n", text)[:2], text.splitlines()[:2])
+    for number, line in ((n, line) for lines in cuts for n, line in enumerate(lines, start=1)):
         match = _COOKIE.match(line)
         if match is None:
             continue

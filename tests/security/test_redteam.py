@@ -63,11 +63,9 @@ def env():
 
 
 # ------------------------------------------------------------------------------------ what runs is what was checked
-_READER_MISSES = "escape: decode_reward_source looks for the coding cookie in str.splitlines()'s first two lines, " \
-                 "but \\v \\f \\x1c-\\x1e end a line there and not for the importer, so a utf-7 cookie on the " \
-                 "importer's line 2 is not refused (gendex_envs/code_check/source.py: split on \\n / \\r only)"
-SPLIT_ESCAPES = [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=_READER_MISSES), id=p.stem)
-                 for p in sorted(LOADING.glob("utf7_cookie_behind_*_on_line1.py"))]
+SPLIT_ESCAPES = sorted(LOADING.glob("utf7_cookie_behind_*_on_line1.py"))
+"""A utf-7 cookie on the importer's line 2, behind \\v \\f \\x1c-\\x1e on line 1 (where str.splitlines() ends a line and
+the importer does not): the reader looks at the lines as every cutter cuts them."""
 REFUSED_ALREADY = sorted(p for p in LOADING.glob("*.py") if not p.stem.startswith("utf7_cookie_behind_")
                          and p.stem != "nul_byte_in_code")
 
