@@ -239,12 +239,15 @@ def trusts_everything() -> bool:
 
 def is_trusted(path: str | Path) -> bool:
     """Whether code under ``path`` runs without the guard: the repository's committed tasks, the package itself,
-    folders passed to :func:`trust`, or everything when ``GENDEX_TRUST_REMOTE_CODE=1``."""
+    folders passed to :func:`trust`, or everything when ``GENDEX_TRUST_REMOTE_CODE=1``. ``path`` is judged where
+    it lies: its folder resolved, its own name not followed (a link in a download to a file under
+    ``generated_tasks/`` is not trusted code)."""
     if trusts_everything():
         return True
     from gendex_envs.registry import REPO_TASKS_DIR
 
-    p = _folder(path)
+    named = Path(path).absolute()
+    p = _folder(named.parent) + named.name + os.sep  # a link is judged where it lies, not by where it points
     package = _folder(Path(__file__).parent)
     return p.startswith((_folder(REPO_TASKS_DIR), package, *_trusted_extra))
 

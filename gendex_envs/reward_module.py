@@ -76,10 +76,14 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
     runtime guard's audit hook and it runs with restricted builtins and read-only copies of its modules
     (:mod:`gendex_envs.guard`). ``static_check=False`` skips the static check of an untrusted module (the probe's
     tests of the runtime fences); the guard applies either way."""
-    path = Path(path).resolve()
+    named = Path(path).absolute()
+    path = named.parent.resolve() / named.name  # its folder resolved; a link is judged where it lies (guard.is_trusted)
     if not path.is_file():
         raise RewardModuleError(f"reward module {path} does not exist; every task version needs a task reward module")
     trusted = guard.is_trusted(path) if trusted is None else trusted
+    if not trusted and path.is_symlink():
+        raise RewardModuleError(f"reward module {path} is a link (to {path.resolve()}); an untrusted folder's reward "
+                                "modules must be regular files of that folder")
     try:
         source = read_reward_source(path, str(path))
     except RewardCodeError as exc:

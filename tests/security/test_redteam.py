@@ -106,11 +106,6 @@ def test_a_nul_byte_is_a_typed_error_not_a_crash(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------- trust by path
-@pytest.mark.xfail(strict=True, reason="escape: load_reward_module resolves links before guard.is_trusted, so an "
-                   "untrusted folder's reward.py linked to any file under generated_tasks/ (a promoted run's "
-                   "progress.csv, an uncommitted `gendex generate` draft) runs in-process with full builtins and no "
-                   "static check (gendex_envs/reward_module.py + guard.is_trusted: judge the folder the module was "
-                   "named by, or refuse links in untrusted folders)")
 def test_a_reward_module_linked_into_the_trusted_root_is_not_trusted(tmp_path, monkeypatch):
     trusted_root = tmp_path / "repo" / "generated_tasks"
     monkeypatch.setattr(registry, "REPO_TASKS_DIR", trusted_root)
