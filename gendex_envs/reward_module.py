@@ -121,13 +121,27 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
             f"reward module {path} lacks {missing}; required: {list(REQUIRED_FUNCTIONS)}, optional: "
             f"{list(OPTIONAL_FUNCTIONS)}"
         )
-    reward_max = float(getattr(module, "REWARD_MAX", 1.0))
-    if not reward_max > 0:
-        raise RewardModuleError(f"reward module {path}: REWARD_MAX={reward_max} must be > 0")
+    reward_max = checked_reward_max(path, getattr(module, "REWARD_MAX", 1.0))
     extra = getattr(module, "_get_obs_extra", None)
     return RewardModule(path=path, evaluate=_through_view(module.evaluate, 0),
                         compute_dense_reward=_through_view(module.compute_dense_reward, 3),
                         get_obs_extra=_through_view(extra, 1) if callable(extra) else None, reward_max=reward_max)
+
+
+REWARD_MAX_RANGE = (1e-3, 1e6)
+"""Bounds of a module's ``REWARD_MAX`` (committed modules use 3 to 7): the env's normalized reward divides by it, so
+a tiny one turns every finite reward into inf."""
+
+
+def checked_reward_max(path: Path, value) -> float:
+    """``value`` as a module's ``REWARD_MAX``: a real number within :data:`REWARD_MAX_RANGE`, else
+    :class:`RewardModuleError` naming the module, the value and the range."""
+    low, high = REWARD_MAX_RANGE
+    number = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
+    if number is None or not low <= number <= high:
+        raise RewardModuleError(f"reward module {path}: REWARD_MAX={str(value)[:40]} must be a number from {low} to "
+                                f"{high:g} (the normalized reward divides by it)")
+    return number
 
 
 def _through_view(fn: Callable, copied: int) -> Callable:

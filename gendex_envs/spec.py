@@ -455,6 +455,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         need(bool(SNAKE_NAME_RE.fullmatch(o.name)), f"{at}.name", o.name,
              "must be ASCII snake_case, the whole name ([a-z][a-z0-9_]*)")
         need(o.name != GOAL_TARGET, f"{at}.name", o.name, f"{GOAL_TARGET!r} is reserved for the goal site")
+        need(o.name != "palm", f"{at}.name", o.name, "'palm' is reserved: the env's own observation palm_pose is the "
+             "hand's, and an object's pose is observed as <name>_pose")
         need(o.name not in seen, f"{at}.name", o.name, "object names must be unique (duplicate name)")
         seen.add(o.name)
         need(bool(o.asset.strip()), f"{at}.asset", o.asset, "must be a non-empty asset id (`gendex assets` lists them)")

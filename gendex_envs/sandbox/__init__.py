@@ -61,7 +61,7 @@ def load(path: Path, source: str, full_builtins: bool = False):
     """``path``'s module, from its already checked ``source`` text, loaded in this process's confined worker: a
     :class:`~gendex_envs.reward_module.RewardModule` whose functions run there. ``full_builtins`` (tests only)
     runs it with Python's ordinary builtins, as if the first wall had a hole."""
-    from gendex_envs.reward_module import OPTIONAL_FUNCTIONS, REQUIRED_FUNCTIONS, RewardModule
+    from gendex_envs.reward_module import OPTIONAL_FUNCTIONS, REQUIRED_FUNCTIONS, RewardModule, checked_reward_max
     from gendex_envs.sandbox import host
 
     remote = RemoteModule(Path(path), source, full_builtins or host.FULL_BUILTINS_FOR_TESTS)
@@ -69,8 +69,7 @@ def load(path: Path, source: str, full_builtins: bool = False):
     if missing:
         raise RewardModuleError(f"reward module {path} lacks {missing}; required: {list(REQUIRED_FUNCTIONS)}, "
                                 f"optional: {list(OPTIONAL_FUNCTIONS)}")
-    if not remote.reward_max > 0:
-        raise RewardModuleError(f"reward module {path}: REWARD_MAX={remote.reward_max} must be > 0")
+    checked_reward_max(path, remote.reward_max)
     return RewardModule(path=Path(path), evaluate=_function(remote, "evaluate", 0),
                         compute_dense_reward=_function(remote, "compute_dense_reward", 3),
                         get_obs_extra=_function(remote, "_get_obs_extra", 1)

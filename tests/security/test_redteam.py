@@ -359,10 +359,6 @@ def _hostile_copy(task_copy, as_name: str, edit) -> TaskVersion:
     return TaskVersion.at(version.root)
 
 
-@pytest.mark.xfail(strict=True, reason="escape: REWARD_MAX is only checked > 0; the env's default reward mode "
-                   "(normalized_dense) divides the checked reward by it, so REWARD_MAX = 1e-300 makes every step's "
-                   "reward inf after check_reward (gendex_envs/reward_module.py and sandbox/__init__.py: a finite, "
-                   "bounded REWARD_MAX; or check in TaskEnv.compute_normalized_dense_reward)")
 def test_reward_max_cannot_make_the_normalized_reward_infinite(task_copy):
     from gendex_envs.task_env import TaskEnv
 
@@ -378,9 +374,6 @@ def test_reward_max_cannot_make_the_normalized_reward_infinite(task_copy):
     assert all(bool(torch.isfinite(r).all()) for r in rewards), rewards
 
 
-@pytest.mark.xfail(strict=True, reason="escape: an object named `palm` makes the env's own observation `palm_pose` "
-                   "the object's pose (TaskEnv._get_obs_extra writes <object>_pose over palm_pose); the spec check "
-                   "should refuse object names whose observation keys are the env's (gendex_envs/spec.py)")
 def test_an_object_name_cannot_replace_the_palm_observation(task_copy):
     from gendex_envs.task_env import TaskEnv
 
