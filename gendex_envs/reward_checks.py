@@ -31,7 +31,7 @@ The rules:
     names (``palm_pose``, ``tip_pos``, ``<object>_pose``, ``<object>_qpos``, ``goal_pos``) nor the agent's
     (``qpos``, ``qvel``, ``controller``) nor the observation's top-level names (:data:`RESERVED_OBS_KEYS`); each
     value a float, bool or integer tensor ``[num_envs]`` or ``[num_envs, k]`` on the env's device, ``k`` at most
-    :data:`MAX_VALUES_PER_ENV`; floating values finite and within ``±``:data:`MAX_ABS_VALUE`.
+    :data:`MAX_VALUES_PER_ENV`; floating and integer values finite and within ``±``:data:`MAX_ABS_VALUE`.
 
 A broken rule raises :class:`RewardOutputError`, naming the module, the function, the step, what was returned and
 what is allowed. The checks run only on what the functions return; the ``info`` reward code receives is filtered
@@ -185,13 +185,19 @@ def _within(value: torch.Tensor) -> bool:
     """Every value of ``value`` (floating) finite and within the bound. NaN fails every comparison."""
     if value.numel() <= SMALL_CPU_TENSOR and value.get_device() == -1:
         return all(-MAX_ABS_VALUE <= x <= MAX_ABS_VALUE for x in value.detach().reshape(-1).tolist())
+    if not value.is_floating_point():  # integers: abs() of the most negative one is itself, so compare both ends
+        return bool(value.min() >= -MAX_ABS_VALUE) and bool(value.max() <= MAX_ABS_VALUE)
     return bool(value.detach().abs().max() <= MAX_ABS_VALUE)
 
 
+def _is_integer(value: torch.Tensor) -> bool:
+    return not value.is_floating_point() and not value.is_complex() and value.dtype != torch.bool
+
+
 def _check_values(entries: list[tuple[str | None, torch.Tensor]]) -> None:
-    """Every floating tensor of ``entries`` finite and within the bound (on an accelerator: one reduction, one
-    synchronisation, when they all are)."""
-    floats = [(k, v) for k, v in entries if v.is_floating_point() and v.numel()]
+    """Every floating or integer tensor of ``entries`` finite and within the bound (on an accelerator: one
+    reduction, one synchronisation, when they all are)."""
+    floats = [(k, v) for k, v in entries if (v.is_floating_point() or _is_integer(v)) and v.numel()]
     if not floats:
         return
     if floats[0][1].get_device() != -1 and len(floats) > 1:

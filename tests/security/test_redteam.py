@@ -336,10 +336,6 @@ def test_task_observations_cannot_take_the_envs_names_in_any_spelling(key):
 
 
 @pytest.mark.parametrize("dtype, value", [(torch.int64, 2**62), (torch.int64, -2**63), (torch.int32, 2**31 - 1)])
-@pytest.mark.xfail(strict=True, reason="escape: check_obs_extra bounds only floating values, so an integer task "
-                   "observation of 2**62 passes and the flat state observation (float32) carries 4.6e18, far past "
-                   "MAX_ABS_VALUE = 1e9 that the rule sets to keep normalised observations from overflowing "
-                   "(gendex_envs/reward_checks.py: bound integer values too, or refuse integer observations)")
 def test_an_integer_task_observation_is_bounded_like_a_float_one(dtype, value):
     with pytest.raises(GenDexError):
         check_obs_extra({"count": torch.full((1, 3), value, dtype=dtype)}, 1, "cpu", {}, path="r.py", step=30)
