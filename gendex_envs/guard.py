@@ -130,6 +130,28 @@ class ModuleView(types.ModuleType):
 _proxies: dict[str, ModuleView] = {}
 
 
+class _TensorTypeMeta(type):
+    def __instancecheck__(cls, obj) -> bool:
+        import torch
+
+        return isinstance(obj, torch.Tensor)
+
+    def __subclasscheck__(cls, sub) -> bool:
+        import torch
+
+        return issubclass(sub, torch.Tensor)
+
+    def __call__(cls, *args, **kwargs):
+        raise UntrustedCodeError("reward code may not call torch.Tensor(...): with sizes it hands out uninitialised "
+                                 "memory (torch.empty); build tensors with torch.zeros, torch.full or torch.tensor")
+
+
+class TensorType(metaclass=_TensorTypeMeta):
+    """What ``torch.Tensor`` is in reward code's copy of torch: ``isinstance(x, torch.Tensor)`` and annotations
+    work; calling it raises :class:`UntrustedCodeError` (the legacy constructor ``torch.Tensor(n)`` is
+    ``torch.empty(n)``: uninitialised memory, which could carry state from one call to the next)."""
+
+
 def _proxy(name: str) -> ModuleView:
     """The copy of module ``name`` reward code gets: exactly the names
     :data:`~gendex_envs.code_check.rules.MODULE_MEMBERS` allows for it (an allow-list: torch's functions that
@@ -149,6 +171,8 @@ def _proxy(name: str) -> ModuleView:
         for member in MODULE_MEMBERS[name]:
             value = getattr(real, member)
             public[member] = _proxy(value.__name__) if isinstance(value, types.ModuleType) else value
+        if name == "torch" and "Tensor" in public:
+            public["Tensor"] = TensorType  # a type to name, not to call: Tensor(n) is torch.empty(n)
         copy.__dict__.update(public)
         _proxies[name] = copy
     return _proxies[name]

@@ -379,6 +379,10 @@ class NameRules:
     def check_call(self, node: ast.Call) -> None:
         func = node.func
         self.check_positional_inplace(node)
+        if self.calls_tensor_type(func):
+            self.add(node, f"`{_snippet(self.source, node)}`: calling torch.Tensor is not allowed (with sizes it "
+                     "hands out uninitialised memory, like torch.empty); use torch.zeros, torch.full or torch.tensor")
+            return
         if not isinstance(func, ast.Name) or func.id not in ("getattr", "hasattr"):
             return
         fn = func.id
@@ -401,6 +405,26 @@ class NameRules:
                          f"`{first.id}.{name}.<name>` directly")
         else:
             self.check_value_attribute(node, name, f"`{_snippet(self.source, node)}`")
+
+    def calls_tensor_type(self, func: ast.AST) -> bool:
+        """Whether ``func`` names ``torch.Tensor`` (or a subclass of it) through a module alias."""
+        import importlib
+
+        import torch
+
+        names: list[str] = []
+        while isinstance(func, ast.Attribute):
+            names.insert(0, func.attr)
+            func = func.value
+        if not (isinstance(func, ast.Name) and func.id in self.module_aliases) or not names:
+            return False
+        try:
+            obj = importlib.import_module(self.module_aliases[func.id])
+            for name in names:
+                obj = getattr(obj, name)
+        except (ImportError, AttributeError):
+            return False
+        return isinstance(obj, type) and issubclass(obj, torch.Tensor)
 
     def check_positional_inplace(self, node: ast.Call) -> None:
         """``F.relu(t, True)``, ``F.dropout(t, 0.5, True, True)``, ``torch.nn.ReLU(True)``: a torch callable with an

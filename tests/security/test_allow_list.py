@@ -154,3 +154,18 @@ def test_any_name_on_a_module_copy_is_allowed_or_refused_with_a_gendex_error(mod
     else:
         with pytest.raises(UntrustedCodeError, match=f"may not use {module}"):
             getattr(copy, name)
+
+
+def test_reward_codes_torch_tensor_is_a_type_to_name_not_to_call():
+    """The runtime wall behind the static check: torch.Tensor(n) is torch.empty(n) (uninitialised memory, which
+    could carry state from call to call); reward code's torch.Tensor answers isinstance but refuses to build."""
+    import torch
+
+    from gendex_envs import guard
+    from gendex_envs.guard import UntrustedCodeError
+
+    copy = guard._proxy("torch")
+    assert isinstance(torch.zeros(2), copy.Tensor) and not isinstance([1.0], copy.Tensor)
+    for args in ((4,), (torch.Size([2, 2]),), (2, 3)):
+        with pytest.raises(UntrustedCodeError, match="torch.zeros"):
+            copy.Tensor(*args)

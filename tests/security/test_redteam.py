@@ -124,10 +124,6 @@ def test_a_reward_module_linked_into_the_trusted_root_is_not_trusted(tmp_path, m
 
 
 # ---------------------------------------------------------------------------------------------- the allow-list
-@pytest.mark.xfail(strict=True, reason="escape: torch.Tensor is allow-listed as a type, and calling it with a size "
-                   "is torch.empty: uninitialised memory that carries a call counter from one call to the next in "
-                   "the worker (state across calls, waiting out the probe); gendex_envs/code_check (refuse calling "
-                   "torch.Tensor) and guard's torch copy (a non-callable stand-in)")
 def test_uninitialised_memory_cannot_carry_state_across_calls(env, tmp_path, monkeypatch):
     monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", str(CALL_LIMIT_S))
     module = _untrusted(tmp_path, (PAYLOADS / "state" / "tensor_ctor_counter.py").read_text())
@@ -145,8 +141,6 @@ def test_uninitialised_memory_cannot_carry_state_across_calls(env, tmp_path, mon
 
 
 @pytest.mark.parametrize("call", ["torch.Tensor(4)", "torch.Tensor(torch.Size([2, 2]))", "torch.Tensor(2, 3)"])
-@pytest.mark.xfail(strict=True, reason="escape: the legacy constructor torch.Tensor(size) hands out uninitialised "
-                   "memory and passes the static check (gendex_envs/code_check: refuse calling torch.Tensor)")
 def test_the_legacy_tensor_constructor_is_refused(call):
     src = (f"import torch\n\n\ndef evaluate(env):\n    x = {call}\n    return {{\"fail\": x.sum() > 1}}\n\n\n"
            "def compute_dense_reward(env, obs, action, info):\n    return torch.zeros(env.num_envs)\n")
