@@ -99,8 +99,9 @@ def committed_version(env_id: str) -> TaskVersion | None:
 def discover_tasks(roots: list[Path] | None = None, override: bool | None = None) -> dict[str, TaskVersion]:
     """Every task version in ``roots`` (default :func:`task_roots`): env id -> version; the first root wins.
 
-    A version outside ``generated_tasks/`` whose id is a committed one is refused (logged, skipped: the committed
-    version keeps the id) unless ``override`` (None: ``GENDEX_ALLOW_OVERRIDE``). Roots given explicitly must be
+    A version outside ``generated_tasks/`` whose id, or whose task name, is a committed one is refused (logged,
+    skipped: the committed versions keep the id and the unversioned name) unless ``override`` (None:
+    ``GENDEX_ALLOW_OVERRIDE``). Roots given explicitly must be
     folders (:class:`TaskNotFoundError`)."""
     override = override_allowed() if override is None else override
     committed: set[str] | None = None
@@ -120,6 +121,12 @@ def discover_tasks(roots: list[Path] | None = None, override: bool | None = None
                                 "register_tasks(roots, override=True)) to use it instead", version.env_id,
                                 version.root, REPO_TASKS_DIR / version.name / f"v{version.version}",
                                 ALLOW_OVERRIDE_ENV)
+                    continue
+                if version.name in {i.split("/", 1)[1].rsplit("-v", 1)[0] for i in committed}:
+                    # a new version of a committed name would become what GenDex/<Name> and resolve_task pick
+                    log.warning("refusing %s from %s: %s is a committed task's name, whose versions are the "
+                                "repository's; set %s=1 (or call register_tasks(roots, override=True)) to add one",
+                                version.env_id, version.root, version.name, ALLOW_OVERRIDE_ENV)
                     continue
             found[version.env_id] = version
     return found

@@ -397,10 +397,6 @@ def test_start_states_of_the_wrong_width_are_a_typed_error(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------- identity
-@pytest.mark.xfail(strict=True, reason="escape: a GENDEX_TASKS_PATH folder PutAppleBowl/v9 registers (no exact id "
-                   "collision) and then resolve_task('PutAppleBowl') and gym.make('GenDex/PutAppleBowl') pick it, the "
-                   "untrusted folder, over the committed versions (gendex_envs/registry.py: a committed task name's "
-                   "unversioned id keeps to committed versions unless override)")
 def test_a_higher_version_on_the_tasks_path_does_not_take_a_committed_name(tmp_path):
     from gendex_envs.registry import REPO_TASKS_DIR, register_tasks, resolve_task, unregister_tasks
 
