@@ -109,6 +109,15 @@ class StartStates:
                                  f"{float(norm[np.argmax(np.abs(norm - 1))]):.6g}; norms must lie within "
                                  f"QUAT_NORM_TOLERANCE = {QUAT_NORM_TOLERANCE} of 1")
 
+    def check_fits(self, width: int, objects) -> None:
+        """:class:`StageError` unless these states restore into an env whose :meth:`TaskEnv.get_state` rows are
+        ``width`` values wide and whose objects are ``objects`` (states of another task or layout)."""
+        missing = sorted(set(objects) - set(self.obj_reset_pos))
+        if self.state.shape[1] != width or missing:
+            raise StageError(f"start states of stage {self.stage!r} ({self.source or 'given'}) do not fit this env: "
+                             f"rows of {self.state.shape[1]} values (the env's state has {width})"
+                             + (f", no reset poses for {missing}" if missing else ""))
+
     def __len__(self) -> int:
         return len(self.state)
 

@@ -346,8 +346,7 @@ class TaskEnv(BaseEnv):
             seeds = self.np_random.integers(2**31, size=self.num_envs).tolist()
             seed = seeds[0] if self.num_envs == 1 else seeds
         obs, info = super().reset(seed=seed, options=options)
-        # BaseEnv.__init__ resets once before it records the flat-state layout (_init_raw_state) that set_state
-        # needs; that reset only sizes the spaces, so it keeps the task's own initial state
+        # BaseEnv.__init__'s first reset (before _init_raw_state, which set_state needs) keeps the task's own state
         if self.start_states is None or not hasattr(self, "_init_raw_state"):
             return obs, info
         env_idx = (options or {}).get("env_idx")
@@ -360,6 +359,7 @@ class TaskEnv(BaseEnv):
     def _apply_start_states(self, env_idx: torch.Tensor) -> None:
         """Restore one saved start state (drawn with ``env.np_random``) into each env of ``env_idx``."""
         s = self.start_states
+        s.check_fits(self.get_state().shape[-1], self.objects)  # states of another layout: a typed error, not SAPIEN's
         rows = self.np_random.integers(len(s), size=len(env_idx))
         state = torch.as_tensor(s.state[rows], dtype=torch.float32, device=self.device)
         self.set_state(state, env_idx)

@@ -377,10 +377,6 @@ def test_an_object_name_cannot_replace_the_palm_observation(task_copy):
     assert torch.equal(obs["extra"]["palm_pose"], e.palm_pose.raw_pose), "palm_pose is not the palm's pose"
 
 
-@pytest.mark.xfail(strict=True, reason="escape (smaller class): start states of the wrong width (5 values; the "
-                   "task's flat state has about 120) load, and reset raises a bare TypeError from SAPIEN instead of "
-                   "a GenDex error naming the file (gendex_envs/task_env.py _load_start_states: check the width "
-                   "against the env's flat state)")
 def test_start_states_of_the_wrong_width_are_a_typed_error(tmp_path):
     from gendex_envs.registry import resolve_task
     from gendex_envs.start_states import StartStates
