@@ -18,7 +18,6 @@ tables for ``docs/leaderboard.md``.
 from __future__ import annotations
 
 import html
-import json
 import re
 import shutil
 from dataclasses import dataclass, field, replace
@@ -28,10 +27,17 @@ import dacite
 
 from gendex.eval.suite import Suite, load_suite, suite_task_digests
 from gendex_envs.errors import GenDexError
+from gendex_envs.typed_yaml import parse_json_bounded
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 LEADERBOARD_DIR = REPO_ROOT / "leaderboard"
 KINDS = ("baseline", "oracle", "imitation", "reinforcement", "other")
+
+
+MAX_RESULT_BYTES = 8_000_000
+MAX_RESULT_NODES = 200_000
+"""Bounds of a result file, checked while it is parsed (the committed ones: at most 160 KB; the library suite's 43
+tasks x 5 episodes, with every episode's record)."""
 
 
 class LeaderboardError(GenDexError, ValueError):
@@ -87,10 +93,27 @@ def _check(e: Entry, suite: Suite, path: Path) -> list[str]:
     unknown = sorted(set(info["per_task"]) - set(suite.tasks))
     if unknown:
         problems.append(f"tasks {unknown} are not in suite {suite.name}")
+    missing = sorted(set(suite.tasks) - set(info["per_task"]))
+    if missing:
+        problems.append(f"tasks {missing} of suite {suite.name} have no result: a result covers every task")
+    total = [0, 0]
     for task, t in info["per_task"].items():
-        if not 0 <= t["successes"] <= t["episodes"] or abs(100.0 * t["successes"] / t["episodes"]
-                                                          - t["pc_success"]) > 1e-6:
-            problems.append(f"{task}: {t['successes']} of {t['episodes']} is not {t['pc_success']} %")
+        counts = [t.get(k) if isinstance(t, dict) else None for k in ("successes", "episodes", "pc_success")]
+        if not (all(isinstance(c, int) and not isinstance(c, bool) for c in counts[:2])
+                and isinstance(counts[2], int | float) and not isinstance(counts[2], bool)):
+            problems.append(f"{task}: successes and episodes must be integers and pc_success a number")
+            continue
+        successes, episodes, pc = counts
+        if episodes < 1:
+            problems.append(f"{task}: {episodes} episodes; a result has at least one episode per task")
+        elif not 0 <= successes <= episodes or abs(100.0 * successes / episodes - pc) > 1e-6:
+            problems.append(f"{task}: {successes} of {episodes} is not {pc} %")
+        total = [total[0] + successes, total[1] + episodes]
+    agg = info["aggregated"]
+    claimed = agg.get("pc_success") if isinstance(agg, dict) else None
+    if not problems and (not isinstance(claimed, int | float) or abs(100.0 * total[0] / total[1] - claimed) > 1e-6):
+        problems.append(f"aggregated pc_success {str(claimed)[:40]} is not the tasks' {total[0]} of {total[1]} "
+                        f"episodes ({100.0 * total[0] / total[1]:.4g} %)")
     return problems
 
 
@@ -113,9 +136,10 @@ def load_entries(suite_name: str, root: Path = LEADERBOARD_DIR) -> list[Entry]:
     out = []
     for path in sorted((root / suite_name).glob("*.json")):
         try:
-            raw = json.loads(path.read_text())
+            raw = parse_json_bounded(path.read_bytes(), str(path), max_bytes=MAX_RESULT_BYTES,
+                                     max_nodes=MAX_RESULT_NODES)
             entry = dacite.from_dict(Entry, {**raw, "file": path.name}, config=dacite.Config(strict=True))
-        except (json.JSONDecodeError, dacite.DaciteError, TypeError) as exc:
+        except (ValueError, dacite.DaciteError, TypeError) as exc:
             raise LeaderboardError(f"{path}: {exc}") from exc
         problems = _check(entry, suite, path)
         if problems:
