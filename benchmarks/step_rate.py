@@ -233,7 +233,7 @@ def untrusted_comparison(args) -> None:
     with tempfile.TemporaryDirectory(prefix="gendex_step_rate_") as tmp:
         copy = Path(tmp) / "tasks" / version.name / version.root.name
         shutil.copytree(version.root, copy, ignore=shutil.ignore_patterns("__pycache__"))
-        assert guard.is_trusted(version.root / "task.yaml") and not guard.is_trusted(copy / "task.yaml")
+        assert guard.is_trusted(version.root) and not guard.is_trusted(copy)
         envs = {"trusted": make_env(version, control_mode="pd_joint_delta_pos"),
                 "untrusted": make_env(copy, control_mode="pd_joint_delta_pos")}
         try:
