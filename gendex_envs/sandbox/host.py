@@ -102,7 +102,18 @@ def _key(raw) -> tuple:
     for a in raw[1:]:
         if not (a is None or isinstance(a, str) and len(a) <= MAX_KEY_ARG_CHARS):
             raise TypeError(f"object and joint names are strings, got {str(a)[:80]!r}")
+    if raw[0] in _WITH_PART and (raw[2] not in (None, "handle") or raw[2] is None and raw[3] is not None):
+        raise TypeError(f"part is None (the object itself, with no joint) or 'handle', got part {str(raw[2])[:80]!r} "
+                        f"and joint {str(raw[3])[:80]!r}")
     return tuple(raw)
+
+
+_WITH_PART = ("entity.pose", "entity.linear_velocity", "entity.angular_velocity", "hand_forces")
+"""Members whose second argument is the part of an object (None or "handle")."""
+MAX_PREFETCH_KEYS = 256
+"""Keys sent ahead with every call of one function (a reward module reads a few dozen); keys asked for beyond them
+are answered on demand within the call's time limit, so a flood of distinct requests cannot grow the parent's
+per-call work without bound."""
 
 
 _LIMIT_ERRORS: dict[type, type] = {}
@@ -430,7 +441,8 @@ class RemoteModule:
                         errors[type(exc).__name__] = exc
                         worker.write({"op": "err", "type": type(exc).__name__, "msg": str(exc)[:4000]}, [], deadline)
                         continue
-                    keys[key] = None
+                    if len(keys) < MAX_PREFETCH_KEYS:
+                        keys[key] = None
                     worker.write({"op": "val", "value": protocol.encode(value, out)}, out, deadline)
                 elif op in ("ret", "loaded"):
                     return msg
