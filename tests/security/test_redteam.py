@@ -678,7 +678,8 @@ def test_a_bc_checkpoint_weight_that_is_a_strided_view_is_refused_at_once(tmp_pa
 
 
 @pytest.mark.parametrize("raw", [["hand_forces", "apple", "p123", None], ["hand_forces", "apple", None, "j1"],
-                                 ["entity.pose", "apple", None, "any joint"], ["entity.linear_velocity", "a", "x", None]])
+                                 ["entity.pose", "apple", None, "any joint"],
+                                 ["entity.linear_velocity", "a", "x", None]])
 def test_the_parent_refuses_member_arguments_the_real_view_would_ignore(raw):
     """Arguments the real view ignores (a part that is not 'handle', a joint without the handle) would each make a
     new key the parent computes and prefetches: refused before the view is asked."""
