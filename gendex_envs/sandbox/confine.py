@@ -158,8 +158,8 @@ def load_seccomp():
 
 def seccomp(sc) -> list[str]:
     """Load the filter: default allow (Landlock covers files), :data:`DENIED_SYSCALLS` fail with EPERM, ``clone``
-    only with CLONE_THREAD (threads, no processes), ``kill``/``tgkill`` only of this process, ``prlimit64`` only
-    to read limits. ``sc``: :func:`load_seccomp`."""
+    only with CLONE_THREAD (threads, no processes), ``kill``, ``tgkill``, ``rt_sigqueueinfo`` and
+    ``rt_tgsigqueueinfo`` only to this process, ``prlimit64`` only to read limits. ``sc``: :func:`load_seccomp`."""
     pid = os.getpid()
     deny = sc.ERRNO(errno.EPERM)
     f = sc.SyscallFilter(sc.ALLOW)
@@ -172,6 +172,9 @@ def seccomp(sc) -> list[str]:
     f.add_rule(deny, "clone", sc.Arg(0, sc.MASKED_EQ, CLONE_THREAD, 0))
     f.add_rule(deny, "kill", sc.Arg(0, sc.NE, pid))
     f.add_rule(deny, "tgkill", sc.Arg(0, sc.NE, pid))
+    # queued signals to another process: Landlock's signal scope (ABI >= 6) refuses them too, older kernels do not
+    f.add_rule(deny, "rt_sigqueueinfo", sc.Arg(0, sc.NE, pid))
+    f.add_rule(deny, "rt_tgsigqueueinfo", sc.Arg(0, sc.NE, pid))
     f.add_rule(deny, "prlimit64", sc.Arg(2, sc.NE, 0))
     try:
         f.load()

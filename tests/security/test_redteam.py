@@ -279,11 +279,6 @@ def test_no_signal_by_rt_sigqueueinfo_reaches_another_process(env, tmp_path, fir
     assert error is not None and "PermissionError" in str(error), error
 
 
-@pytest.mark.xfail(strict=True, reason="escape on kernels before 6.12 (Landlock ABI < 6, no signal scope; the "
-                   "sandbox accepts any ABI from 1): the seccomp filter denies kill/tkill/tgkill/pidfd_send_signal to "
-                   "other processes but not rt_sigqueueinfo or rt_tgsigqueueinfo, so a worker whose first wall fell "
-                   "can SIGKILL its parent (here a victim got SIGTERM); gendex_envs/sandbox/confine.py seccomp(): "
-                   "allow both only with arg0 == own pid")
 def test_seccomp_alone_stops_rt_sigqueueinfo_to_another_process(tmp_path, victim):
     """Landlock's signal scope needs ABI 6 (Linux 6.12); the sandbox also runs on older kernels (any ABI from 1),
     where only the seccomp filter stands between the worker and its parent's pid."""

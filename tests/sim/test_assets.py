@@ -33,7 +33,7 @@ def _grid_spec(objects: list[dict], table_m: float) -> dict:
         "stages": [{"name": "idle", "instruction": "Idle.", "skill": "reorient", "method": "RL",
                     "control_joint": "hand"}],
         "success": {"description": "never", "conditions": [{"type": "lifted", "object": objects[0]["name"],
-                                                             "min_height_m": 4.0}]},
+                                                             "min_height_m": 10.0}]},
     }, source="<test_assets>")
 
 
