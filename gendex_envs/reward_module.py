@@ -72,10 +72,11 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
     ``trusted`` defaults to the folder's trust (:func:`gendex_envs.guard.is_trusted`: the repository's committed
     tasks, or ``trust_remote_code``). An untrusted module is first statically checked
     (:func:`gendex_envs.code_check.check_reward_source`; a rejection is a :class:`RewardModuleError` listing every
-    problem, raised before any of its code runs), then its folder goes under the
-    runtime guard's audit hook and it runs with restricted builtins and read-only copies of its modules
-    (:mod:`gendex_envs.guard`). ``static_check=False`` skips the static check of an untrusted module (the probe's
-    tests of the runtime fences); the guard applies either way."""
+    problem, raised before any of its code runs), then its folder goes under the runtime guard's audit hook and it
+    runs with restricted builtins and read-only copies of its modules (:mod:`gendex_envs.guard`), in the confined
+    worker process (:mod:`gendex_envs.sandbox`; ``GENDEX_IN_PROCESS_GUARD=1`` runs it in this process instead). An
+    untrusted module that is a link is refused: trust is judged where a file lies. ``static_check=False`` skips the
+    static check of an untrusted module (the probe's tests of the runtime fences); the guard applies either way."""
     named = Path(path).absolute()
     path = named.parent.resolve() / named.name  # its folder resolved; a link is judged where it lies (guard.is_trusted)
     if not path.is_file():
