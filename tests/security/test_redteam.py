@@ -4,9 +4,8 @@ pull, saved tensors).
 
 Each test asserts the safe outcome: a typed :class:`~gendex_envs.errors.GenDexError` (or a contained, harmless
 result), no marker file, nothing written outside where it may write, and an end within a few seconds. Payloads are
-in ``tests/data/hostile_r2/redteam/`` or built here from a committed task. A test marked ``xfail(strict=True)``
-records an escape that is still open: the reason names it and the code that should close it; it turns into an
-error (XPASS) the moment that code is fixed, and then the mark goes.
+in ``tests/data/hostile_r2/redteam/`` or built here from a committed task. Every escape this round found is closed;
+an escape found later and not yet closed is recorded as ``xfail(strict=True)`` naming the code that should close it.
 """
 
 from __future__ import annotations
