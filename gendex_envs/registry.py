@@ -105,6 +105,7 @@ def discover_tasks(roots: list[Path] | None = None, override: bool | None = None
     folders (:class:`TaskNotFoundError`)."""
     override = override_allowed() if override is None else override
     committed: set[str] | None = None
+    committed_names: set[str] = set()
     found: dict[str, TaskVersion] = {}
     for root in task_roots() if roots is None else roots:
         if not root.is_dir():
@@ -115,14 +116,16 @@ def discover_tasks(roots: list[Path] | None = None, override: bool | None = None
                 log.info("%s in %s is shadowed by %s", version.env_id, version.root, found[version.env_id].root)
                 continue
             if not own and not override:
-                committed = committed_ids() if committed is None else committed
+                if committed is None:
+                    committed = committed_ids()
+                    committed_names = {i.split("/", 1)[1].rsplit("-v", 1)[0] for i in committed}
                 if version.env_id in committed:
                     log.warning("refusing %s from %s: it would replace the committed task %s; set %s=1 (or call "
                                 "register_tasks(roots, override=True)) to use it instead", version.env_id,
                                 version.root, REPO_TASKS_DIR / version.name / f"v{version.version}",
                                 ALLOW_OVERRIDE_ENV)
                     continue
-                if version.name in {i.split("/", 1)[1].rsplit("-v", 1)[0] for i in committed}:
+                if version.name in committed_names:
                     # a new version of a committed name would become what GenDex/<Name> and resolve_task pick
                     log.warning("refusing %s from %s: %s is a committed task's name, whose versions are the "
                                 "repository's; set %s=1 (or call register_tasks(roots, override=True)) to add one",
