@@ -21,7 +21,9 @@ Checksums cover every file of each task's ``lerobot/`` folder (data, meta, video
 the collector's bookkeeping (``collect_state.json``, which holds wall-clock time) is left out.
 
 A pulled repo is untrusted data. Before anything reaches ``out``, :func:`pull` refuses (:class:`DatasetError` naming
-the entry) a symbolic link or any other non-regular file anywhere in the download, a build record over
+the entry) a symbolic link or any other non-regular file anywhere in the download, a download of more than
+``MAX_DOWNLOAD_FILES`` files and folders or ``MAX_DOWNLOAD_BYTES`` bytes (the Hub's listing is checked before
+anything is downloaded, the files on disk before anything is copied, and the copy counts again), a build record over
 ``MAX_BUILD_RECORD_BYTES`` (checked before parsing; parsed with the bounded JSON loader), and a task that is not a
 versioned GenDex id ``GenDex/<Name>-v<N>`` (so its folder is a plain name: no ``/``, ``..``, absolute path or
 newline); every joined path must resolve inside its folder. The copy is assembled in a hidden folder beside
@@ -284,7 +286,15 @@ class HubRemote:
         return str(getattr(info, "commit_url", repo_id))
 
     def pull(self, repo_id: str, out: Path) -> Path:
-        return Path(self.api.snapshot_download(repo_id=repo_id, repo_type="dataset", local_dir=str(out)))
+        """Download the repo's files at one revision, after its listing passed :func:`check_listing` (so an
+        oversized repo is refused before any byte of it is fetched, and the files fetched are the ones listed)."""
+        info = self.api.dataset_info(repo_id, files_metadata=True)
+        if info.siblings is None:
+            raise DatasetError(f"the Hub did not list the files of {repo_id}; a pull checks their number and sizes "
+                               "before downloading")
+        check_listing([(s.rfilename, s.size) for s in info.siblings])
+        return Path(self.api.snapshot_download(repo_id=repo_id, repo_type="dataset", revision=info.sha,
+                                               local_dir=str(out)))
 
 
 class FolderRemote:
@@ -326,18 +336,70 @@ MAX_DOWNLOAD_DEPTH = 32
 file-000.mp4``, is 6 levels down). The copy recurses once per level: 500 levels raised a bare ``RecursionError``."""
 
 
+MAX_DOWNLOAD_FILES = 500_000
+"""Files and folders a download may hold, all together (folders count too: a flood of empty folders costs inodes
+and time as files do). A task's LeRobot dataset holds 7 files in 7 folders, plus per camera 2 folders and one video
+per episode: the published one-task datasets hold 8 to 11 files, ``gendex-lib-v1`` (86 tasks, 50 episodes, no
+camera) about 1 200 entries, and 86 tasks of 200 episodes with 4 cameras about 71 000."""
+MAX_DOWNLOAD_BYTES = 200_000_000_000
+"""Bytes a download's files may hold, all together (each file's size as listed or as ``lstat`` gives it, so a sparse
+file counts at its full length, the bytes a copy would write). ``gendex-smoke`` is 0.36 MB; a task's state data is
+about 60 kB an episode and a 64 px AV1 video about 23 kB an episode and camera, so ``gendex-lib-v1`` is about
+0.26 GB, and 86 tasks of 200 episodes with 4 cameras at 256 px (about 0.4 MB a video) about 29 GB."""
+
+
+def _too_many(count: int, where: str) -> DatasetError:
+    return DatasetError(f"the download holds more than MAX_DOWNLOAD_FILES = {MAX_DOWNLOAD_FILES} files and folders "
+                        f"(entry {count}: {quote(where)}); a dataset holds about 14 per task and one video per "
+                        "episode and camera")
+
+
+def _too_big(total: int, where: str) -> DatasetError:
+    return DatasetError(f"the download's files hold more than MAX_DOWNLOAD_BYTES = {MAX_DOWNLOAD_BYTES} bytes "
+                        f"({total} with {quote(where)}); a dataset's state data is about 60 kB an episode, a video "
+                        "tens to hundreds of kB")
+
+
+def check_listing(files: list[tuple[str, int | None]]) -> None:
+    """Refuse (:class:`DatasetError`) a remote's listing of ``(path, size)`` that would exceed
+    :data:`MAX_DOWNLOAD_FILES` (files and the folders their paths imply), :data:`MAX_DOWNLOAD_BYTES` or
+    :data:`MAX_DOWNLOAD_DEPTH`, or that does not say a file's size: checked before anything is downloaded."""
+    folders: set[str] = set()
+    total = 0
+    for count, (name, size) in enumerate(files, start=1):
+        parts = name.split("/")
+        if len(parts) - 1 > MAX_DOWNLOAD_DEPTH:
+            raise DatasetError(f"{quote(name)} is nested more than MAX_DOWNLOAD_DEPTH = {MAX_DOWNLOAD_DEPTH} folders "
+                               "deep; a dataset's files lie a few levels down")
+        folders.update("/".join(parts[:i]) for i in range(1, len(parts)))
+        if count + len(folders) > MAX_DOWNLOAD_FILES:
+            raise _too_many(count + len(folders), name)
+        if not isinstance(size, int) or isinstance(size, bool) or size < 0:
+            raise DatasetError(f"the remote lists {quote(name)} without a size ({quote(size)}); every file's size "
+                               "must be known before the download, to keep it within MAX_DOWNLOAD_BYTES")
+        total += size
+        if total > MAX_DOWNLOAD_BYTES:
+            raise _too_big(total, name)
+
+
 def regular_files_only(root: Path) -> None:
     """Refuse (:class:`DatasetError` naming the entry) a symbolic link or a non-regular file anywhere under ``root``,
-    or folders nested deeper than :data:`MAX_DOWNLOAD_DEPTH`; links are not followed. The walk keeps its own stack,
-    so no depth of nesting makes it recurse."""
+    folders nested deeper than :data:`MAX_DOWNLOAD_DEPTH`, more than :data:`MAX_DOWNLOAD_FILES` files and folders,
+    or files holding more than :data:`MAX_DOWNLOAD_BYTES` together; links are not followed. The walk keeps its own
+    stack, so no depth of nesting makes it recurse, and stops at the first entry over a limit."""
     root = Path(root)
     stack = [(root, 0)]
+    count = total = 0
     while stack:
         folder, depth = stack.pop()
         with os.scandir(folder) as entries:
             for entry in entries:
                 path = Path(entry.path)
-                mode = entry.stat(follow_symlinks=False).st_mode
+                info = entry.stat(follow_symlinks=False)
+                mode = info.st_mode
+                count += 1
+                if count > MAX_DOWNLOAD_FILES:
+                    raise _too_many(count, str(path.relative_to(root)))
                 if stat.S_ISLNK(mode):
                     raise DatasetError(f"{path.relative_to(root)} is a symbolic link: a dataset may hold only regular "
                                        "files and folders")
@@ -350,6 +412,33 @@ def regular_files_only(root: Path) -> None:
                 elif not stat.S_ISREG(mode):
                     raise DatasetError(f"{path.relative_to(root)} is not a regular file or folder: a dataset may hold "
                                        "only regular files and folders")
+                else:
+                    total += info.st_size
+                    if total > MAX_DOWNLOAD_BYTES:
+                        raise _too_big(total, str(path.relative_to(root)))
+
+
+class _CopyBudget:
+    """A ``copytree`` copy function that counts what it copies (files; bytes, each file's size before and after the
+    copy, whichever is larger) against :data:`MAX_DOWNLOAD_FILES` and :data:`MAX_DOWNLOAD_BYTES`, refusing a file
+    that would pass a limit before copying it: a download that changed after :func:`regular_files_only` saw it is
+    still stopped, and the caller removes the partial copy."""
+
+    def __init__(self) -> None:
+        self.count = self.total = 0
+
+    def __call__(self, src: str, dst: str) -> str:
+        self.count += 1
+        if self.count > MAX_DOWNLOAD_FILES:
+            raise _too_many(self.count, os.path.basename(src))
+        size = os.lstat(src).st_size
+        if self.total + size > MAX_DOWNLOAD_BYTES:
+            raise _too_big(self.total + size, os.path.basename(src))
+        shutil.copy2(src, dst, follow_symlinks=False)
+        self.total += max(size, os.lstat(dst).st_size)
+        if self.total > MAX_DOWNLOAD_BYTES:
+            raise _too_big(self.total, os.path.basename(src))
+        return dst
 
 
 def _inside(root: Path, *parts: str) -> Path:
@@ -408,16 +497,18 @@ def _from_repo(staging: Path, out: Path) -> None:
     ``staging`` must have passed :func:`regular_files_only`; every task name is checked by :func:`_tasks_of`."""
     tasks = _tasks_of(staging)
     out.mkdir(parents=True, exist_ok=True)
+    budget = _CopyBudget()
     if len(tasks) == 1:
         dest = _inside(out, tasks[0], "lerobot")
-        shutil.copytree(staging, dest, ignore=shutil.ignore_patterns(BUILD_RECORD, ".*"), dirs_exist_ok=True)
+        shutil.copytree(staging, dest, ignore=shutil.ignore_patterns(BUILD_RECORD, ".*"), dirs_exist_ok=True,
+                        copy_function=budget)
     else:
         for t in tasks:
             src = _inside(staging, t)
             if not src.is_dir():
                 raise DatasetError(f"the repo has no folder {t}/ for a task its {BUILD_RECORD} names")
-            shutil.copytree(src, _inside(out, t), dirs_exist_ok=True)
-    shutil.copy2(staging / BUILD_RECORD, out / BUILD_RECORD)
+            shutil.copytree(src, _inside(out, t), dirs_exist_ok=True, copy_function=budget)
+    budget(str(staging / BUILD_RECORD), str(out / BUILD_RECORD))
 
 
 def _move_into(work: Path, out: Path) -> None:
@@ -464,6 +555,7 @@ def pull(repo_id: str, out: Path, remote: Remote, manifest: DatasetManifest | No
     return verify(out, manifest) if manifest is not None else None
 
 
-__all__ = ["BUILD_RECORD", "DATASETS_DIR", "MAX_BUILD_RECORD_BYTES", "DatasetError", "DatasetManifest", "DatasetTask",
-           "FolderRemote", "HubRemote", "Remote", "Verification", "build", "checksums", "load_manifest", "pull", "push",
-           "record_checksums", "regular_files_only", "save_manifest", "verify"]
+__all__ = ["BUILD_RECORD", "DATASETS_DIR", "MAX_BUILD_RECORD_BYTES", "MAX_DOWNLOAD_BYTES", "MAX_DOWNLOAD_FILES",
+           "DatasetError", "DatasetManifest", "DatasetTask", "FolderRemote", "HubRemote", "Remote", "Verification",
+           "build", "check_listing", "checksums", "load_manifest", "pull", "push", "record_checksums",
+           "regular_files_only", "save_manifest", "verify"]

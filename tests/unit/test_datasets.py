@@ -135,6 +135,11 @@ def test_the_hub_remote_makes_a_tagged_dataset_repo_of_the_whole_folder(tmp_path
         def create_tag(self, repo_id, **kw):
             calls.append(("create_tag", repo_id, kw["tag"]))
 
+        def dataset_info(self, repo_id, **kw):
+            calls.append(("dataset_info", repo_id, kw))
+            return type("Info", (), {"sha": "c0ffee", "siblings": [
+                type("Sibling", (), {"rfilename": "gendex_dataset.json", "size": 469})()]})()
+
         def snapshot_download(self, **kw):
             calls.append(("snapshot_download", kw))
             return kw["local_dir"]
@@ -145,5 +150,7 @@ def test_the_hub_remote_makes_a_tagged_dataset_repo_of_the_whole_folder(tmp_path
     assert calls[0] == ("create_repo", "org/ds", {"repo_type": "dataset", "exist_ok": True})
     assert calls[1][1]["repo_type"] == "dataset"
     assert [c[2] for c in calls if c[0] == "create_tag"] == ["v3.0"]
-    hub.pull("org/ds", tmp_path / "dl")
-    assert calls[-1][1] == {"repo_id": "org/ds", "repo_type": "dataset", "local_dir": str(tmp_path / "dl")}
+    hub.pull("org/ds", tmp_path / "dl")  # the listing (sizes included) first, then that revision's files
+    assert calls[-2] == ("dataset_info", "org/ds", {"files_metadata": True})
+    assert calls[-1][1] == {"repo_id": "org/ds", "repo_type": "dataset", "revision": "c0ffee",
+                            "local_dir": str(tmp_path / "dl")}
