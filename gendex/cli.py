@@ -22,6 +22,7 @@ from gendex.cli_common import backend_of, ray_address_option, ray_option
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
+from gendex.cli_trust import trust_command
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="GenDex: generative simulation for dexterous hands (ShadowHand on UR10e, SAPIEN/ManiSkill3).")
@@ -29,6 +30,7 @@ app.add_typer(dataset_app, name="dataset")
 app.add_typer(bc_app, name="bc")
 app.command("eval")(eval_command)
 app.add_typer(leaderboard_app, name="leaderboard")
+app.command("trust")(trust_command)
 log = logging.getLogger("gendex")
 
 
@@ -446,6 +448,9 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                         fg=typer.colors.YELLOW)
     for reason in failed:
         typer.secho(f"  no task: {reason}", fg=typer.colors.RED, err=True)
+    if rows:  # model-written code stays untrusted until a person reviews it (gendex_envs.trust_record)
+        typer.echo("The new reward code runs as untrusted code (static check, sandbox); once you have reviewed a task, "
+                   "`gendex trust FOLDER` records it as trusted (generated_tasks/ only).")
     gated = sum(1 for s in rows for r in s.dropped if "solvability gate" in r)
     typer.echo(f"\n{len(rows)} of {n} task(s) committed; {sum(len(s.dropped) for s in rows)} proposal(s) rejected on "
                f"the way ({gated} by the solvability gate); {len(failed)} task slot(s) without a task")
