@@ -31,9 +31,11 @@ be withheld in-process, so :data:`~gendex_envs.code_check.rules.TENSOR_METHODS` 
 with the confined worker process as the wall behind it. Python has no in-process isolation, so
 these fences hold together, not one by one; a process boundary (the probe's child) is the stronger one.
 
-Trust: the repository's own committed tasks (``generated_tasks/``) and the package's preview module are trusted;
-any other folder (``GENDEX_TASKS_PATH``, a downloaded task, a generator run's output) is untrusted unless the user
-says so: ``gym.make(id, trust_remote_code=True)``, ``TaskEnv(..., trust_remote_code=True)``, or
+Trust: the package's preview module and the reward modules of the repository's task folder (``generated_tasks/``)
+whose bytes the trust record lists (:mod:`gendex_envs.trust_record`, ``generated_tasks/TRUSTED.sha256``: what people
+reviewed and recorded with ``gendex trust``) are trusted. Anything else (a file there that is new or changed, such as
+``gendex generate``'s output, ``GENDEX_TASKS_PATH``, a downloaded task) is untrusted unless the user says so:
+``gym.make(id, trust_remote_code=True)``, ``TaskEnv(..., trust_remote_code=True)``, or
 ``GENDEX_TRUST_REMOTE_CODE=1`` in the environment (as ``transformers`` names it).
 """
 
@@ -261,11 +263,13 @@ def trusts_everything() -> bool:
     return os.environ.get(TRUST_ENV, "").strip().lower() in ("1", "true", "yes")
 
 
-def is_trusted(path: str | Path) -> bool:
-    """Whether code under ``path`` runs without the guard: the repository's committed tasks, the package itself,
-    folders passed to :func:`trust`, or everything when ``GENDEX_TRUST_REMOTE_CODE=1``. ``path`` is judged where
-    it lies: its folder resolved, its own name not followed (a link in a download to a file under
-    ``generated_tasks/`` is not trusted code)."""
+def is_trusted(path: str | Path, data: bytes | None = None) -> bool:
+    """Whether code at ``path`` runs without the guard: everything when ``GENDEX_TRUST_REMOTE_CODE=1``, the package
+    itself, folders passed to :func:`trust`, and, in the repository's task folder (``generated_tasks/``), only the
+    files whose bytes match the trust record (:mod:`gendex_envs.trust_record`: a new or changed file there is
+    untrusted, wherever it came from; a folder there is trusted when every ``.py`` file in it is). ``data``: the
+    bytes about to run, judged instead of the file's. ``path`` is judged where it lies: its folder resolved, its own
+    name not followed (a link in a download to a file under ``generated_tasks/`` is not trusted code)."""
     if trusts_everything():
         return True
     from gendex_envs.registry import REPO_TASKS_DIR
@@ -273,7 +277,14 @@ def is_trusted(path: str | Path) -> bool:
     named = Path(path).absolute()
     p = _folder(named.parent) + named.name + os.sep  # a link is judged where it lies, not by where it points
     package = _folder(Path(__file__).parent)
-    return p.startswith((_folder(REPO_TASKS_DIR), package, *_trusted_extra))
+    if p.startswith((package, *_trusted_extra)):
+        return True
+    tasks = _folder(REPO_TASKS_DIR)
+    if not p.startswith(tasks):
+        return False
+    from gendex_envs import trust_record
+
+    return trust_record.is_recorded(tasks, p[len(tasks):-1], data)
 
 
 def untrust(folder: str | Path) -> None:

@@ -18,8 +18,8 @@ documented members as fresh tensors, no handle to the scene, agent or controller
 are copies. The wrapping happens here, once, so every caller (the env, the judge, the probe, the solver) passes the
 env and the module sees only the view.
 
-Modules written by a language model are validated by the generator before they are committed. A module from a
-folder that is not trusted (anything but the repository's committed tasks, unless the user trusts it) is checked
+Modules written by a language model are validated by the generator before they are committed. A module that is not
+trusted (anything but a reviewed task the repository's trust record lists, unless the user trusts it) is checked
 again here, statically, before it runs, and runs under the runtime guard (:mod:`gendex_envs.guard`). Every module,
 trusted or not, is read once as UTF-8 and that exact text is checked and run: nothing is imported from the task
 folder, so a ``coding:`` declaration, a byte-order mark or a ``__pycache__`` shipped with it cannot change what
@@ -38,7 +38,7 @@ from types import ModuleType
 
 from gendex_envs import guard
 from gendex_envs.code_check import check_reward_source
-from gendex_envs.code_check.source import compile_reward_source, read_reward_source
+from gendex_envs.code_check.source import compile_reward_source, decode_reward_source, read_reward_bytes
 from gendex_envs.errors import RewardCodeError, RewardModuleError
 from gendex_envs.reward_view import view_args, view_of
 
@@ -69,8 +69,9 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
     at. This is one code path for trusted and untrusted modules; the code objects name the real path, by which the
     runtime guard's audit hook recognises untrusted frames.
 
-    ``trusted`` defaults to the folder's trust (:func:`gendex_envs.guard.is_trusted`: the repository's committed
-    tasks, or ``trust_remote_code``). An untrusted module is first statically checked
+    ``trusted`` defaults to the file's trust (:func:`gendex_envs.guard.is_trusted`: a reward module of the
+    repository's task folder whose bytes the trust record lists, or ``trust_remote_code``; the bytes read are the
+    bytes judged). An untrusted module is first statically checked
     (:func:`gendex_envs.code_check.check_reward_source`; a rejection is a :class:`RewardModuleError` listing every
     problem, raised before any of its code runs), then its folder goes under the runtime guard's audit hook and it
     runs with restricted builtins and read-only copies of its modules (:mod:`gendex_envs.guard`), in the confined
@@ -81,12 +82,16 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
     path = named.parent.resolve() / named.name  # its folder resolved; a link is judged where it lies (guard.is_trusted)
     if not path.is_file():
         raise RewardModuleError(f"reward module {path} does not exist; every task version needs a task reward module")
-    trusted = guard.is_trusted(path) if trusted is None else trusted
+    judged = trusted is None
+    trusted = guard.is_trusted(path) if judged else trusted
     if not trusted and path.is_symlink():
         raise RewardModuleError(f"reward module {path} is a link (to {path.resolve()}); an untrusted folder's reward "
                                 "modules must be regular files of that folder")
     try:
-        source = read_reward_source(path, str(path))
+        data = read_reward_bytes(path)
+        if judged and trusted and not guard.is_trusted(path, data):  # what runs is what the trust record lists
+            raise RewardModuleError(f"reward module {path} changed while it was being loaded; load it again")
+        source = decode_reward_source(data, str(path))
     except RewardCodeError as exc:
         raise RewardModuleError(f"reward module {path} was refused before any of it ran: {exc}") from exc
     if not trusted:
@@ -95,9 +100,9 @@ def load_reward_module(path: str | Path, trusted: bool | None = None, static_che
                 check_reward_source(source, str(path))
             except RewardCodeError as exc:
                 raise RewardModuleError(
-                    f"reward module {path} is not trusted (not a committed task of this repository) and the static "
-                    f"check rejected it before any of it ran; trust_remote_code=True runs a folder you wrote as it "
-                    f"is.\n{exc}") from exc
+                    f"reward module {path} is not trusted (not a reviewed task recorded in the repository's "
+                    f"generated_tasks/TRUSTED.sha256) and the static check rejected it before any of it ran; "
+                    f"trust_remote_code=True runs a folder you wrote as it is.\n{exc}") from exc
         guard.untrust(path.parent)
         from gendex_envs import sandbox  # here: the sandbox builds RewardModules of this module
 

@@ -69,16 +69,18 @@ def decode_reward_source(data: bytes, filename: str) -> str:
     return text
 
 
-def read_reward_source(path: str | Path, filename: str | None = None) -> str:
-    """Read ``path`` once (at most :data:`~gendex_envs.code_check.rules.MAX_SOURCE_BYTES` + 1 bytes) and decode
-    it with :func:`decode_reward_source`."""
+def read_reward_bytes(path: str | Path) -> bytes:
+    """The bytes of ``path``, read once (at most :data:`~gendex_envs.code_check.rules.MAX_SOURCE_BYTES` + 1)."""
     path = Path(path)
-    name = filename or path.name
     if not path.is_file():
         raise FileNotFoundError(f"reward module {path} does not exist")
     with path.open("rb") as f:
-        data = f.read(MAX_SOURCE_BYTES + 1)
-    return decode_reward_source(data, name)
+        return f.read(MAX_SOURCE_BYTES + 1)
+
+
+def read_reward_source(path: str | Path, filename: str | None = None) -> str:
+    """Read ``path`` once (:func:`read_reward_bytes`) and decode it with :func:`decode_reward_source`."""
+    return decode_reward_source(read_reward_bytes(path), filename or Path(path).name)
 
 
 def compile_reward_source(text: str, path: str | Path) -> CodeType:
