@@ -6,6 +6,7 @@ from __future__ import annotations
 import atexit
 import builtins
 import logging
+import math
 import os
 import queue
 import select
@@ -20,7 +21,7 @@ from pathlib import Path
 import torch
 
 from gendex_envs.errors import GenDexError, RewardModuleError, RewardSandboxError, RewardTimeoutError
-from gendex_envs.sandbox import confine, protocol
+from gendex_envs.sandbox import confine, protocol, replay
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +43,19 @@ FULL_BUILTINS_FOR_TESTS = False
 """Tests only: load modules in the worker with Python's ordinary builtins, as if the first wall had a hole."""
 MAX_KEY_ARG_CHARS = 4096
 FUNCTIONS = ("evaluate", "compute_dense_reward", "_get_obs_extra")
+ARITY = {"evaluate": 0, "_get_obs_extra": 1, "compute_dense_reward": 3}
+REPLAY_ENV = "GENDEX_SANDBOX_REPLAY"
+"""Set to 0 to serve every call of untrusted reward code from the worker (no in-process replay of recorded calls)."""
+MAX_TRACES = 8
+"""Recordings one function of one module may ask of the worker (a function whose calls keep coming out otherwise
+than recorded, a branch on data, stays with the worker after these)."""
+MAX_VARIANTS = 4
+"""Graphs kept per function and argument signature (one per outcome of the guards that differ)."""
+REPLAY_SLOW_S = 0.25
+"""A replay that takes longer than this ends replays of the module (committed modules replay in 0.05-0.3 ms)."""
+AUDIT_EVERY = 64
+"""Every this-many-th replay of a function is also asked of the worker and compared; a difference ends replays of
+the module."""
 
 
 def enabled() -> bool:
@@ -153,6 +167,30 @@ def _at_line(exc: BaseException, path: Path, line) -> BaseException:
     return exc
 
 
+def replay_enabled() -> bool:
+    return os.environ.get(REPLAY_ENV, "").strip().lower() not in ("0", "false", "no")
+
+
+def agree(a, b) -> bool:
+    """``a`` and ``b`` hold the same values: the same structure, tensors of one dtype and shape, floating ones equal
+    to rounding (the worker computes with one thread, the parent with several), all others exactly."""
+    if isinstance(a, torch.Tensor) or isinstance(b, torch.Tensor):
+        if not (isinstance(a, torch.Tensor) and isinstance(b, torch.Tensor) and a.dtype == b.dtype
+                and a.shape == b.shape):
+            return False
+        b = b.to(a.device)
+        if a.is_floating_point():
+            return bool(torch.allclose(a, b, rtol=1e-5, atol=1e-6, equal_nan=True))
+        return bool(torch.equal(a, b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return list(a) == list(b) and all(agree(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(agree(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return type(a) is type(b) and a == b
+
+
 def _same(a, b) -> bool:
     """``a`` is ``b``, or both are dicts holding the very same objects under the same keys (the env hands
     ``_get_obs_extra`` and ``compute_dense_reward`` each a fresh dict of one step's info tensors)."""
@@ -160,6 +198,28 @@ def _same(a, b) -> bool:
         return True
     return (isinstance(a, dict) and isinstance(b, dict) and len(a) == len(b)
             and all(k in b and b[k] is v for k, v in a.items()))
+
+
+def _reader(view, args: tuple):
+    """How a replay reads its leaves: an env member of the real view, or an entry of an argument."""
+    def read(source):
+        if source[0] == "m":
+            return MEMBERS[source[1]][1](view, *source[2:])
+        value = args[source[1]]
+        for part in source[2:]:
+            value = value[part]
+        return value
+    return read
+
+
+def _check_source(source: list, arity: int) -> None:
+    """Raises unless ``source`` names a member the worker may ask for, or an entry of one of ``arity`` arguments."""
+    if source[0] == "m":
+        _key(list(source[1:]))
+        return
+    if not (source[0] == "a" and len(source) >= 2 and type(source[1]) is int and 0 <= source[1] < arity
+            and all(type(p) is int and 0 <= p < 4096 or type(p) is str and len(p) <= 256 for p in source[2:])):
+        raise ValueError(f"not a member or argument entry: {str(source)[:100]}")
 
 
 # ---------------------------------------------------------------------------------------------- the worker
@@ -345,6 +405,12 @@ class RemoteModule:
         self.early: tuple | None = None  # (env, info, elapsed_steps, reward) computed with _get_obs_extra
         self.functions: tuple[str, ...] = ()
         self.reward_max = 1.0
+        self.graphs: dict[tuple, list[replay.Graph]] = {}
+        self.traces_left: dict[str, int] = {}
+        self.replays: dict[str, int] = {}
+        """Per function: calls replayed in this process, and (``worker_calls``) calls the worker served."""
+        self.worker_calls: dict[str, int] = {}
+        self.replay_off: str | None = None if replay_enabled() else f"{REPLAY_ENV}=0"
         self._load()
 
     def _load(self) -> None:
@@ -388,11 +454,40 @@ class RemoteModule:
         if fn == "compute_dense_reward" and early is not None and early[0] is u and _same(early[1], info) and \
                 isinstance(steps, torch.Tensor) and torch.equal(early[2], steps):
             return early[3]
+        view = view_of(env)
+        signature = None
+        if self.replay_off is None:
+            signature = (fn, view.num_envs, view.table_height, tuple(view.object_names),
+                         tuple(view.stage_targets), replay.signature(args))
+            for graph in self.graphs.get(signature, ()):
+                start = time.perf_counter()
+                try:
+                    value = graph.run(_reader(view, args))
+                except replay.Miss as miss:
+                    log.debug("reward module %s: %s: replay missed (%s)", self.path, fn, miss)
+                    continue
+                finally:
+                    self._timed(fn, time.perf_counter() - start)
+                count = self.replays[fn] = self.replays.get(fn, 0) + 1
+                if count % AUDIT_EVERY == 0:
+                    self._audit(fn, env, args, info, value)
+                return value
+        record = signature is not None and self.traces_left.get(fn, MAX_TRACES) > 0
+        self.worker_calls[fn] = self.worker_calls.get(fn, 0) + 1
+        value, graph = self._remote(fn, env, view, args, info, steps, record)
+        if record:
+            self.traces_left[fn] = self.traces_left.get(fn, MAX_TRACES) - 1
+            self._keep(fn, signature, graph, view, args, value)
+        return value
+
+    def _remote(self, fn: str, env, view, args: tuple, info, steps, record: bool):
+        """``fn`` called in the worker: its value, and with ``record`` the graph the worker recorded (or None)."""
         if self.worker is None or not self.worker.alive():
             self._load()  # the worker died (a limit, another module's timeout): modules keep no state, reload
-        worker, view = self.worker, view_of(env)
+        worker = self.worker
         device = torch.device(view.device)
-        then = fn == "_get_obs_extra" and self.early_reward and info is not None and isinstance(steps, torch.Tensor)
+        then = (fn == "_get_obs_extra" and self.early_reward and info is not None and isinstance(steps, torch.Tensor)
+                and not record)
         keys = dict(self.prefetch.setdefault(fn, {}))
         if then:
             keys.update(self.prefetch.setdefault("compute_dense_reward", {}))
@@ -406,14 +501,59 @@ class RemoteModule:
             snapshot.append([list(key), protocol.encode(value, tensors)])
         static = {"num_envs": view.num_envs, "table_height": view.table_height,
                   "object_names": list(view.object_names), "stage_targets": list(view.stage_targets)}
-        header = {"op": "call", "id": self.id, "fn": fn, "then": then, "snapshot": snapshot,
+        header = {"op": "call", "id": self.id, "fn": fn, "then": then, "trace": record, "snapshot": snapshot,
                   "static": protocol.encode(static, tensors), "args": protocol.encode(list(args), tensors)}
         with worker.lock:
             reply = self._exchange(worker, header, tensors, fn, view, time.monotonic() + call_timeout(), device)
         after = reply.get("then")
         if then and isinstance(after, list) and len(after) == 1:
-            self.early = (u, info, steps.clone(), after[0])
-        return reply.get("value")
+            self.early = (getattr(env, "unwrapped", env), info, steps.clone(), after[0])
+        return reply.get("value"), reply.get("graph") if record else None
+
+    def _keep(self, fn: str, signature: tuple, graph, view, args: tuple, value) -> None:
+        """Check the worker's recording of a call and keep it when its replay, on the very state the call read,
+        gives the value the worker returned (:mod:`gendex_envs.sandbox.replay`)."""
+        if not (isinstance(graph, dict) and "entries" in graph):
+            why = graph.get("failed") if isinstance(graph, dict) else "no graph"
+            log.debug("reward module %s: %s is served by the worker: %s", self.path, fn, str(why)[:300])
+            return
+        arity = ARITY[fn]
+        try:
+            compiled = replay.compile_graph(graph, view.num_envs, torch.device(view.device),
+                                            lambda source: _check_source(source, arity))
+            start = time.perf_counter()
+            replayed = compiled.run(_reader(view, args))
+            self._timed(fn, time.perf_counter() - start)
+        except (replay.GraphError, replay.Miss) as exc:
+            log.debug("reward module %s: %s's recording is not replayed: %s", self.path, fn, exc)
+            return
+        if self.replay_off is not None:
+            return
+        if not agree(replayed, value):
+            log.debug("reward module %s: %s's replay differs from its call; the worker serves it", self.path, fn)
+            return
+        kept = self.graphs.setdefault(signature, [])
+        kept.insert(0, compiled)
+        del kept[MAX_VARIANTS:]
+        log.debug("reward module %s: %s replays in process (%d leaves, %d operations)", self.path, fn,
+                  compiled.leaves, compiled.ops)
+
+    def _timed(self, fn: str, seconds: float) -> None:
+        if seconds > REPLAY_SLOW_S and self.replay_off is None:
+            self.replay_off = f"a replay of {fn} took {seconds:.2f} s (more than {REPLAY_SLOW_S} s)"
+            self.graphs.clear()
+            log.warning("reward module %s: %s; its calls go to the worker from now on", self.path, self.replay_off)
+
+    def _audit(self, fn: str, env, args: tuple, info, value) -> None:
+        """Ask the worker for a replayed call too; when the two differ, stop replaying this module."""
+        from gendex_envs.reward_view import view_of
+
+        u = getattr(env, "unwrapped", env)
+        worker_value, _ = self._remote(fn, env, view_of(env), args, info, getattr(u, "elapsed_steps", None), False)
+        if not agree(value, worker_value):
+            self.replay_off = f"{fn}'s replay differed from the worker's call"
+            self.graphs.clear()
+            log.warning("reward module %s: %s; its calls go to the worker from now on", self.path, self.replay_off)
 
     def _exchange(self, worker: Worker, header: dict, tensors: list, fn: str, answer, deadline: float,
                   device=None) -> dict:

@@ -40,7 +40,7 @@ import torch  # noqa: E402
 
 from gendex_envs import errors, guard  # noqa: E402
 from gendex_envs.reward_view import PoseView, view_args  # noqa: E402
-from gendex_envs.sandbox import confine, protocol  # noqa: E402
+from gendex_envs.sandbox import confine, protocol, trace  # noqa: E402
 
 FUNCTIONS = ("evaluate", "compute_dense_reward", "_get_obs_extra")
 
@@ -49,6 +49,7 @@ class Channel:
     def __init__(self, rfd: int, wfd: int):
         self.rfd, self.wfd = rfd, wfd
         self.remote_errors: set[int] = set()
+        self.tracer: trace.Tracer | None = None  # recording the current call (gendex_envs.sandbox.trace)
         self.running = ""  # the function being called: the parent files what it asks for under it
 
     def send(self, header: dict, value=None) -> None:
@@ -59,8 +60,15 @@ class Channel:
 
     def get(self, key: tuple):
         """The parent's answer for an env member missing from the snapshot (its error, raised here as it was)."""
-        self.send({"op": "get", "key": list(key), "fn": self.running})
-        reply = protocol.read_frame(self.rfd)
+        tracer = self.tracer
+        if tracer is not None:
+            tracer.paused = True  # the frame's own tensor building is not the reward call's
+        try:
+            self.send({"op": "get", "key": list(key), "fn": self.running})
+            reply = protocol.read_frame(self.rfd)
+        finally:
+            if tracer is not None:
+                tracer.paused = False
         if reply.get("op") == "val":
             return reply.get("value")
         exc = _rebuild(reply.get("type"), str(reply.get("msg", "")))
@@ -161,6 +169,8 @@ class RemoteView:
         if key in self._snapshot:
             return self._snapshot[key]
         value = self._snapshot[key] = self._channel.get(key)
+        if self._channel.tracer is not None:
+            self._channel.tracer.source(value, ("m", *key))
         return value
 
     def obj_pose(self, name: str) -> PoseView:
@@ -255,21 +265,36 @@ def _ignores(fn, positions: tuple[int, ...]) -> bool:
 
 
 def _call(msg: dict, modules: dict, channel: Channel):
-    """The function's value, and with ``then`` the reward of the same state and info computed right after it (for a
-    reward function that reads neither ``obs`` nor ``action``; see :mod:`gendex_envs.sandbox.host`)."""
+    """The function's value; with ``then`` the reward of the same state and info computed right after it (for a
+    reward function that reads neither ``obs`` nor ``action``; see :mod:`gendex_envs.sandbox.host`); with ``trace``
+    the call recorded as a graph the parent may replay (:mod:`gendex_envs.sandbox.trace`)."""
     fns = modules[msg["id"]]
     snapshot = {tuple(k): v for k, v in msg["snapshot"]}
     view = RemoteView(snapshot, channel, msg["static"])
     channel.running = msg["fn"]
-    value = fns[msg["fn"]](view, *(view_args(a) for a in msg["args"]))
+    args = msg["args"]
+    if msg.get("trace"):
+        sources: dict[int, tuple] = {}
+        keep: list = []
+        for key, v in snapshot.items():
+            trace.sources_of(v, ("m", *key), sources, keep)
+        trace.sources_of(list(args), ("a",), sources, keep)
+        channel.tracer = tracer = trace.Tracer(sources, keep)
+        try:
+            with tracer:
+                value = fns[msg["fn"]](view, *(view_args(a) for a in args))
+        finally:
+            channel.tracer = None
+        return value, None, tracer.finish(value)
+    value = fns[msg["fn"]](view, *(view_args(a) for a in args))
     if not msg.get("then"):
-        return value, None
+        return value, None, None
     channel.running = "compute_dense_reward"
     try:  # any failure here is the real call's to report, when the env makes it
-        early = fns["compute_dense_reward"](view, None, None, view_args(msg["args"][-1]))
+        early = fns["compute_dense_reward"](view, None, None, view_args(args[-1]))
     except Exception:
-        return value, None
-    return value, [early]
+        return value, None, None
+    return value, [early], None
 
 
 def _line(exc: BaseException) -> int | None:
@@ -296,10 +321,15 @@ def serve(rfd: int, wfd: int) -> None:
                 channel.send(_load(msg, modules))
             elif op == "call":
                 start = time.perf_counter()
-                value, early = _call(msg, modules, channel)
+                value, early, graph = _call(msg, modules, channel)
                 tensors: list = []
                 header = {"op": "ret", "value": protocol.encode(value, tensors),
                           "then": protocol.encode(early, tensors), "busy_s": time.perf_counter() - start}
+                if graph is not None:
+                    try:
+                        header["graph"] = protocol.encode(graph, tensors)
+                    except protocol.ProtocolError as exc:
+                        header["graph"] = {"$d": [["failed", f"not sent: {exc}"[:500]]]}
                 protocol.write_frame(channel.wfd, header, tensors)
             elif op == "exit":
                 return
