@@ -14,7 +14,12 @@ Reward functions get a view with the members of ``prompts/env_api.txt`` whose va
 the parent takes from the real view (:func:`gendex_envs.reward_view.view_of`); a member missing from it is asked
 of the parent within the call, and from then on sent with every call of that function (one round trip per call
 after the first). Each call has a wall-clock limit (:data:`CALL_TIMEOUT_S`, ``GENDEX_SANDBOX_TIMEOUT_S``); a
-worker that runs past it is killed and the call raises :class:`~gendex_envs.errors.RewardTimeoutError`. A system
+worker that runs past it is killed and the call raises :class:`~gendex_envs.errors.RewardTimeoutError`.
+
+The worker also records a function's call as a graph of torch operations (:mod:`gendex_envs.sandbox.trace`); the
+parent checks it and replays later calls from it in its own process, through a table of allow-listed operations
+only (:mod:`gendex_envs.sandbox.ops`, :mod:`gendex_envs.sandbox.replay`), so that a step needs no round trip; a
+call a replay does not reproduce goes to the worker (``GENDEX_SANDBOX_REPLAY=0`` sends every call there). A system
 that cannot confine the worker refuses untrusted modules (:class:`~gendex_envs.errors.RewardSandboxError`) unless
 ``GENDEX_IN_PROCESS_GUARD=1`` opts into the first wall alone. See ``docs/security.md``, "Isolation".
 """

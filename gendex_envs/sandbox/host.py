@@ -53,9 +53,10 @@ MAX_VARIANTS = 4
 """Graphs kept per function and argument signature (one per outcome of the guards that differ)."""
 REPLAY_SLOW_S = 0.25
 """A replay that takes longer than this ends replays of the module (committed modules replay in 0.05-0.3 ms)."""
-AUDIT_EVERY = 64
-"""Every this-many-th replay of a function is also asked of the worker and compared; a difference ends replays of
-the module."""
+AUDIT_AT = (16, 64, 256)
+AUDIT_EVERY = 1024
+"""The replays of a function also asked of the worker and compared (the :data:`AUDIT_AT`-th, then every
+:data:`AUDIT_EVERY`-th); a difference ends replays of the module."""
 
 
 def enabled() -> bool:
@@ -200,26 +201,24 @@ def _same(a, b) -> bool:
             and all(k in b and b[k] is v for k, v in a.items()))
 
 
-def _reader(view, args: tuple):
-    """How a replay reads its leaves: an env member of the real view, or an entry of an argument."""
-    def read(source):
-        if source[0] == "m":
-            return MEMBERS[source[1]][1](view, *source[2:])
-        value = args[source[1]]
-        for part in source[2:]:
-            value = value[part]
-        return value
-    return read
-
-
-def _check_source(source: list, arity: int) -> None:
-    """Raises unless ``source`` names a member the worker may ask for, or an entry of one of ``arity`` arguments."""
+def _source_reader(source: list, arity: int):
+    """How a replay reads a leaf: ``(view, args) -> tensor`` for an env member the worker may ask for, or an entry of
+    one of ``arity`` arguments; raises for any other source."""
     if source[0] == "m":
-        _key(list(source[1:]))
-        return
+        key = _key(list(source[1:]))
+        member, rest = MEMBERS[key[0]][1], key[1:]
+        return lambda view, args: member(view, *rest)
     if not (source[0] == "a" and len(source) >= 2 and type(source[1]) is int and 0 <= source[1] < arity
             and all(type(p) is int and 0 <= p < 4096 or type(p) is str and len(p) <= 256 for p in source[2:])):
         raise ValueError(f"not a member or argument entry: {str(source)[:100]}")
+    index, path = source[1], tuple(source[2:])
+
+    def read(view, args):
+        value = args[index]
+        for part in path:
+            value = value[part]
+        return value
+    return read
 
 
 # ---------------------------------------------------------------------------------------------- the worker
@@ -462,14 +461,14 @@ class RemoteModule:
             for graph in self.graphs.get(signature, ()):
                 start = time.perf_counter()
                 try:
-                    value = graph.run(_reader(view, args))
+                    value = graph.run(view, args)
                 except replay.Miss as miss:
                     log.debug("reward module %s: %s: replay missed (%s)", self.path, fn, miss)
                     continue
                 finally:
                     self._timed(fn, time.perf_counter() - start)
                 count = self.replays[fn] = self.replays.get(fn, 0) + 1
-                if count % AUDIT_EVERY == 0:
+                if count % AUDIT_EVERY == 0 or count in AUDIT_AT:
                     self._audit(fn, env, args, info, value)
                 return value
         record = signature is not None and self.traces_left.get(fn, MAX_TRACES) > 0
@@ -520,9 +519,9 @@ class RemoteModule:
         arity = ARITY[fn]
         try:
             compiled = replay.compile_graph(graph, view.num_envs, torch.device(view.device),
-                                            lambda source: _check_source(source, arity))
+                                            lambda source: _source_reader(source, arity))
             start = time.perf_counter()
-            replayed = compiled.run(_reader(view, args))
+            replayed = compiled.run(view, args)
             self._timed(fn, time.perf_counter() - start)
         except (replay.GraphError, replay.Miss) as exc:
             log.debug("reward module %s: %s's recording is not replayed: %s", self.path, fn, exc)

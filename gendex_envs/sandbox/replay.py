@@ -228,22 +228,27 @@ class Graph:
     def __init__(self, steps: list, out, leaves: int, ops_count: int):
         self.steps, self._out, self.leaves, self.ops = steps, out, leaves, ops_count
 
-    def run(self, read_leaf: Callable[[list], torch.Tensor]):
-        """The function's value on the current state; ``read_leaf(source)`` reads an env member or argument entry.
+    def run(self, view, args: tuple):
+        """The function's value on the current state of ``view`` (the env's reward view) with the call's ``args``.
         Raises :class:`Miss` when the replay does not reproduce the recorded call."""
         vals: list = [None] * len(self.steps)
+        tensor = torch.Tensor
         try:
             for i, step in enumerate(self.steps):
-                if step[0] == 0:  # a leaf
-                    _, source, dtype, shape = step
-                    t = read_leaf(source)
-                    if not (isinstance(t, torch.Tensor) and t.dtype == dtype and t.shape == shape):
+                if step[0] == 0:  # a leaf: the real view's member or the argument's entry, copied
+                    _, read, dtype, shape, source = step
+                    t = read(view, args)
+                    if not (isinstance(t, tensor) and t.dtype == dtype and t.shape == shape):
                         raise Miss(f"leaf {source} is not {dtype} {list(shape)}")
                     vals[i] = t.clone()
                     continue
-                _, fn, args, kwargs, check = step
-                out = fn(*args(vals), **kwargs(vals))
-                check(out)
+                _, fn, bind_args, bind_kwargs, stated, check = step
+                out = fn(*bind_args(vals), **bind_kwargs(vals)) if bind_kwargs else fn(*bind_args(vals))
+                if stated is not None:
+                    if type(out) is not tensor or out.dtype != stated[0] or out.shape != stated[1]:
+                        raise Miss(f"a result is not {stated[0]} {list(stated[1])}")
+                else:
+                    check(out)
                 vals[i] = out
             return self._out(vals)
         except Miss:
@@ -306,9 +311,10 @@ def _spec(raw) -> tuple:
     raise GraphError(f"bad result spec {str(raw)[:100]}")
 
 
-def compile_graph(raw, num_envs: int, device, check_source: Callable[[list], None]) -> Graph:
+def compile_graph(raw, num_envs: int, device, source_reader: Callable[[list], Callable]) -> Graph:
     """``raw`` (a decoded graph from the worker) checked and bound to ``device``; raises :class:`GraphError`.
-    ``check_source(source)`` raises for a leaf source the parent would not read."""
+    ``source_reader(source)`` gives the function ``(view, args) -> tensor`` that reads a leaf's source, and raises
+    (``TypeError``/``ValueError``) for a source the parent would not read."""
     if not (isinstance(raw, dict) and isinstance(raw.get("entries"), list) and "out" in raw):
         raise GraphError("a graph is an object with entries and out")
     entries = raw["entries"]
@@ -329,12 +335,12 @@ def compile_graph(raw, num_envs: int, device, check_source: Callable[[list], Non
                 raise GraphError(f"bad leaf {str(entry)[:100]}")
             source = entry[1]
             try:
-                check_source(source)
+                read = source_reader(source)
             except (TypeError, ValueError) as exc:
                 raise GraphError(f"leaf {str(source)[:100]}: {exc}") from None
             dtype, shape = _dtype(entry[2]), _shape(entry[3])
             total += _elements(shape, node_cap)
-            parsed.append(("L", source, dtype, shape))
+            parsed.append(("L", source, dtype, shape, read))
             kinds.append(("T",))
             n_leaves += 1
             continue
@@ -375,14 +381,15 @@ def compile_graph(raw, num_envs: int, device, check_source: Callable[[list], Non
     steps: list = []
     for p in parsed:
         if p[0] == "L":
-            steps.append((0, p[1], p[2], torch.Size(p[3])))
+            steps.append((0, p[4], p[2], torch.Size(p[3]), p[1]))
             continue
         _, name, args, kwargs, kind, spec = p
+        stated = None
         if kind == "T":
-            spec = (spec[0], torch.Size(spec[1]))
+            spec = stated = (spec[0], torch.Size(spec[1]))
         elif kind == "S":
             spec = [(d, torch.Size(s)) for d, s in spec]
-        steps.append((1, ops.OPS[name], _binder(args, device), _binder(kwargs, device),
+        steps.append((1, ops.OPS[name], _binder(args, device), _binder(kwargs, device) if kwargs else None, stated,
                       _checker(kind, spec, decoder)))
     return Graph(steps, _binder(out, device), n_leaves, len(steps) - n_leaves)
 

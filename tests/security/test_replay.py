@@ -28,17 +28,30 @@ SLICE_P = ["O", "Tensor.__getitem__", ["$u", ["$r", 0, None], ["$u", ["$e"], ["$
 
 def _compile(entries, out=("$r", 1, None), arity=0, num_envs=1):
     raw = {"entries": entries, "out": list(out) if isinstance(out, tuple) else out}
-    return replay.compile_graph(raw, num_envs, torch.device("cpu"), lambda s: host._check_source(s, arity))
+    return replay.compile_graph(raw, num_envs, torch.device("cpu"), lambda s: _read(s, arity))
+
+
+def _read(source: list, arity: int):
+    host._source_reader(source, arity)  # the parent's own check of a source
+    return lambda view, args: view[tuple(source)]
+
+
+class _Values(dict):
+    """Stands for the view: leaf source -> tensor."""
 
 
 def _reader(values: dict):
-    return lambda source: values[tuple(source)]
+    return _Values(values)
+
+
+def _run(graph, view):
+    return graph.run(view, ())
 
 
 def test_a_valid_graph_compiles_and_replays():
     pose = torch.arange(7, dtype=torch.float32)[None]
     graph = _compile([LEAF, SLICE_P])
-    assert torch.equal(graph.run(_reader({("m", "obj_pose", "apple"): pose})), pose[..., :3])
+    assert torch.equal(_run(graph, _reader({("m", "obj_pose", "apple"): pose})), pose[..., :3])
 
 
 def _op(name, args=("$u", ["$r", 0, None]), kwargs=None, spec=("T", "float32", [1, 7])):
@@ -150,7 +163,7 @@ def test_in_place_operations_change_only_the_replays_own_copies():
                _op("Tensor.__setitem__", ("$u", ["$r", 2, None], 0, False), spec=("N",)),
                _op("Tensor.zero_", ("$u", ["$r", 0, None]))]
     graph = _compile(entries, out={"pose": ["$r", 4, None], "success": ["$r", 2, None]}, arity=1)
-    out = graph.run(_reader({("m", "obj_pose", "apple"): pose, ("a", 0, "success"): success}))
+    out = _run(graph, _reader({("m", "obj_pose", "apple"): pose, ("a", 0, "success"): success}))
     assert not out["success"].any() and not out["pose"].any()
     assert torch.equal(pose, keep_pose) and torch.equal(success, keep_success)
 
@@ -158,7 +171,7 @@ def test_in_place_operations_change_only_the_replays_own_copies():
 def test_a_constant_changed_in_place_is_fresh_in_the_next_replay():
     entries = [_op("Tensor.add_", ("$u", ["$c", torch.ones(3)], 1.0), spec=("T", "float32", [3]))]
     graph = _compile(entries, out=("$r", 0, None))
-    first, second = graph.run(_reader({})), graph.run(_reader({}))
+    first, second = _run(graph, _reader({})), _run(graph, _reader({}))
     assert torch.equal(first, torch.full((3,), 2.0)) and torch.equal(second, first)
 
 
@@ -168,10 +181,10 @@ def test_a_guard_or_leaf_that_comes_out_otherwise_is_a_miss():
                _op("Tensor.__bool__", ("$u", ["$r", 1, None]), spec=("V", True))]
     graph = _compile(entries, out=("$r", 0, None))
     with pytest.raises(replay.Miss, match="guard"):
-        graph.run(_reader({("m", "obj_pose", "apple"): pose}))
-    assert torch.equal(graph.run(_reader({("m", "obj_pose", "apple"): pose + 1})), pose + 1)
+        _run(graph, _reader({("m", "obj_pose", "apple"): pose}))
+    assert torch.equal(_run(graph, _reader({("m", "obj_pose", "apple"): pose + 1})), pose + 1)
     with pytest.raises(replay.Miss, match="leaf"):
-        graph.run(_reader({("m", "obj_pose", "apple"): torch.zeros(2, 7)}))
+        _run(graph, _reader({("m", "obj_pose", "apple"): torch.zeros(2, 7)}))
 
 
 # ---------------------------------------------------------------------------------------------- the whole path

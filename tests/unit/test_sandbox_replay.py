@@ -166,7 +166,7 @@ def test_a_module_that_differs_from_its_recording_is_caught_by_the_audit(env, tm
     path.write_text(STATEFUL)
     module = load_reward_module(path, trusted=False, static_check=False)
     remote = _remote(module)
-    values = [float(module.evaluate(env)["calls"][0]) for _ in range(host.AUDIT_EVERY + 5)]
+    values = [float(module.evaluate(env)["calls"][0]) for _ in range(host.AUDIT_AT[0] + 5)]
     assert remote.replay_off is not None and "differed" in remote.replay_off
     assert "its calls go to the worker" in caplog.text
     assert values[-4:] == [1.0] * 4  # the worker's values once the audit found it
