@@ -16,8 +16,9 @@ Run: ``.venv/bin/python benchmarks/step_rate.py [--steps 1000] [--repeats 3] [--
 
 ``--untrusted`` measures instead, in one run, ``env.step`` per second of the task as committed (trusted: its
 reward module runs in this process) and of an untrusted copy of the same folder under a temporary task root (its
-reward module runs in the sandbox's confined worker, :mod:`gendex_envs.sandbox`), interleaved, and their ratio
-(issue 43's goal: >= 0.85). Episode resets are not timed on either side.
+reward module runs in the sandbox: recorded by its confined worker, replayed in this process,
+:mod:`gendex_envs.sandbox`), interleaved in chunks of ``--chunk`` steps (the machine's speed drifts within seconds),
+and their ratio (issue 43's goal: >= 0.85). Episode resets are not timed on either side.
 """
 
 from __future__ import annotations
@@ -254,10 +255,18 @@ def untrusted_comparison(args) -> None:
             rates = {name: [] for name in sides}
             for sample, step, reset in sides.values():
                 timed_rate(sample, step, reset, args.warmup)
-            for r in range(args.repeats):  # interleaved, so slow drifts of the machine hit both sides
-                for name, (sample, step, reset) in sides.items():
-                    reset()
-                    rates[name].append(timed_rate(sample, step, reset, args.steps)[0])
+            for _, _, reset in sides.values():
+                reset()
+            for r in range(args.repeats):  # interleaved in chunks, so the machine's drifts hit both sides alike
+                busy = dict.fromkeys(sides, 0.0)
+                done = 0
+                while done < args.steps:
+                    n = min(args.chunk, args.steps - done)
+                    for name, (sample, step, reset) in sides.items():
+                        busy[name] += n / timed_rate(sample, step, reset, n)[0]
+                    done += n
+                for name in sides:
+                    rates[name].append(args.steps / busy[name])
                 print(f"  repeat {r + 1}: trusted {rates['trusted'][-1]:8.1f} /s   untrusted "
                       f"{rates['untrusted'][-1]:8.1f} /s   ratio {rates['untrusted'][-1] / rates['trusted'][-1]:.3f}")
             trusted, untrusted = statistics.median(rates["trusted"]), statistics.median(rates["untrusted"])
@@ -277,6 +286,7 @@ def main():
     ap.add_argument("--warmup", type=int, default=50)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--chunk", type=int, default=25, help="--untrusted: steps per side before switching sides")
     ap.add_argument("--torch-threads", type=int, default=None, help="torch.set_num_threads(N) (default: leave)")
     ap.add_argument("--untrusted", action="store_true",
                     help="compare the committed task with an untrusted copy of it (sandboxed reward code)")
