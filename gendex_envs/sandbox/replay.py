@@ -45,6 +45,8 @@ MAX_WORK_PER_ENV = 1 << 14
 """The work of a graph: the elements each operation reads and writes, summed over operations (an input used by many
 operations counts each time), weighted (:func:`_work`); at most this many per env and :data:`MAX_WORK` at
 least. A committed reward function's graph does about 3 000 per env."""
+MAX_CONST_BYTES = 1 << 20
+"""Constant tensors of one graph (module-level constants the call used; the recorder sends at most as much)."""
 MAX_PATH = 16
 _DTYPES = {**DTYPES, "complex64": torch.complex64, "complex128": torch.complex128}
 FORBIDDEN_KEYWORDS = frozenset({"out", "inplace"})
@@ -93,6 +95,7 @@ class _Decoder:
     def __init__(self, kinds: list):
         self.kinds = kinds  # per entry: ("T",) or ("S", n) or ("V",) / ("N",)
         self.refs = 0
+        self.const_bytes = 0
 
     def value(self, raw, depth: int = 0):
         kind = type(raw)
@@ -122,6 +125,9 @@ class _Decoder:
         if tag == "$c":
             if not (len(rest) == 1 and isinstance(rest[0], torch.Tensor)):
                 raise GraphError("bad constant tensor")
+            self.const_bytes += rest[0].numel() * rest[0].element_size()
+            if self.const_bytes > MAX_CONST_BYTES:
+                raise GraphError(f"more than {MAX_CONST_BYTES} bytes of constant tensors")
             return _Const(rest[0])
         if tag in ("$l", "$u"):
             items = [self.value(v, depth + 1) for v in rest]

@@ -96,6 +96,13 @@ def test_a_malformed_graph_is_refused(entries, out, match):
         _compile(entries, out=out)
 
 
+def test_constant_tensors_are_bounded():
+    big = ["$c", torch.zeros(replay.MAX_CONST_BYTES // 4 + 1)]
+    with pytest.raises(replay.GraphError, match="constant tensors"):
+        _compile([_op("Tensor.clone", ("$u", big), spec=("T", "float32", [replay.MAX_CONST_BYTES // 4 + 1]))],
+                 out=("$r", 0, None))
+
+
 def test_deep_nesting_is_refused():
     value = 1.0
     for _ in range(40):
