@@ -479,14 +479,16 @@ class RemoteModule:
             self._keep(fn, signature, graph, view, args, value)
         return value
 
-    def _remote(self, fn: str, env, view, args: tuple, info, steps, record: bool):
-        """``fn`` called in the worker: its value, and with ``record`` the graph the worker recorded (or None)."""
+    def _remote(self, fn: str, env, view, args: tuple, info, steps, record: bool, early: bool = True):
+        """``fn`` called in the worker: its value, and with ``record`` the graph the worker recorded (or None).
+        ``early``: a ``_get_obs_extra`` call may compute the reward too (not for recordings and audits, whose
+        values only check the replay's)."""
         if self.worker is None or not self.worker.alive():
             self._load()  # the worker died (a limit, another module's timeout): modules keep no state, reload
         worker = self.worker
         device = torch.device(view.device)
         then = (fn == "_get_obs_extra" and self.early_reward and info is not None and isinstance(steps, torch.Tensor)
-                and not record)
+                and not record and early)
         keys = dict(self.prefetch.setdefault(fn, {}))
         if then:
             keys.update(self.prefetch.setdefault("compute_dense_reward", {}))
@@ -548,7 +550,8 @@ class RemoteModule:
         from gendex_envs.reward_view import view_of
 
         u = getattr(env, "unwrapped", env)
-        worker_value, _ = self._remote(fn, env, view_of(env), args, info, getattr(u, "elapsed_steps", None), False)
+        worker_value, _ = self._remote(fn, env, view_of(env), args, info, getattr(u, "elapsed_steps", None), False,
+                                       early=False)
         if not agree(value, worker_value):
             self.replay_off = f"{fn}'s replay differed from the worker's call"
             self.graphs.clear()
