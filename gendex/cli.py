@@ -23,6 +23,7 @@ from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
 from gendex.cli_trust import trust_command
+from gendex_envs.registry import REFERENCE_TASKS
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="GenDex: generative simulation for dexterous hands (ShadowHand on UR10e, SAPIEN/ManiSkill3).")
@@ -514,8 +515,8 @@ def promote(runs: list[Path] = typer.Argument(..., help="Training run folders (g
 
 
 @app.command()
-def ablate(tasks: list[str] = typer.Option(["OpenCabinet", "PickUpBottle", "PutAppleBowl"], "--tasks",
-                                           help="Task names (latest version) or env ids."),
+def ablate(tasks: list[str] = typer.Option(list(REFERENCE_TASKS), "--tasks",
+                                           help="Task names (latest version) or env ids (default: reference tasks)."),
            budget: int = typer.Option(100_000, "--budget", min=1, help="PPO env steps per task and variant."),
            variants: list[str] = typer.Option(None, "--variant", help="Run only these (repeatable): no_subgoals, "
                                                                       "subgoals, frozen_dofs, mp_rl."),

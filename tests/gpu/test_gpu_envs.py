@@ -7,11 +7,13 @@ import gymnasium as gym
 import pytest
 import torch
 
+from gendex_envs.registry import REFERENCE_TASKS as REFERENCE_NAMES
+
 pytestmark = pytest.mark.gpu
 if not torch.cuda.is_available():
     pytest.skip("ManiSkill's GPU backend needs a CUDA device; none here", allow_module_level=True)
 
-REFERENCE_TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
+REFERENCE_TASKS = tuple(f"GenDex/{name}-v0" for name in REFERENCE_NAMES)  # version 0 of each reference task
 NUM_ENVS = 8
 
 

@@ -7,13 +7,11 @@ import json
 
 import pytest
 
+from gendex_envs.registry import REFERENCE_TASKS
 from gendex_envs.spec import TaskSpec, parse_task_spec, spec_to_dict
 from generator.critic.directives import apply_directives
 from generator.critic.physical import FALL_TOL_M, PENETRATION_TOL_M, apply_joint_fix
 from generator.critic.physical_sim import check_scene
-
-REFERENCE_TASKS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
-
 
 REFERENCE: dict[str, TaskSpec] = {}
 """Specs of the reference tasks' version 0, filled from the ``task_version`` fixture."""

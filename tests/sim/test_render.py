@@ -7,9 +7,10 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from gendex.cli import app
+from gendex_envs.registry import REFERENCE_TASKS as REFERENCE_NAMES
 from gendex_envs.task_env import VIEW_CAMERAS
 
-REFERENCE_TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
+REFERENCE_TASKS = tuple(f"GenDex/{name}-v0" for name in REFERENCE_NAMES)  # version 0 of each reference task
 
 
 def _seg_ids(entity) -> set[int]:

@@ -5,10 +5,11 @@ import pytest
 import torch
 from gymnasium.utils.env_checker import check_env
 
+from gendex_envs.registry import REFERENCE_TASKS as REFERENCE_NAMES
 from gendex_envs.registry import registered_tasks
 from gendex_envs.success import conditions_hold
 
-REFERENCE_TASKS = ("GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0")
+REFERENCE_TASKS = tuple(f"GenDex/{name}-v0" for name in REFERENCE_NAMES)  # version 0 of each reference task
 
 
 def test_reference_tasks_are_registered():

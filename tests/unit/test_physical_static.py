@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from gendex_envs.registry import REFERENCE_TASKS
 from gendex_envs.spec import (
     SCALE_RANGE,
     TaskSpec,
@@ -23,9 +24,6 @@ from generator.critic.physical import (
     check_scene_static,
 )
 from generator.errors import DirectiveError
-
-REFERENCE_TASKS = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
-
 
 REFERENCE: dict[str, TaskSpec] = {}
 """Specs of the reference tasks' version 0, filled from the ``task_version`` fixture."""

@@ -4,14 +4,14 @@ import gymnasium as gym
 import pytest
 
 from gendex_envs.errors import DuplicateTaskError, RewardModuleError, TaskNotFoundError, TaskSpecError
-from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks, register_tasks, resolve_task
+from gendex_envs.registry import REFERENCE_TASKS, REPO_TASKS_DIR, discover_tasks, register_tasks, resolve_task
 from gendex_envs.reward_module import load_reward_module
 from gendex_envs.task_version import TaskLayout
 
 
 def test_reference_tasks_are_discovered_with_versions(task_version):
     found = discover_tasks([REPO_TASKS_DIR])
-    assert {"GenDex/OpenCabinet-v0", "GenDex/PickUpBottle-v0", "GenDex/PutAppleBowl-v0"} <= set(found)
+    assert {f"GenDex/{name}-v0" for name in REFERENCE_TASKS} <= set(found)
     version = found["GenDex/PutAppleBowl-v0"]
     assert version.name == "PutAppleBowl" and version.version == 0
     assert version == task_version("PutAppleBowl", 0)
