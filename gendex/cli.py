@@ -172,9 +172,10 @@ def tasks_doc(out: Path = typer.Option(Path("docs/tasks.md"), "--out", help="The
 def _save_png(rgb, path: Path) -> Path:
     from PIL import Image
 
-    tmp = path.with_suffix(".tmp.png")
-    Image.fromarray(rgb).save(tmp)
-    tmp.replace(path)  # never leave a half-written PNG behind
+    from gendex_envs.atomic_io import atomic_path
+
+    with atomic_path(path) as tmp:  # never leave a half-written PNG behind
+        Image.fromarray(rgb).save(tmp)
     return path
 
 

@@ -100,6 +100,7 @@ def leaderboard_add(result: Path = typer.Argument(..., help="A gendex eval resul
 
     from gendex.eval.leaderboard import LEADERBOARD_DIR, load_entries
     from gendex.eval.suite import SUITES_DIR
+    from gendex_envs.atomic_io import write_json
     from gendex_envs.errors import GenDexError
 
     path = result / "eval_info.json" if result.is_dir() else result
@@ -113,10 +114,7 @@ def leaderboard_add(result: Path = typer.Argument(..., help="A gendex eval resul
                  "training_data": training_data, "date": date or datetime.date.today().isoformat(),
                  "policy": info["policy"], "notes": notes, "eval_info": info}
         dest = LEADERBOARD_DIR / suite / (re.sub(r"[^a-z0-9]+", "-", method.lower()).strip("-") + ".json")
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        tmp = dest.with_name(f".{dest.name}.tmp")
-        tmp.write_text(json.dumps(entry, indent=1) + "\n")
-        tmp.replace(dest)
+        write_json(dest, entry, indent=1)
         try:
             load_entries(suite)
         except GenDexError:

@@ -11,6 +11,7 @@ from PIL import Image
 from tqdm import tqdm
 
 from gendex_envs.assets.catalog import AssetRecord, catalog
+from gendex_envs.atomic_io import atomic_path, write_text
 from gendex_envs.spec import parse_task_spec
 
 log = logging.getLogger(__name__)
@@ -65,9 +66,8 @@ def render_gallery(out: Path, size: int = 256) -> Path:
     rows = []
     for record in tqdm(records, desc="gallery", unit="asset"):
         png = out / f"{record.id}.png"
-        tmp = png.with_suffix(".tmp.png")
-        Image.fromarray(render_thumbnail(record, size)).save(tmp)
-        tmp.replace(png)
+        with atomic_path(png) as tmp:
+            Image.fromarray(render_thumbnail(record, size)).save(tmp)
         size_cm = " × ".join(f"{100 * v:.1f}" for v in record.size_m)
         joints = ", ".join(f"{j.name} ({j.type})" for j in record.joints) or "—"
         rows.append(f"| ![{record.id}]({out.name}/{png.name}) | `{record.id}` | {record.category} | {size_cm} | "
@@ -82,7 +82,5 @@ def render_gallery(out: Path, size: int = 256) -> Path:
         "| view | id | category | size cm (x × y × z) | mass kg | joints | tags | licence |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    tmp = index.with_suffix(".tmp")
-    tmp.write_text("\n".join(header + rows) + "\n")
-    tmp.replace(index)
+    write_text(index, "\n".join(header + rows) + "\n")
     return index

@@ -50,6 +50,7 @@ import yaml
 
 from gendex.data.episode import EpisodeError
 from gendex.fanout import Backend, session
+from gendex_envs.atomic_io import atomic_dir, write_text
 from gendex_envs.typed_yaml import load_yaml_bounded, parse_json_bounded, quote
 
 log = logging.getLogger(__name__)
@@ -156,9 +157,7 @@ def save_manifest(m: DatasetManifest, path: Path) -> None:
     header = (f"# GenDex dataset manifest: `gendex dataset build {m.name}` collects it, `gendex dataset verify`\n"
               "# checks a copy against the checksums (written by `gendex dataset build --record`). See\n"
               "# docs/datasets.md.\n")
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(header + yaml.safe_dump(raw, sort_keys=False, width=110))
-    tmp.replace(path)
+    write_text(path, header + yaml.safe_dump(raw, sort_keys=False, width=110))
 
 
 # --------------------------------------------------------------------------------------------- checksums
@@ -310,12 +309,9 @@ class FolderRemote:
 
     def push(self, root: Path, repo_id: str, tags: tuple[str, ...]) -> str:
         dest = self._repo(repo_id)
-        tmp = dest.with_name(f".{dest.name}.tmp")
-        shutil.rmtree(tmp, ignore_errors=True)
-        shutil.copytree(root, tmp)
-        (tmp / ".tags").write_text("\n".join(tags) + "\n")
-        shutil.rmtree(dest, ignore_errors=True)
-        tmp.replace(dest)
+        with atomic_dir(dest, replace=True) as tmp:
+            shutil.copytree(root, tmp, dirs_exist_ok=True)
+            (tmp / ".tags").write_text("\n".join(tags) + "\n")
         return str(dest)
 
     def pull(self, repo_id: str, out: Path) -> Path:

@@ -39,6 +39,7 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from gendex.data.episode import Episode, EpisodeError
+from gendex_envs.atomic_io import write_text
 from gendex_envs.video import CODECS, PIX_FMT, encode
 
 log = logging.getLogger(__name__)
@@ -531,8 +532,4 @@ by column in `meta/info.json`. `LeRobotObservation` returns exactly these featur
 ## Dataset structure
 
 {structure}"""
-    root.mkdir(parents=True, exist_ok=True)
-    path = root / "README.md"
-    _tmp(path).write_text(text, encoding="utf-8")
-    os.replace(_tmp(path), path)
-    return path
+    return write_text(root / "README.md", text, encoding="utf-8")

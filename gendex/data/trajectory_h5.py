@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 from pathlib import Path
 
 import h5py
@@ -30,6 +29,7 @@ import numpy as np
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.rollout import ReplayError, ReplayResult, replay_rollout
+from gendex_envs.atomic_io import write_text
 
 __all__ = ["ReplayError", "ReplayResult", "TrajectoryFileError", "TrajectoryWriter", "load_trajectory_json",
            "replay_episode", "replay_file", "trajectory_paths"]
@@ -140,13 +140,7 @@ class TrajectoryWriter:
             return {k: int(g[k].shape[-1]) for k in ("actions", "obs", "env_states")}
 
     def _write_json(self):
-        text = _to_json(self._json, str(self.json_path))
-        tmp = self.json_path.with_name(f".{self.json_path.name}.{os.getpid()}.tmp")
-        with open(tmp, "w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, self.json_path)
+        write_text(self.json_path, _to_json(self._json, str(self.json_path)), fsync=True)
 
     # ------------------------------------------------------------------ writing
     def _check(self, ep: Episode) -> dict[str, np.ndarray]:

@@ -36,6 +36,7 @@ from gymnasium.envs.registration import parse_env_id
 from torch import nn
 
 from gendex.imitation.frames import DatasetReadError, Frames, lerobot_root, load_frames
+from gendex_envs.atomic_io import atomic_path
 from gendex_envs.errors import GenDexError, PolicyError
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 from gendex_envs.saved_tensors import check_tensor_sizes
@@ -225,9 +226,8 @@ def save_checkpoint(path: Path | str, weights: dict, norm: dict, info: dict) -> 
     ckpt = {"format": CHECKPOINT_FORMAT, "model": {k: v.detach().cpu() for k, v in weights.items()},
             **{k: torch.as_tensor(np.asarray(norm[k], np.float32)) for k in _NORMS}, **info}
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp")
-    torch.save(ckpt, tmp)
-    tmp.replace(path)
+    with atomic_path(path) as tmp:
+        torch.save(ckpt, tmp)
     return path
 
 

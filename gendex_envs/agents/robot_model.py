@@ -18,12 +18,13 @@ import hashlib
 import logging
 import os
 import shutil
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+
+from gendex_envs.atomic_io import atomic_dir
 
 log = logging.getLogger(__name__)
 
@@ -304,18 +305,12 @@ def robot_urdf_path() -> Path:
     urdf = target / "ur10e_shadow.urdf"
     if urdf.is_file():
         return urdf
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=".building-", dir=target.parent))
     try:
-        (tmp / "ur10e_shadow.urdf").write_text(build_urdf_text(tmp))
-        # the MJCF's header: "LICENSE.md must be kept together with this file"
-        shutil.copy(shadow_hand_mjcf_path().parent.parent / "LICENSE.md", tmp / "SHADOW_HAND_LICENSE.md")
-        try:
-            tmp.rename(target)
-            log.info("built robot model %s", target)
-        except OSError:  # another process won the race; its copy is identical
-            shutil.rmtree(tmp, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        with atomic_dir(target) as tmp:
+            (tmp / "ur10e_shadow.urdf").write_text(build_urdf_text(tmp))
+            # the MJCF's header: "LICENSE.md must be kept together with this file"
+            shutil.copy(shadow_hand_mjcf_path().parent.parent / "LICENSE.md", tmp / "SHADOW_HAND_LICENSE.md")
+        log.info("built robot model %s", target)
+    except FileExistsError:  # another process won the race; its copy is identical
+        pass
     return urdf

@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import json
 import logging
-import os
-import tempfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Literal
 
 import dacite
 
+from gendex_envs.atomic_io import write_json
 from gendex_envs.errors import AssetNotFoundError
 
 log = logging.getLogger(__name__)
@@ -115,14 +114,8 @@ def read_manifest(path: Path) -> list[AssetEntry]:
 
 def write_manifest(path: Path, entries: list[AssetEntry], note: str = "") -> None:
     """Write entries atomically (temp file, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     payload = {"note": note, "assets": [asdict(e) for e in sorted(entries, key=lambda e: e.id)]}
-    fd, tmp = tempfile.mkstemp(prefix=".manifest-", dir=path.parent)
-    with os.fdopen(fd, "w") as f:
-        json.dump(payload, f, indent=1)
-        f.write("\n")
-    os.replace(tmp, path)
+    write_json(path, payload, indent=1)
 
 
 def shipped_manifests() -> list[Path]:
