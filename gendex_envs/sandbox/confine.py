@@ -156,10 +156,15 @@ def load_seccomp():
     return pyseccomp
 
 
-def seccomp(sc) -> list[str]:
+def seccomp(sc, *, settable_limit: int | None = None) -> list[str]:
     """Load the filter: default allow (Landlock covers files), :data:`DENIED_SYSCALLS` fail with EPERM, ``clone``
     only with CLONE_THREAD (threads, no processes), ``kill``, ``tgkill``, ``rt_sigqueueinfo`` and
-    ``rt_tgsigqueueinfo`` only to this process, ``prlimit64`` only to read limits. ``sc``: :func:`load_seccomp`."""
+    ``rt_tgsigqueueinfo`` only to this process, ``prlimit64`` only to read limits. ``sc``: :func:`load_seccomp`.
+
+    ``settable_limit`` (the reward probe's child, which moves its own ``RLIMIT_CPU`` soft limit before each
+    candidate): that one resource stays settable by this process on itself (``prlimit64(0, resource, new, ...)``,
+    what glibc's ``setrlimit`` makes); within its hard limit, as always for a process without capabilities. The
+    worker passes nothing: its filter is unchanged."""
     pid = os.getpid()
     deny = sc.ERRNO(errno.EPERM)
     f = sc.SyscallFilter(sc.ALLOW)
@@ -175,7 +180,11 @@ def seccomp(sc) -> list[str]:
     # queued signals to another process: Landlock's signal scope (ABI >= 6) refuses them too, older kernels do not
     f.add_rule(deny, "rt_sigqueueinfo", sc.Arg(0, sc.NE, pid))
     f.add_rule(deny, "rt_tgsigqueueinfo", sc.Arg(0, sc.NE, pid))
-    f.add_rule(deny, "prlimit64", sc.Arg(2, sc.NE, 0))
+    if settable_limit is None:
+        f.add_rule(deny, "prlimit64", sc.Arg(2, sc.NE, 0))
+    else:  # a new limit only for this process (pid 0) and only for that resource
+        f.add_rule(deny, "prlimit64", sc.Arg(2, sc.NE, 0), sc.Arg(0, sc.NE, 0))
+        f.add_rule(deny, "prlimit64", sc.Arg(2, sc.NE, 0), sc.Arg(1, sc.NE, settable_limit))
     try:
         f.load()
     except OSError as exc:
@@ -193,6 +202,12 @@ def rlimits(memory_bytes: int = MEMORY_LIMIT_BYTES, cpu_s: int = CPU_LIMIT_S,
         resource.setrlimit(res, (value, value))
     return [f"rlimits: address space {memory_bytes >> 20} MiB, CPU {cpu_s} s, file size 0, {open_files} files, "
             f"no core"]
+
+
+def not_dumpable() -> None:
+    """``PR_SET_DUMPABLE`` 0: no core dumps, no ptrace attach by the user's other processes (what :func:`confine`
+    does first; public for the reward probe's child, which raises its own walls)."""
+    _check(_libc.prctl(PR_SET_DUMPABLE, 0, 0, 0, 0), "prctl(PR_SET_DUMPABLE)")
 
 
 def drop_capabilities() -> None:
