@@ -14,6 +14,10 @@ Process hygiene: nothing the probe starts or writes may outlive the parent, even
 * The child dies with its parent: it asks the kernel for ``SIGKILL`` at the parent's death (``PR_SET_PDEATHSIG``)
   before it imports anything untrusted, and checks right after that its parent is still the one named in the job
   (the parent may have died before the ``prctl``). Without ``prctl`` (not Linux) a thread polls ``os.getppid``.
+* The child raises the sandbox worker's kernel walls around itself before the first candidate (Landlock, seccomp,
+  no privileges; :func:`generator.steps.probe_child._confine`): a candidate past the static check and the runtime
+  guard still writes, connects and spawns nothing. Where the system cannot raise them, the probe raises
+  :class:`~gendex_envs.errors.RewardSandboxError` unless ``GENDEX_IN_PROCESS_GUARD=1``.
 * The child limits its own CPU time (``RLIMIT_CPU``, budgets computed here from the job: ``startup_timeout_s`` and
   ``timeout_s`` per module, times :data:`CPU_MARGIN`), so a hung module is ended by the kernel even when no parent
   watches it; the parent reports such a death as "exceeded its CPU budget of N s".
@@ -66,6 +70,11 @@ MAX_FILE_MB = 256
 _POLL_S = 0.05
 _REAPER_WAIT_S = 5.0
 _STACK_WAIT_S = 2.0
+FIRST_WALL_DOWN_FOR_TESTS = False
+"""Tests only (``tests/security/test_probe_confinement.py``): the child loads every candidate as if the first wall
+had a hole (no static check, Python's ordinary builtins, neither the runtime guard's audit hook nor the probe's
+own), so that a test reaches the kernel's walls behind it. No parameter, job option of a caller or file of a task
+folder sets it; only code running in this process can."""
 _FRAME_RE = re.compile(r'File "(?P<file>[^"]+)", line (?P<line>\d+) in (?P<fn>\S+)')
 
 
@@ -202,6 +211,8 @@ def _setup_error(task_dir: Path, record: dict) -> GenDexError:
     import gendex_envs.errors as gerr
 
     cls = getattr(gerr, record.get("type", ""), None)
+    if cls is gerr.RewardSandboxError:  # the child cannot be confined: it refused to run any candidate
+        return cls(f"the reward probe did not probe the candidates of {task_dir}: {record.get('message')}")
     text = f"the reward probe could not build the env of {task_dir}: {record.get('type')}: {record.get('message')}"
     if isinstance(cls, type) and issubclass(cls, GenDexError):
         return cls(text)
@@ -227,12 +238,14 @@ class _Child:
                     "memory_limit_mb": memory_limit_mb, "stop_on_error": stop_on_error, "check_static": check_static,
                     "progress": str(self.progress_path), "parent_pid": os.getpid(),
                     "cpu_startup_s": self.cpu_startup_s, "cpu_module_s": self.cpu_module_s,
-                    "max_file_mb": MAX_FILE_MB}
+                    "max_file_mb": MAX_FILE_MB, "first_wall_down_for_tests": bool(FIRST_WALL_DOWN_FOR_TESTS)}
         self.results: dict[int, ProbeReport | RewardCodeError] = {}
         self.current: int | None = None
         self.started_at = 0.0
         self.last_call: tuple[str | None, int | None] = (None, None)
         self.ready = False
+        self.walls: list[str] = []
+        """The kernel walls the child raised before the first candidate (its ``ready`` event)."""
         self.baseline_rss_kb = 0
         self.cpu_seen_s = 0.0
         self.cpu_at_module_s = 0.0
@@ -337,6 +350,13 @@ class _Child:
         if kind == "ready":
             self.ready = True
             self.baseline_rss_kb = int(ev.get("rss_kb", 0))
+            self.walls = [str(w)[:300] for w in ev.get("walls") or []][:20]
+            if ev.get("unconfined"):
+                log.warning("reward probe: the child for %s runs the candidates unconfined (%s); walls: %s",
+                            self.task_dir, str(ev["unconfined"])[:500], "; ".join(self.walls) or "none")
+            else:
+                log.info("reward probe: the child for %s is confined in %s ms; walls: %s", self.task_dir,
+                         ev.get("confine_ms"), "; ".join(self.walls))
         elif kind == "module":
             self.current = int(ev["i"])
             self.started_at = time.monotonic()
@@ -481,7 +501,8 @@ def probe_modules(task_dir: Path, modules: list[Path], *, steps: int, timeout_s:
     """Probe ``modules`` in as few processes as possible (a new one only after a module was killed).
 
     The child loads every module as untrusted: statically checked again (unless ``check_static`` is False) and run
-    under the runtime guard (:mod:`gendex_envs.guard`), whichever folder it is in.
+    under the runtime guard (:mod:`gendex_envs.guard`), whichever folder it is in, behind the kernel walls the child
+    raises around itself first (:func:`generator.steps.probe_child._confine`).
 
     Returns one entry per module: its report, its error, or None when ``stop_on_error`` left it unprobed.
     ``module_cpu_s`` is the CPU time a module may use before the child's own limit ends it (default

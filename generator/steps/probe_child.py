@@ -4,13 +4,15 @@
 swaps it in (wrapped so that every call is checked), resets with the job's seed and steps seeded random actions.
 It reports JSON lines to the job's ``progress`` file, one object per line (``ev`` says which):
 
-* ``{"ev": "ready", "rss_kb": int}``: the env is built.
+* ``{"ev": "ready", "rss_kb": int, "cpu_s": float, "walls": [str], "unconfined": str | None, "confine_ms": float}``:
+  the env is built and the kernel walls are up (``walls``; ``unconfined`` says why not, under an opt-out).
 * ``{"ev": "module", "i": int}``: module ``i`` starts (the parent's per-module time limit starts here).
 * ``{"ev": "call", "i": int, "fn": str, "step": int}``: a reward function is about to run (step 0 is the reset).
 * ``{"ev": "result", "i": int, "ok": true, "report": {...}}`` or ``{..., "ok": false, "error": {...}}`` where
   ``error`` is ``{"kind", "fn", "step", "message"}``; ``kind`` is ``violation`` (wrong output), ``exception``,
   ``import``, ``audit`` (file/process/network access) or ``env`` (the env failed outside reward code).
-* ``{"ev": "setup_error", "type": str, "message": str}``: the env could not be built.
+* ``{"ev": "setup_error", "type": str, "message": str}``: the env could not be built, or (``RewardSandboxError``)
+  this system cannot confine this process and no opt-out is set (:data:`OPT_OUT_ENVS`).
 * ``{"ev": "done"}``.
 
 The checks are batched tensor operations (no per-env Python loops), so they work on the GPU backend as well.
@@ -24,6 +26,9 @@ Process hygiene does not depend on the parent staying alive or responsive (see :
 * it limits its own CPU time (``RLIMIT_CPU``; the job's budgets): a hung module gets ``SIGXCPU`` (stack dumped,
   then the default action ends the process) even when nobody watches it; no core files (``RLIMIT_CORE`` 0) and
   no file larger than the job's ``max_file_mb`` (``RLIMIT_FSIZE``);
+* once the env is built, before the first candidate is read, it raises the kernel walls of the sandbox's worker
+  around itself (:func:`_confine`: no privileges, Landlock, seccomp), and refuses to run candidates where it
+  cannot (``docs/security.md``, Isolation);
 * ``python -m generator.steps.probe_child --reaper WORKDIR`` is the reaper the parent starts next to each child: it
   reads child process-group ids from stdin, a pipe whose write end only the parent holds, and exits at ``done``;
   at end of file without ``done`` the parent died, so it kills the groups and removes ``WORKDIR``.
@@ -316,7 +321,8 @@ def _limit_before_untrusted_code(job: dict) -> None:
     Not set: ``RLIMIT_AS`` (torch, SAPIEN and the CUDA runtime reserve far more virtual address space than they use,
     so an address-space cap breaks them; ``RLIMIT_DATA`` bounds heap growth instead, see :func:`main`) and
     ``RLIMIT_NPROC`` (it counts every process and thread of the user, machine-wide, so any useful value would break
-    thread pools and other work of the same user; spawning is refused by the audit hook instead).
+    thread pools and other work of the same user; spawning is refused by the audit hook and the seccomp filter
+    instead).
     """
     max_file_mb = job.get("max_file_mb")
     if max_file_mb:
@@ -331,6 +337,92 @@ def _limit_module_cpu(job: dict) -> None:
     module = job.get("cpu_module_s")
     if module:
         _set_cpu_limit(_cpu_used_s() + float(module))
+
+
+# ------------------------------------------------------------------ kernel walls
+OPT_OUT_ENVS = ("GENDEX_IN_PROCESS_GUARD", "GENDEX_TRUST_REMOTE_CODE")
+"""Either set to 1 in the parent's environment lets the candidates run unconfined where this system cannot confine
+this process: the opt-outs of the sandbox's worker (the runtime guard alone; all code trusted). Without one such a
+system refuses to probe."""
+
+
+def _opted_out() -> str | None:
+    """The first :data:`OPT_OUT_ENVS` variable set (read before :func:`main` sets its own guard variable)."""
+    for name in OPT_OUT_ENVS:
+        if os.environ.get(name, "").strip().lower() in ("1", "true", "yes"):
+            return name
+    return None
+
+
+def _unconfinable(exc: Exception) -> str:
+    return (f"the reward probe runs model-written reward code only in a confined child process, and this system "
+            f"cannot confine one: {exc}. GENDEX_IN_PROCESS_GUARD=1 probes the candidates under the weaker runtime "
+            f"guard only; GENDEX_TRUST_REMOTE_CODE=1 trusts all code")
+
+
+def _confinement_tools():
+    """``(pyseccomp, Landlock ABI)``, loaded before the env is built, so that a system that cannot confine fails at
+    once (and finding libseccomp runs ``ldconfig``, which the walls refuse). Raises
+    :class:`~gendex_envs.sandbox.confine.ConfinementError` naming what is missing."""
+    from gendex_envs.sandbox import confine
+
+    if not sys.platform.startswith("linux"):
+        raise confine.ConfinementError(f"Landlock and seccomp are Linux's; this is {sys.platform}")
+    sc = confine.load_seccomp()
+    abi = confine.landlock_abi()
+    if abi < 1:
+        raise confine.ConfinementError("Landlock is not available (Linux >= 5.13 with Landlock enabled is needed)")
+    return sc, abi
+
+
+def _candidate_files(job: dict) -> list[str]:
+    """The candidates' files as :func:`~gendex_envs.reward_module.load_reward_module` names them (folder resolved,
+    the name not followed); links are left out: that loader refuses them, and a rule would open their target."""
+    files = []
+    for module in job["modules"]:
+        named = Path(module).absolute()
+        path = named.parent.resolve() / named.name
+        if path.is_file() and not path.is_symlink():
+            files.append(str(path))
+    return files
+
+
+def _confine(job: dict, tools, walls: list[str]) -> None:
+    """Raise the kernel walls of the sandbox's worker (:mod:`gendex_envs.sandbox.confine`) around this process, once
+    the env is built and before any candidate is read, appending each to ``walls``; irreversible.
+
+    * not dumpable, no new privileges, no capabilities (a child of root keeps uid 0 but none of its powers);
+    * Landlock: read files only under :func:`~gendex_envs.sandbox.confine.readable_roots` (the Python installation,
+      the system libraries), the ``gendex_envs`` package (what candidates import from it, ``reward_terms``, and the
+      source lines of tracebacks) and the candidate module files themselves (not their folders); write, create,
+      delete or execute nothing anywhere; no TCP bind or connect (ABI >= 4), no signals out, no abstract unix
+      sockets (ABI >= 6). Landlock judges a file when it is opened: the progress file and the log, opened before,
+      stay writable;
+    * seccomp: the worker's filter (no exec, fork, sockets, ptrace...; threads stay allowed), except that this
+      process may still move its own ``RLIMIT_CPU`` soft limit (:func:`_limit_module_cpu`, within the hard limit).
+
+    Not the worker's rlimits: this process keeps its own (its CPU budgets, ``RLIMIT_FSIZE`` for its progress file,
+    ``RLIMIT_DATA``).
+    """
+    from gendex_envs.sandbox import confine
+
+    sc, abi = tools
+    confine.not_dumpable()
+    walls.append("not dumpable")
+    candidates = _candidate_files(job)
+    package = str(Path(confine.__file__).resolve().parents[1])  # gendex_envs/
+    landlock = confine.landlock([*confine.readable_roots(), package, *candidates], abi)  # sets no_new_privs first
+    walls.append("no new privileges")
+    walls.append(f"landlock: files read-only under the Python installation, the system libraries, the gendex_envs "
+                 f"package and the {len(candidates)} candidate module files; no write anywhere (the progress file "
+                 f"was opened before)")
+    walls += landlock[1:]
+    if os.geteuid() == 0 or os.getuid() == 0:
+        confine.drop_capabilities()  # before the filter, which denies capset
+        walls.append("capabilities: none")
+    confine.seccomp(sc, settable_limit=resource.RLIMIT_CPU)
+    walls.append("seccomp: no exec, fork, sockets, ptrace, mounts, bpf, keys, signals to others or new limits "
+                 "(but its own CPU soft limit)")
 
 
 def reap(workdir: str, stream=None) -> int:
@@ -365,6 +457,8 @@ def reap(workdir: str, stream=None) -> int:
 
 
 class _Progress:
+    """The JSON-lines progress file; opened before the kernel walls, which refuse every later open for writing."""
+
     def __init__(self, path: str):
         self.f = open(path, "a", buffering=1, encoding="utf-8")
 
@@ -398,7 +492,7 @@ def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
         # model code, wherever its folder is: statically checked (unless the job says not to) and guarded, unless
         # the user trusts all code (GENDEX_TRUST_REMOTE_CODE=1); this process's own audit fence applies either way
         module = load_reward_module(path, trusted=guard.trusts_everything(),
-                                    static_check=job.get("check_static", True))
+                                    static_check=job.get("check_static", True) and not _first_wall_down(job))
     except Exception as exc:
         cause = exc.__cause__ or exc
         text = _exception_text(cause, path) if exc.__cause__ else f"{type(exc).__name__}: {exc}"
@@ -439,11 +533,29 @@ def _probe_module(env, job: dict, index: int, progress: _Progress) -> dict:
     return {"ev": "result", "i": index, "ok": True, "report": checked.report(display, time.monotonic() - t0)}
 
 
+def _first_wall_down(job: dict) -> bool:
+    """Tests only (:data:`generator.steps.probe.FIRST_WALL_DOWN_FOR_TESTS`, set in the parent's process): load the
+    candidates as if the first wall had a hole, to test the kernel's walls behind it."""
+    return job.get("first_wall_down_for_tests") is True
+
+
+def _take_first_wall_down() -> None:
+    """No restricted builtins and no runtime guard's audit hook for the candidates (the probe's own hook is not
+    installed either: :func:`main`)."""
+    import builtins
+
+    from gendex_envs import guard
+
+    guard.restricted_builtins = lambda: dict(vars(builtins))
+    guard.untrust = lambda folder: None
+
+
 def main(argv: list[str]) -> int:
     if argv[:1] == ["--reaper"]:
         return reap(argv[1])
     job = json.loads(Path(argv[0]).read_text(encoding="utf-8"))
     _die_with_parent(job.get("parent_pid"))  # first: before any simulator, reward code or audit hook
+    opted_out = _opted_out()  # the parent's environment, before the next line sets this process's own
     # this process is the probe's own boundary (its CPU budgets, memory and file limits, audit hook, reaper): the
     # candidates run here, in-process, so that those budgets measure them (not gendex_envs.sandbox's worker)
     os.environ["GENDEX_IN_PROCESS_GUARD"] = "1"
@@ -452,6 +564,14 @@ def main(argv: list[str]) -> int:
     _limit_startup(job)
     progress = _Progress(job["progress"])
     logging.basicConfig(level=logging.WARNING, stream=sys.stderr)
+    unconfined = None
+    try:
+        tools = _confinement_tools()
+    except Exception as exc:  # ConfinementError; anything else a broken libseccomp raises, too
+        if opted_out is None:
+            progress.emit(ev="setup_error", type="RewardSandboxError", message=_unconfinable(exc))
+            return 2
+        tools, unconfined = None, f"{opted_out}=1 and this system cannot confine it: {exc}"
     try:
         import torch
 
@@ -478,8 +598,27 @@ def main(argv: list[str]) -> int:
         resource.setrlimit(resource.RLIMIT_DATA, (limit if hard == resource.RLIM_INFINITY else min(limit, hard),
                                                   hard))
     _limit_before_untrusted_code(job)
-    sys.addaudithook(_Audit.hook)
-    progress.emit(ev="ready", rss_kb=_vm_kb("VmRSS"), cpu_s=round(_cpu_used_s(), 3))
+    rss_kb = _vm_kb("VmRSS")  # /proc: read before the walls
+    walls: list[str] = []
+    t0 = time.perf_counter()
+    if tools is not None:
+        try:
+            _confine(job, tools, walls)
+        except Exception as exc:  # ConfinementError: a wall the kernel refused; the earlier ones stay up
+            if opted_out is None:
+                progress.emit(ev="setup_error", type="RewardSandboxError", message=_unconfinable(exc))
+                return 2
+            unconfined = f"{opted_out}=1 and this system cannot confine it: {exc}"
+    confine_ms = round((time.perf_counter() - t0) * 1000, 1)
+    if unconfined:
+        log.warning("the reward probe's child runs the candidates unconfined (%s); walls: %s", unconfined,
+                    "; ".join(walls) or "none")
+    if _first_wall_down(job):
+        _take_first_wall_down()
+    else:
+        sys.addaudithook(_Audit.hook)
+    progress.emit(ev="ready", rss_kb=rss_kb, cpu_s=round(_cpu_used_s(), 3), walls=walls, unconfined=unconfined,
+                  confine_ms=confine_ms)
     for index in range(len(job["modules"])):
         _limit_module_cpu(job)
         result = _probe_module(env, job, index, progress)
