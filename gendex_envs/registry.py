@@ -29,6 +29,7 @@ import gymnasium as gym
 from gymnasium.envs.registration import WrapperSpec, find_highest_version, parse_env_id
 
 from gendex_envs.errors import DuplicateTaskError, TaskNotFoundError, TaskSpecError, suggest
+from gendex_envs.library import library_dir
 from gendex_envs.spec import TASK_NAME_RE
 from gendex_envs.task_version import NAMESPACE, TaskVersion, versions_in
 
@@ -38,7 +39,9 @@ TASKS_PATH_ENV = "GENDEX_TASKS_PATH"
 ALLOW_OVERRIDE_ENV = "GENDEX_ALLOW_OVERRIDE"
 """``GENDEX_ALLOW_OVERRIDE=1``: folders on ``$GENDEX_TASKS_PATH`` may replace committed task ids (read as
 ``GENDEX_TRUST_REMOTE_CODE`` is: 1, true or yes)."""
-REPO_TASKS_DIR = Path(__file__).resolve().parent.parent / "generated_tasks"
+REPO_TASKS_DIR = library_dir("generated_tasks")
+"""The committed library: the checkout's ``generated_tasks/``, or the one an installed wheel ships
+(:mod:`gendex_envs.library`)."""
 GYM_API_WRAPPER = WrapperSpec(name="GymApi", entry_point="gendex_envs.wrappers:GymApi", kwargs={})
 
 

@@ -16,9 +16,10 @@ import jinja2
 import jinja2.meta
 import yaml
 
+from gendex_envs.library import library_dir
 from generator.errors import PromptError
 
-PROMPTS_DIR = Path(__file__).resolve().parent.parent / "prompts"
+PROMPTS_DIR = library_dir("prompts")  # the checkout's prompts/, or the installed wheel's (gendex_envs.library)
 
 
 @dataclass(frozen=True)

@@ -51,12 +51,12 @@ import yaml
 from gendex.data.episode import EpisodeError
 from gendex.fanout import Backend, session
 from gendex_envs.atomic_io import atomic_dir, write_text
+from gendex_envs.library import library_dir
 from gendex_envs.typed_yaml import load_yaml_bounded, parse_json_bounded, quote
 
 log = logging.getLogger(__name__)
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-DATASETS_DIR = REPO_ROOT / "datasets"
+DATASETS_DIR = library_dir("datasets")  # the checkout's datasets/, or the installed wheel's (gendex_envs.library)
 BUILD_RECORD = "gendex_dataset.json"
 MAX_BUILD_RECORD_BYTES = 1_000_000
 """A build record (``gendex-smoke``'s is 1 KB; 10 tasks of 1 000 episodes about 100 KB)."""

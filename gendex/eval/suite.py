@@ -24,10 +24,10 @@ from pathlib import Path
 import dacite
 
 from gendex_envs.errors import GenDexError
+from gendex_envs.library import library_dir
 from gendex_envs.typed_yaml import load_yaml_bounded
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-SUITES_DIR = REPO_ROOT / "suites"
+SUITES_DIR = library_dir("suites")  # the checkout's suites/, or the installed wheel's (gendex_envs.library)
 METRICS = ("success_at_end", "success_once")
 SEED_FLOOR = 1_000_000
 """Suite seeds start at or above this: datasets use 0 .. their manifests' max attempts, benchmarks 1 000-97 000."""
