@@ -4,11 +4,11 @@
 
 What it proves (issue 44, "installable tasks"): with no checkout on the path, ``import gendex_envs`` registers as
 many ``GenDex/`` ids as the checkout does, from the library shipped in the wheel; ``gym.make`` + reset + 10 steps
-works on N random ids; suites, dataset manifests and prompts load; the shipped trust record trusts the shipped
-reward modules, while a folder on ``$GENDEX_TASKS_PATH`` registers, is untrusted, and cannot take a shipped id. It
-also reports how many task versions' file digests (what suites and leaderboard results pin) differ from the
-checkout's: ``TaskVersion.file_digest`` counts ``__pycache__`` files, and ``pip install`` compiles every shipped
-``.py`` file (``pip install --no-compile`` does not).
+works on N random ids; ``gendex list`` lists them all; suites, dataset manifests and prompts load; the shipped trust
+record trusts the shipped reward modules, while a folder on ``$GENDEX_TASKS_PATH`` registers, is untrusted, and
+cannot take a shipped id. It also reports how many task versions' file digests (what suites and leaderboard results
+pin) differ from the checkout's: ``TaskVersion.file_digest`` counts ``__pycache__`` files, and ``pip install``
+compiles every shipped ``.py`` file (``pip install --no-compile`` does not).
 
 How, without downloading torch and ManiSkill again: the wheel is built (``pip wheel --no-deps
 --no-build-isolation``) from an export of the work tree (the files git tracks, as they are now, plus new files git
@@ -203,6 +203,12 @@ def main() -> int:
             raise SystemExit("the installed wheel failed its checks")
         summary["installed"] = json.loads(done.stdout.strip().splitlines()[-1])
         summary["installed_check_s"] = round(time.perf_counter() - t, 1)
+        done = subprocess.run([str(venv / "bin" / "gendex"), "list"], cwd=elsewhere, env=env, capture_output=True,
+                              text=True)  # the console script, with every subpackage of gendex it imports
+        if done.returncode:
+            print(done.stderr[-3000:], file=sys.stderr)
+            raise SystemExit("`gendex list` failed in the venv")
+        summary["gendex_list_ids"] = sum(line.startswith("GenDex/") for line in done.stdout.splitlines())
 
         done = subprocess.run([sys.executable, "-c", CHECKOUT], cwd=REPO, env=env, capture_output=True, text=True,
                               check=True)
@@ -212,7 +218,7 @@ def main() -> int:
         summary["digests_differ"] = sorted(i for i in checkout["digests"] | installed_digests
                                            if checkout["digests"].get(i) != installed_digests.get(i))
         summary["digests_differ"] = len(summary["digests_differ"])  # reported, not failed: see the docstring
-        ok = summary["installed"]["count"] == summary["checkout_count"]
+        ok = summary["installed"]["count"] == summary["checkout_count"] == summary["gendex_list_ids"]
         summary["ok"] = ok
         print(json.dumps(summary))
         return 0 if ok else 1
