@@ -77,6 +77,21 @@ own), so that a test reaches the kernel's walls behind it. No parameter, job opt
 folder sets it; only code running in this process can."""
 _FRAME_RE = re.compile(r'File "(?P<file>[^"]+)", line (?P<line>\d+) in (?P<fn>\S+)')
 
+CHILD_ENV_NAMES = frozenset({"PATH", "HOME", "LANG", "LANGUAGE", "TMPDIR", "TZ", "LD_LIBRARY_PATH", "DISPLAY",
+                             "PYTHONPATH", "PYTHONHASHSEED", "PYTHONDONTWRITEBYTECODE", "PYTHONUNBUFFERED",
+                             "PYTHONFAULTHANDLER", "PYTHONWARNINGS"})
+CHILD_ENV_PREFIXES = ("LC_", "GENDEX_", "OMP_", "MKL_", "OPENBLAS_", "TORCH_", "CUDA_", "NVIDIA_", "VK_", "MESA_",
+                      "SAPIEN_", "MS_", "XDG_")
+"""The parent's environment variables the probe's child gets: the locale, paths, thread counts and the simulator's
+and GenDex's own settings. Everything else (API keys, tokens, cloud credentials) stays in the parent: a candidate
+past the first wall could put what it reads into an error message, which goes back to the model."""
+
+
+def child_environment() -> dict[str, str]:
+    """The environment the probe's child (and its reaper) start with: :data:`CHILD_ENV_NAMES` and names with one of
+    :data:`CHILD_ENV_PREFIXES`."""
+    return {k: v for k, v in os.environ.items() if k in CHILD_ENV_NAMES or k.startswith(CHILD_ENV_PREFIXES)}
+
 
 @dataclass
 class ProbeReport:
@@ -254,7 +269,7 @@ class _Child:
         job_path = self.workdir / "job.json"
         job_path.write_text(json.dumps(self.job), encoding="utf-8")
         self.progress_path.write_text("", encoding="utf-8")
-        env = dict(os.environ)
+        env = child_environment()
         root = str(Path(__file__).resolve().parents[2])  # the checkout holding generator/ and gendex_envs/
         env["PYTHONPATH"] = os.pathsep.join([root, *[p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]])
         reaper, pipe = self._start_reaper(env)

@@ -35,6 +35,8 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="La
 
 TASK = resolve_task("GenDex/PutAppleBowl-v1")
 SECRET = "the user's own data"
+API_KEY = "sk-ant-probe-test-0123456789"
+"""Stands for the model's API key in the parent's environment."""
 OK = "return {'fail': torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)}"
 REWARD = (
     "def compute_dense_reward(env, obs, action, info):\n"
@@ -95,6 +97,10 @@ def _attacks(marks: Path, secret: Path, beside: Path, port: int, victim: int) ->
         "kill_victim": f"""
             import os
             os.kill({victim}, 9)
+        """,
+        "read_environment": """
+            import os
+            raise RuntimeError('environment: ' + repr(sorted(os.environ.items())))
         """,
     }
 
@@ -157,6 +163,7 @@ def hostile(tmp_path_factory):
         mp.setattr(probe, "FIRST_WALL_DOWN_FOR_TESTS", True, raising=False)
         mp.delenv("GENDEX_IN_PROCESS_GUARD", raising=False)
         mp.delenv("GENDEX_TRUST_REMOTE_CODE", raising=False)
+        mp.setenv("ANTHROPIC_API_KEY", API_KEY)
         results, messages = _probe([*paths, TASK.files.reward])
     try:
         victim_alive = victim.poll() is None
@@ -189,6 +196,13 @@ def test_a_candidate_past_the_first_wall_reaches_nothing(hostile, name):
     assert EXPECTED.get(name, "PermissionError") in text, text
     assert SECRET not in text
     assert list(hostile["marks"].iterdir()) == []
+
+
+def test_the_childs_environment_holds_no_credentials(hostile):
+    """What a candidate can read of its environment goes back to the model in its error: no key is there."""
+    text = str(hostile["results"]["read_environment"])
+    assert "environment: [" in text and "'PATH'" in text, text  # it did read its environment
+    assert API_KEY not in text and "ANTHROPIC_API_KEY" not in text
 
 
 def test_no_connection_reached_the_listener(hostile):
