@@ -326,9 +326,11 @@ class TaskVersion:
     def file_digest(self) -> str:
         """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version. It covers
         everything in the folder (spec, reward and stage reward modules, policies and their records, start states,
-        any other file, hidden ones and bytecode caches included), so any change that could alter behaviour changes
-        it; only the ``solvability`` record is left out: it is a measurement of the version (``gendex gate --write``
-        may add or renew it), not part of it.
+        any other file, hidden ones included), so any change that could alter behaviour changes it; left out are the
+        ``solvability`` record, a measurement of the version (``gendex gate --write`` may add or renew it), not part
+        of it, and ``__pycache__`` folders: nothing reads them (reward modules are compiled from their checked text,
+        :func:`~gendex_envs.reward_module.load_reward_module`), and ``pip install`` of the wheel writes them beside
+        every shipped ``.py`` file, so an installed library digests as the checkout does.
 
         Stable across checkouts and machines: files are taken in the order of their relative paths (by parts), and only
         their bytes count (not times, modes or owners). Files are read in chunks; a symbolic link counts as its
@@ -341,6 +343,7 @@ class TaskVersion:
         skip = self.files.record("solvability").relative_to(self.root).as_posix()
         entries: list[tuple[str, Path]] = []
         for folder, dirs, names in os.walk(self.root, followlinks=False):
+            dirs[:] = [d for d in dirs if d != "__pycache__"]
             here = Path(folder)
             for n in names + [d for d in dirs if (here / d).is_symlink()]:
                 entries.append(((here / n).relative_to(self.root).as_posix(), here / n))

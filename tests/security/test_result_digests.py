@@ -111,12 +111,19 @@ def test_file_digest_covers_every_file_and_never_follows_links(tmp_path):
     first = copy.file_digest()
     assert copy.file_digest() == first  # stable
     for rel in ("stage_rewards/grasp_apple.py", "policies/grasp_apple.zip", "start_states/grasp_apple.npz",
-                "__pycache__/reward.cpython-311.pyc", ".hidden"):
+                "stage_rewards/notes.pyc", ".hidden"):
         path = copy.root / rel
         path.parent.mkdir(parents=True, exist_ok=True)
         before = copy.file_digest()
         path.write_bytes(path.read_bytes() + b"x" if path.exists() else b"x")
         assert copy.file_digest() != before, rel
+    # bytecode caches are never read (modules run from their checked text) and pip writes them when it installs
+    # the library: an installed copy digests as the checkout does
+    before = copy.file_digest()
+    for rel in ("__pycache__/reward.cpython-311.pyc", "stage_rewards/__pycache__/grasp_apple.cpython-311.pyc"):
+        (copy.root / rel).parent.mkdir(parents=True, exist_ok=True)
+        (copy.root / rel).write_bytes(b"x")
+    assert copy.file_digest() == before
     (copy.root / "solvability.json").write_text("{}")  # a measurement, not part of the version
     before = copy.file_digest()
     (copy.root / "solvability.json").write_text('{"renewed": true}')
