@@ -25,18 +25,25 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
                   ray: bool = ray_option(), ray_address: str = ray_address_option(),
                   record: bool = typer.Option(False, "--record", help="Write the built files' checksums into the "
                                                                      "manifest (the expected ones).")) -> None:
-    """Collect every task of a dataset manifest, then check the result against the manifest's checksums."""
+    """Collect every task of a dataset manifest, then check the result against the manifest's checksums. Before it
+    collects, one attempt tells whether this code collects as the code that built the manifest did."""
     from gendex.data.datasets import build, load_manifest, manifest_path, record_checksums, save_manifest, verify
+    from gendex.data.provenance import BuiltWith, canary, check_code, current_commit
     from gendex_envs.errors import GenDexError
 
     try:
         m = load_manifest(name)
         target = out or Path("out/datasets") / m.name
+        code = check_code(m)
+        if not record or code.status != "same":
+            typer.echo(("note: " if code.status != "same" else "") + code.message, err=True)
         sums = build(m, target, backend=backend_of(workers, ray, ray_address),
                      progress=lambda task, ok, n: typer.echo(f"  {task}: {ok} episodes after {n} attempts", err=True))
         if record:
-            save_manifest(record_checksums(m, sums), manifest_path(m.name))
-            typer.echo(f"built {target}: {len(sums)} files; checksums recorded in {manifest_path(m.name)}")
+            built = BuiltWith(canary=code.canary or canary(m), commit=current_commit())
+            save_manifest(record_checksums(m, sums, built), manifest_path(name))
+            typer.echo(f"built {target}: {len(sums)} files; checksums and the code that built them recorded in "
+                       f"{manifest_path(name)}")
             return
         if m.checksums:
             v = verify(target, m)
@@ -47,6 +54,44 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
             typer.echo(f"built {target}: {len(sums)} files (the manifest records no checksums: --record)")
     except GenDexError as exc:
         die(exc)
+
+
+@dataset_app.command("check")
+def dataset_check(names: list[str] = typer.Argument(None, help="Manifests in datasets/ (default: all).")) -> None:
+    """Does this code collect each manifest as the code that built it did? One attempt per manifest (its first
+    task's first seed); exits 1 when one differs and is not marked as built by older code (`gendex dataset stale`)."""
+    from gendex.data.datasets import load_manifest
+    from gendex.data.provenance import check_code
+    from gendex_envs.errors import GenDexError
+    from gendex_envs.library import library_dir
+
+    try:
+        manifests = [load_manifest(n) for n in (names or sorted(p.stem for p in
+                                                                 library_dir("datasets").glob("*.yaml")))]
+        checks = [check_code(m) for m in manifests]
+    except GenDexError as exc:
+        die(exc)
+    for c in checks:
+        typer.echo(f"{c.status:8s} {c.message}")
+    if not all(c.ok for c in checks):
+        raise typer.Exit(1)
+
+
+@dataset_app.command("stale")
+def dataset_stale(name: str = typer.Argument(..., help="A manifest in datasets/.")) -> None:
+    """Mark a manifest as built by older code: its checksums stay as the record of what was published, `gendex
+    dataset check` accepts it, and a build says that it will give other files."""
+    from gendex.data.datasets import load_manifest, manifest_path, mark_stale, save_manifest
+    from gendex_envs.errors import GenDexError
+
+    try:
+        m = load_manifest(name)
+        path = manifest_path(name)  # the file named, when a path was given
+        save_manifest(mark_stale(m), path)
+    except GenDexError as exc:
+        die(exc)
+    typer.echo(f"{path}: marked as built by older code; `gendex dataset build {m.name} --record` rebuilds it and "
+               f"records the new checksums")
 
 
 @dataset_app.command("verify")

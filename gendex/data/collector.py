@@ -166,6 +166,20 @@ class _Attempter:
         return AttemptResult(seed, kept, self.recorder.steps, time.perf_counter() - t0, failure)
 
 
+def attempt_once(cfg: CollectConfig, make_solver: Callable[[], Solver], seed: int
+                 ) -> tuple[Episode | None, int, Failure | None]:
+    """One attempt exactly as :func:`collect` runs it (its env, recorder and solver, built for this attempt): the
+    recorded episode (None when no step was taken), the steps taken, and why it failed (None when it succeeded)."""
+    attempter = _Attempter(cfg, make_solver)
+    try:
+        episode, _images, failure = _attempt(attempter.env, attempter.recorder, attempter.solver, seed, cfg.cameras)
+        if failure is None and (episode is None or not episode.succeeded):
+            failure = Failure("target_not_reached", detail="the episode ended without the task's success")
+        return episode, attempter.recorder.steps, failure
+    finally:
+        attempter.env.close()
+
+
 def _make_attempter(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> _Attempter:
     """A worker process's attempter (:func:`gendex.fanout.ordered_map`): registers a task registered at run time
     in the parent (e.g. a scratch root) first."""

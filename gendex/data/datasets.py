@@ -49,6 +49,7 @@ import dacite
 import yaml
 
 from gendex.data.episode import EpisodeError
+from gendex.data.provenance import BuiltWith
 from gendex.fanout import Backend, session
 from gendex_envs.atomic_io import atomic_dir, write_text
 from gendex_envs.library import library_dir
@@ -96,6 +97,8 @@ class DatasetManifest:
     video_codec: str | None = "libsvtav1"
     checksums: dict[str, str] = field(default_factory=dict)
     """Path in the built dataset -> SHA-256 (hex) of its bytes; empty until a build was recorded."""
+    built_with: BuiltWith | None = None
+    """The code that built the recorded checksums (:mod:`gendex.data.provenance`); None before it was recorded."""
 
     def folder(self, task: DatasetTask) -> str:
         """The sub-folder of a built dataset holding ``task`` (``PutAppleBowl-v1``)."""
@@ -154,6 +157,8 @@ def save_manifest(m: DatasetManifest, path: Path) -> None:
     raw["tasks"] = [{k: v for k, v in t.items() if v is not None} for t in raw["tasks"]]
     raw["cameras"] = list(m.cameras)
     raw["checksums"] = dict(sorted(m.checksums.items()))
+    if m.built_with is None:
+        raw.pop("built_with")
     header = (f"# GenDex dataset manifest: `gendex dataset build {m.name}` collects it, `gendex dataset verify`\n"
               "# checks a copy against the checksums (written by `gendex dataset build --record`). See\n"
               "# docs/datasets.md.\n")
@@ -253,9 +258,18 @@ def _build_task(manifest: DatasetManifest, t: DatasetTask, out: Path, backend: B
                             "failures": dict(sorted(state.failures.items()))})
 
 
-def record_checksums(manifest: DatasetManifest, sums: dict[str, str]) -> DatasetManifest:
-    """``manifest`` with its expected checksums replaced by ``sums`` (``gendex dataset build --record``)."""
-    return replace(manifest, checksums=dict(sums))
+def record_checksums(manifest: DatasetManifest, sums: dict[str, str],
+                     built_with: BuiltWith | None = None) -> DatasetManifest:
+    """``manifest`` with its expected checksums replaced by ``sums`` and, when given, the code that built them
+    (``gendex dataset build --record``)."""
+    return replace(manifest, checksums=dict(sums), built_with=built_with or manifest.built_with)
+
+
+def mark_stale(manifest: DatasetManifest) -> DatasetManifest:
+    """``manifest`` marked as built by older code (``gendex dataset stale``): its checksums stay as the record of
+    what was published, and builds say they will differ."""
+    built = manifest.built_with or BuiltWith()
+    return replace(manifest, built_with=replace(built, stale=True))
 
 
 # --------------------------------------------------------------------------------------------- remotes
