@@ -27,13 +27,12 @@ import torch
 
 from gendex_envs import guard
 from gendex_envs.errors import GenDexError, RewardModuleError
-from gendex_envs.registry import resolve_task
+from gendex_envs.registry import REFERENCE_TASKS, resolve_task
 from gendex_envs.reward_module import load_reward_module
 
 REPO = Path(__file__).resolve().parents[2]
 PAYLOADS = REPO / "tests" / "data" / "hostile_r2" / "sandbox"
 CALL_LIMIT_S = 2.0
-REFERENCE = ("PutAppleBowl", "PickUpBottle", "OpenCabinet")
 
 
 def _sandbox_host():
@@ -308,7 +307,7 @@ def test_the_worker_dies_with_its_parent(tmp_path):
 
 
 # ---------------------------------------------------------------------------------------------- same results
-@pytest.mark.parametrize("name", REFERENCE)
+@pytest.mark.parametrize("name", REFERENCE_TASKS)
 def test_an_untrusted_copy_gives_the_trusted_rewards_success_and_observations(task_copy, name):
     from gendex_envs.task_env import TaskEnv
 
