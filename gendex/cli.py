@@ -18,6 +18,7 @@ from pathlib import Path
 import typer
 
 from gendex.cli_bc import bc_app
+from gendex.cli_check import check_command
 from gendex.cli_common import backend_of, ray_address_option, ray_option
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
@@ -32,6 +33,7 @@ app.add_typer(bc_app, name="bc")
 app.command("eval")(eval_command)
 app.add_typer(leaderboard_app, name="leaderboard")
 app.command("trust")(trust_command)
+app.command("check")(check_command)
 log = logging.getLogger("gendex")
 
 

@@ -1,0 +1,292 @@
+"""Per-version checks of the task library (``gendex check``): what the test suite once ran on every version, now a
+command CI runs on the versions a change touches plus a fixed sample, and a slow test runs on all of them.
+
+For one version :func:`check_version` runs, in order, and stops at the first failure:
+
+``static``
+    every reward module of the folder (the task's, each stage's, and any other ``.py`` file in it) passes
+    the static check of generated reward code (:func:`generator.steps.static_check.check_reward_file`);
+``time_limit``
+    the registered Gymnasium spec carries the version's ``max_episode_steps``;
+``check_env``
+    Gymnasium's ``check_env`` on a fresh ``gym.make(id)`` (its random actions seeded with 1). A version that only
+    rewords its source (``gendex reword``: the same scene, stages and rewards byte for byte) is checked through its
+    source. :data:`KNOWN_DEFECTS` lists the versions known to fail it; for them a failure is expected ("xfail") and
+    a pass is an error, as with ``pytest.mark.xfail(strict=True)``, so the list is kept true;
+``steps``
+    ``reset(seed=0)`` and :data:`STEPS` seeded random actions: finite observation and reward, ``terminated`` and
+    ``truncated`` booleans, ``info["success"]`` present.
+
+:func:`select` turns the command's selection options into ids: explicit ids, the versions whose folders differ
+from a git revision (:func:`changed_since`), the newest version of each reference task and a fixed random sample.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import subprocess
+import time
+import traceback
+import warnings
+from collections.abc import Iterable, Iterator
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+STEPS = 5
+"""Random actions stepped after the reset in the ``steps`` check."""
+
+_HISTORY = ("known defect: after the checker's random full-body step (every arm and hand joint sent to a random "
+            "target{what}), the same seed and action step differently: PhysX state outside get_state() survives "
+            "the reset (the robot's joint accelerations do, and SAPIEN 3.0.3's set_qacc does not clear them on the "
+            "CPU); history-independent stepping is item 2 of the datasets issue. Measured over action seeds 0-7: "
+            "{rate} fail")
+KNOWN_DEFECTS = {"GenDex/OpenOvenCompact-v0": _HISTORY.format(what=", next to a fixed oven", rate="8/8"),
+                 "GenDex/RotateTennisBall-v0": _HISTORY.format(what=", palm up", rate="6/8"),
+                 "GenDex/RotateTennisBall-v1": _HISTORY.format(what=", palm up (v0's scene)", rate="6/8"),
+                 "GenDex/CloseOvenCompact-v0": _HISTORY.format(what=", the oven door open on its stop", rate="8/8"),
+                 "GenDex/CloseDrawerChest2-v0": _HISTORY.format(what=", an open drawer that moves with nobody "
+                                                                    "touching it", rate="8/8")}
+"""Versions whose ``check_env`` is known to fail (checked: it must still fail), with the reason."""
+
+_IGNORED_WARNINGS = (r".*observation space (minimum|maximum) value is", r".*different from the unwrapped version")
+"""check_env's warnings that say nothing about a GenDex env (unbounded observation spaces, the GymApi wrapper)."""
+
+
+class CheckSelectionError(ValueError):
+    """The ids or selection options name nothing checkable (an unknown id, a bad revision)."""
+
+
+@dataclass
+class CheckResult:
+    """One version's outcome: ``status`` passed, failed or xfail (a known defect that still fails as known)."""
+
+    id: str
+    status: str
+    message: str = ""
+    seconds: float = 0.0
+    checks: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return self.status != "failed"
+
+
+# ---------------------------------------------------------------------------------------------- one version
+def _static(version) -> int:
+    from generator.steps.static_check import check_reward_file
+
+    modules = dict.fromkeys([*version.files.reward_modules(),
+                             *sorted(p for p in version.root.rglob("*.py") if "__pycache__" not in p.parts)])
+    for path in modules:
+        check_reward_file(path)
+    return len(modules)
+
+
+def _time_limit(env_id: str, version) -> None:
+    import gymnasium as gym
+
+    got, want = gym.spec(env_id).max_episode_steps, version.spec.max_episode_steps
+    assert got == want, f"the registered spec's max_episode_steps is {got}, the task's {want}"
+
+
+def check_env_target(env_id: str, version) -> str:
+    """The id whose env ``check_env`` runs on for ``env_id``: its source when it only rewords it."""
+    return version.provenance().get("reword", {}).get("source", env_id)
+
+
+def _check_env(env_id: str) -> None:
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make(env_id)
+    try:
+        env.action_space.seed(1)  # the checker's unseeded steps become the same every run
+        with warnings.catch_warnings():
+            for pattern in _IGNORED_WARNINGS:
+                warnings.filterwarnings("ignore", message=pattern, category=UserWarning)
+            check_env(env, skip_render_check=True)
+    finally:
+        env.close()
+
+
+def _steps(env_id: str) -> None:
+    import gymnasium as gym
+    import numpy as np
+
+    env = gym.make(env_id)
+    try:
+        obs, _ = env.reset(seed=0)
+        assert np.isfinite(np.asarray(obs, dtype=np.float64)).all(), "reset: the observation is not finite"
+        env.action_space.seed(0)
+        for i in range(STEPS):
+            obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+            assert np.isfinite(np.asarray(obs, dtype=np.float64)).all(), f"step {i}: the observation is not finite"
+            assert math.isfinite(float(reward)), f"step {i}: reward {reward}"
+            assert isinstance(terminated, bool) and isinstance(truncated, bool), \
+                f"step {i}: terminated={terminated!r}, truncated={truncated!r} (booleans expected)"
+            assert "success" in info, f"step {i}: info has no 'success' ({sorted(info)})"
+    finally:
+        env.close()
+
+
+def _failure(exc: BaseException) -> str:
+    text = f"{type(exc).__name__}: {exc}".strip()
+    if isinstance(exc, AssertionError) and not str(exc):
+        text += " at " + traceback.extract_tb(exc.__traceback__)[-1].line
+    return text
+
+
+def check_version(env_id: str, root: str | None = None) -> CheckResult:
+    """Run every check on the registered version ``env_id`` (see the module doc); never raises. ``root``: its
+    folder, registered here first when this process does not know the id (a worker process, a scratch folder)."""
+    from gendex_envs.registry import register_tasks, registered_tasks
+
+    start = time.perf_counter()
+    result = CheckResult(env_id, "passed")
+    step = "registered"
+    try:
+        if env_id not in registered_tasks() and root is not None:
+            register_tasks([Path(root).parent.parent])
+        version = registered_tasks()[env_id]
+        step = "static"
+        n = _static(version)
+        result.checks.append(f"static ({n} modules)")
+        step = "time_limit"
+        _time_limit(env_id, version)
+        result.checks.append(step)
+        step = "check_env"
+        target = check_env_target(env_id, version)
+        try:
+            _check_env(target)
+        except Exception as exc:  # any failure of the checker is the result
+            if target not in KNOWN_DEFECTS:
+                raise
+            result.status, result.message = "xfail", f"check_env on {target}: {KNOWN_DEFECTS[target]} ({_failure(exc)})"
+        else:
+            if target in KNOWN_DEFECTS:
+                raise AssertionError(f"{target} passes check_env but is listed in gendex.check.KNOWN_DEFECTS: "
+                                     "remove it from the list")
+        result.checks.append(step if target == env_id else f"{step} (through {target})")
+        step = "steps"
+        _steps(env_id)
+        result.checks.append(step)
+    except Exception as exc:  # a failed check is a result, not a crash
+        result.status, result.message = "failed", f"{step}: {_failure(exc)}"
+    result.seconds = round(time.perf_counter() - start, 3)
+    return result
+
+
+def _worker():
+    """The fan-out worker (one per process): registers the tasks on import, then checks one id per job."""
+    import gendex_envs  # noqa: F401  (registers the GenDex tasks in a spawned process)
+
+    return _check_job
+
+
+def _check_job(job: tuple[str, str | None]) -> CheckResult:
+    return check_version(*job)
+
+
+def run_checks(ids: Iterable[str], workers: int = 1) -> Iterator[CheckResult]:
+    """:func:`check_version` for each id, in order, on ``workers`` local processes (1: this process)."""
+    from gendex.fanout import Backend, ordered_map
+    from gendex_envs.registry import registered_tasks
+
+    versions = registered_tasks()
+    jobs = [(i, str(versions[i].root) if i in versions else None) for i in ids]
+    yield from ordered_map(_worker, jobs, Backend.from_options(workers))
+
+
+def write_report(path: Path, results: list[CheckResult], workers: int, seconds: float) -> None:
+    from gendex_envs.atomic_io import write_json
+
+    failed = [r.id for r in results if not r.ok]
+    report = {"ok": not failed, "checked": len(results), "failed": failed, "workers": workers,
+              "seconds": round(seconds, 3), "results": [{**asdict(r), "ok": r.ok} for r in results]}
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_json(path, report, indent=2)
+
+
+# ---------------------------------------------------------------------------------------------- selection
+def _git(args: list[str], cwd: Path) -> str:
+    try:
+        out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        raise CheckSelectionError(f"git {' '.join(args)}: {exc}") from exc
+    if out.returncode:
+        raise CheckSelectionError(f"git {' '.join(args)} failed: {out.stderr.strip()}")
+    return out.stdout
+
+
+def changed_since(rev: str, versions: dict | None = None) -> list[str]:
+    """The registered ids whose version folders differ from git revision ``rev`` (committed changes since it,
+    uncommitted ones and untracked files), sorted. Folders outside the git checkout are never listed."""
+    from gendex_envs.registry import REPO_TASKS_DIR, registered_tasks
+
+    versions = registered_tasks() if versions is None else versions
+    top = Path(_git(["rev-parse", "--show-toplevel"], REPO_TASKS_DIR).strip())
+    names = _git(["diff", "--name-only", rev, "--"], top).splitlines()
+    names += _git(["ls-files", "--others", "--exclude-standard"], top).splitlines()
+    roots = {v.root.resolve(): env_id for env_id, v in versions.items()}
+    found = set()
+    for name in names:
+        path = (top / name).resolve()
+        found.update(roots[p] for p in path.parents if p in roots)
+    return sorted(found)
+
+
+def merge_base() -> str | None:
+    """The merge base of HEAD with the first of origin/main, origin/HEAD, main that exists (None without git)."""
+    from gendex_envs.registry import REPO_TASKS_DIR
+
+    for ref in ("origin/main", "origin/HEAD", "main"):
+        try:
+            return _git(["merge-base", "HEAD", ref], REPO_TASKS_DIR).strip()
+        except CheckSelectionError:
+            continue
+    return None
+
+
+def newest_reference_ids() -> list[str]:
+    """The newest registered version of each reference task."""
+    from gendex_envs.registry import REFERENCE_TASKS, resolve_task
+
+    return [resolve_task(name).env_id for name in REFERENCE_TASKS]
+
+
+def select(ids: Iterable[str] = (), *, changed_since_rev: str | None = None, reference: bool = False,
+           sample: int = 0, seed: int = 0) -> list[str]:
+    """The ids to check, in order: ``ids`` (registered ids, names or version folders), the versions changed since
+    ``changed_since_rev``, the newest reference versions, then ``sample`` more drawn with ``seed`` from the
+    registered ids not already chosen (sorted first, so the same library and seed give the same sample). With no
+    option at all: every registered id."""
+    from gendex_envs.errors import TaskNotFoundError
+    from gendex_envs.registry import registered_tasks, resolve_task
+
+    versions = registered_tasks()
+    ids = list(ids)
+    if not (ids or changed_since_rev or reference or sample):
+        return sorted(versions)
+    chosen: list[str] = []
+    for task in ids:
+        try:
+            chosen.append(resolve_task(task).env_id)
+        except TaskNotFoundError as exc:
+            raise CheckSelectionError(str(exc)) from exc
+    unknown = [i for i in chosen if i not in versions]
+    if unknown:
+        raise CheckSelectionError(f"not registered in this process: {unknown}")
+    if changed_since_rev:
+        chosen += changed_since(changed_since_rev, versions)
+    if reference:
+        chosen += newest_reference_ids()
+    chosen = list(dict.fromkeys(chosen))
+    if sample:
+        rest = sorted(set(versions) - set(chosen))
+        chosen += random.Random(seed).sample(rest, min(sample, len(rest)))
+    return chosen
+
+
+__all__ = ["KNOWN_DEFECTS", "STEPS", "CheckResult", "CheckSelectionError", "changed_since", "check_env_target",
+           "check_version", "merge_base", "newest_reference_ids", "run_checks", "select", "write_report"]
