@@ -7,21 +7,37 @@ Layout (as lerobot's ``LeRobotDataset`` reads it)::
     meta/tasks.parquet                           task_index column; the task string is the pandas index
     meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``)
     data/chunk-CCC/file-FFF.parquet              one row per action (frame); images as struct<bytes PNG, path>
-    videos/<key>/chunk-CCC/file-FFF.mp4          with ``video_codec``: a camera's frames instead, one MP4 per
-                                                 episode (frame k at k / fps), located by the episode row's
-                                                 ``videos/<key>/{chunk_index,file_index,from_,to_timestamp}``
+    videos/<key>/chunk-CCC/file-FFF.mp4          with ``video_codec``: a camera's frames instead, episode after
+                                                 episode (frame k of an episode at from_timestamp + k / fps), located
+                                                 by the episode row's ``videos/<key>/{chunk_index,file_index,
+                                                 from_timestamp,to_timestamp}``
 
 Frame ``t`` of an episode holds ``observation.state = state[t]``, ``action = action[t]``, the images of step ``t``,
 ``next.reward/next.success = reward[t]/success[t]`` and ``next.done`` (True on the last frame), as lerobot's
 ``pusht``-style datasets do. The final observation ``state[T]`` is not stored (there is no action for it).
 
-Durability: each :meth:`LeRobotV3Writer.add_episode` rewrites the current data file (episodes are appended to it in
-memory, and a new file -- then a new chunk after ``chunks_size`` files -- is started when the size limit would be
-passed) and all meta files. Every file is first written to a hidden temp sibling (``.<name>.tmp``); then a journal
-``meta/.commit.json`` listing the renames is itself renamed into place (the commit point) and the renames are made,
-data first and ``info.json`` last. A process killed before the commit point leaves only temp files, which the next
-writer removes; one killed after it is rolled forward by the next writer. Since the data file is renamed before the
-meta files, meta never claims rows that are missing. One writer per root at a time.
+Files are split as lerobot splits them: a data file takes episodes (one parquet row group each) until the next one
+would pass ``data_files_size_in_mb``, a video file until the next episode's packets would pass
+``video_files_size_in_mb`` (500 MB); then a new file is started, and a new chunk after ``chunks_size`` files.
+
+Cost and durability: :meth:`LeRobotV3Writer.add_episode` costs in proportion to that episode, not to the dataset. It
+writes the episode to a journal (``meta/.pending/episode-NNNNNN.arrow``, its rows and stats, and one MP4 per camera
+with its frames; the ``.arrow`` file, written atomically last, is the entry's commit point), then appends its rows as
+a row group to the open data file and copies its video packets into each camera's open video file. Open and
+finished-but-unpublished files are hidden temp siblings (``.<name>.tmp``). :meth:`~LeRobotV3Writer.close` publishes
+them with the meta (``info.json``, ``stats.json``, ``tasks.parquet``, the episodes parquet, written whole: small)
+in one journaled commit: the temp names and the renames are listed in ``meta/.commit.json``, itself renamed into
+place (the commit point), then the renames are made, data and videos first and ``info.json`` last; then the journal
+is cleared. So:
+
+* the visible files always form the dataset as of the last ``close()``: complete, consistent and readable by lerobot
+  (episodes added since are not visible until the writer closes);
+* a writer killed at any point loses no episode that ``add_episode`` returned: the next writer removes the temp
+  files, rolls a committed close forward, reopens the last data and video files (copied row group by row group,
+  packet by packet) and appends the journaled episodes again. The files it ends with are the bytes an uninterrupted
+  writer writes.
+
+One writer per root at a time.
 """
 
 from __future__ import annotations
@@ -30,7 +46,9 @@ import io
 import json
 import logging
 import os
+import shutil
 from collections.abc import Callable
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +57,7 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from gendex.data.episode import Episode, EpisodeError
-from gendex_envs.atomic_io import write_text
+from gendex_envs.atomic_io import write_bytes, write_text
 from gendex_envs.video import CODECS, PIX_FMT, encode
 
 log = logging.getLogger(__name__)
@@ -50,6 +68,7 @@ VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.m
 EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 INFO_PATH, STATS_PATH, TASKS_PATH, JOURNAL_PATH = ("meta/info.json", "meta/stats.json", "meta/tasks.parquet",
                                                    "meta/.commit.json")
+PENDING_DIR = "meta/.pending"  # the journal: episodes added since the last close
 DEFAULT_VIDEO_FILE_SIZE_IN_MB = 500
 # lerobot's DEFAULT_FEATURES (the index columns every dataset has)
 INDEX_FEATURES = {k: {"dtype": d, "shape": [1], "names": None} for k, d in
@@ -85,13 +104,15 @@ def _roll_forward(root: Path) -> bool:
     return True
 
 
-def _commit(root: Path, files: list[tuple[Path, Callable[[Path], None]]]) -> None:
-    """Write each ``(final path, writer)`` to a temp sibling, then make them all visible through the journal."""
+def _commit(root: Path, files: list[tuple[Path, Callable[[Path], None] | None]]) -> None:
+    """Write each ``(final path, writer)`` to a temp sibling (a writer None: the temp sibling is written already),
+    then make them all visible through the journal."""
     staged: list[tuple[Path, Path]] = []
     try:
         for final, write in files:
             final.parent.mkdir(parents=True, exist_ok=True)
-            write(_tmp(final))
+            if write is not None:
+                write(_tmp(final))
             staged.append((_tmp(final), final))
     except BaseException:
         for tmp, _ in staged:
@@ -211,25 +232,118 @@ def read_episode_frames(root: Path | str) -> pa.Table:
     return pa.concat_tables([pq.read_table(p) for p in paths])
 
 
+# --------------------------------------------------------------------------------------------- open files
+class _OpenData:
+    """The data file episodes are being appended to: a parquet writer on the file's hidden temp sibling, one row
+    group per episode; ``size`` is the bytes written so far (the same after a resume, so file splits are too)."""
+
+    def __init__(self, root: Path, chunk: int, file: int, schema: pa.Schema):
+        self.chunk, self.file, self.rows = chunk, file, 0
+        self.final = root / DATA_PATH.format(chunk_index=chunk, file_index=file)
+        self.final.parent.mkdir(parents=True, exist_ok=True)
+        self.sink = pa.OSFile(str(_tmp(self.final)), "wb")
+        self.writer = pq.ParquetWriter(self.sink, schema)
+
+    @property
+    def size(self) -> int:
+        return self.sink.tell()
+
+    def append(self, table: pa.Table) -> None:
+        self.writer.write_table(table)
+        self.rows += table.num_rows
+
+    def finish(self) -> Path:
+        self.writer.close()
+        self.sink.close()
+        return self.final
+
+
+class _OpenVideo:
+    """The video file of one camera episodes are being appended to: an MP4 muxer on the file's hidden temp sibling
+    into which each episode's own encoded packets are copied, shifted to start after the frames already there (as
+    lerobot concatenates episode videos); ``size`` is the bytes of the packets muxed so far."""
+
+    def __init__(self, root: Path, key: str, chunk: int, file: int, template):
+        import av
+
+        self.chunk, self.file, self.frames, self.size = chunk, file, 0, 0
+        self.final = root / VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file)
+        self.final.parent.mkdir(parents=True, exist_ok=True)
+        self.container = av.open(str(_tmp(self.final)), "w", format="mp4")
+        self.stream = self.container.add_stream_from_template(template, opaque=True)
+        # the mp4 muxer writes max(bit rate of the template, measured average) into the btrt box: with the template's
+        # rate unset, a file built from episode videos and one rebuilt from itself (a resume) are the same bytes
+        self.stream.codec_context.bit_rate = 0
+
+    def append(self, source: Path, fps: int, shift: bool = True) -> int:
+        """Copy every packet of the video file ``source``; returns its frame count."""
+        import av
+
+        with av.open(str(source)) as src:
+            stream = src.streams.video[0]
+            offset = Fraction(self.frames, fps) / stream.time_base if shift else Fraction(0)
+            if offset.denominator != 1:
+                raise LeRobotDatasetError(f"{source}: time base {stream.time_base} cannot place frames at k / {fps}")
+            n = 0
+            for packet in src.demux(stream):
+                if packet.dts is None:  # the demuxer's end-of-stream flush packet
+                    continue
+                packet.pts += int(offset)
+                packet.dts += int(offset)
+                packet.stream = self.stream
+                self.size += packet.size
+                self.container.mux(packet)
+                n += 1
+        self.frames += n
+        return n
+
+    def finish(self) -> Path:
+        self.container.close()
+        return self.final
+
+
+def _packet_bytes(path: Path) -> int:
+    """The bytes of the video packets in the file ``path`` (what muxing it into a video file adds, but the index)."""
+    import av
+
+    with av.open(str(path)) as src:
+        return sum(p.size for p in src.demux(src.streams.video[0]) if p.dts is not None)
+
+
+def _next_file(chunk: int, file: int, chunks_size: int) -> tuple[int, int]:
+    return (chunk + 1, 0) if file + 1 >= chunks_size else (chunk, file + 1)
+
+
+def _video_template(path: Path):
+    import av
+
+    container = av.open(str(path))
+    return container, container.streams.video[0]
+
+
 # --------------------------------------------------------------------------------------------- writer
 class LeRobotV3Writer:
     """Append :class:`Episode` records to a LeRobot v3.0 dataset at ``root`` (created, or resumed when it exists).
 
     ``cameras`` maps camera name -> (height, width); those images are stored as ``observation.images.<name>``.
-    ``data_files_size_in_mb`` is the size at which a new data file is started (lerobot's default 100 MB).
+    ``data_files_size_in_mb`` / ``video_files_size_in_mb`` are the sizes at which a new data / video file is started
+    (lerobot's defaults: 100 MB and 500 MB). The dataset is complete and readable after :meth:`close`; episodes added
+    since the last close are kept in a journal, so a killed writer loses none of them (see the module doc).
     """
 
     def __init__(self, root: Path | str, *, fps: int, robot_type: str, state_names: list[str],
                  action_names: list[str], cameras: dict[str, tuple[int, int]] | None = None,
                  environment_state_names: list[str] | None = None, video_codec: str | None = None,
                  chunks_size: int = 1000, data_files_size_in_mb: float = 100,
+                 video_files_size_in_mb: float = DEFAULT_VIDEO_FILE_SIZE_IN_MB,
                  codebase_version: str = CODEBASE_VERSION):
         if codebase_version != CODEBASE_VERSION:
             raise LeRobotDatasetError(f"codebase_version {codebase_version!r} is not supported; only "
                                       f"{CODEBASE_VERSION!r} is")
-        if fps <= 0 or chunks_size <= 0 or data_files_size_in_mb <= 0:
-            raise LeRobotDatasetError(f"fps ({fps}), chunks_size ({chunks_size}) and data_files_size_in_mb "
-                                      f"({data_files_size_in_mb}) must be positive")
+        if fps <= 0 or chunks_size <= 0 or data_files_size_in_mb <= 0 or video_files_size_in_mb <= 0:
+            raise LeRobotDatasetError(f"fps ({fps}), chunks_size ({chunks_size}), data_files_size_in_mb "
+                                      f"({data_files_size_in_mb}) and video_files_size_in_mb "
+                                      f"({video_files_size_in_mb}) must be positive")
         self.root = Path(root)
         self.fps, self.robot_type = int(fps), robot_type
         self.state_names, self.action_names = list(state_names), list(action_names)
@@ -240,12 +354,16 @@ class LeRobotV3Writer:
         self.video_codec = video_codec
         self.cameras = {k: (int(h), int(w)) for k, (h, w) in (cameras or {}).items()}
         self.chunks_size, self.data_files_size_in_mb = int(chunks_size), data_files_size_in_mb
+        self.video_files_size_in_mb = video_files_size_in_mb
         self.features = self._declared_features()
         self._rows: list[dict] = []  # episodes parquet rows
         self._tasks: dict[str, int] = {}
         self._stats: dict | None = None
-        self._n_frames, self._chunk, self._file = 0, 0, 0
-        self._current: pa.Table | None = None  # content of the current data file
+        self._n_frames = 0
+        self._data: _OpenData | None = None
+        self._videos: dict[str, _OpenVideo] = {}
+        self._finished: list[Path] = []  # files complete at their hidden temp names, published at close
+        self._published = 0  # episodes the visible meta holds
         self._closed = False
         self.root.mkdir(parents=True, exist_ok=True)
         _recover(self.root)
@@ -257,6 +375,7 @@ class LeRobotV3Writer:
                                           f"complete LeRobot v3.0 root")
             _commit(self.root, [(self.root / INFO_PATH, lambda p: _write_json(self._info(0, 0, {}), p))])
             log.info("created LeRobot v3.0 dataset at %s", self.root)
+        self._replay()
 
     # -- context manager
     def __enter__(self) -> LeRobotV3Writer:
@@ -297,7 +416,7 @@ class LeRobotV3Writer:
         return {"codebase_version": CODEBASE_VERSION, "robot_type": self.robot_type,
                 "total_episodes": n_episodes, "total_frames": n_frames, "total_tasks": len(tasks),
                 "chunks_size": self.chunks_size, "data_files_size_in_mb": self.data_files_size_in_mb,
-                "video_files_size_in_mb": DEFAULT_VIDEO_FILE_SIZE_IN_MB, "fps": self.fps,
+                "video_files_size_in_mb": self.video_files_size_in_mb, "fps": self.fps,
                 "splits": {"train": f"0:{n_episodes}"} if n_episodes else {},
                 "data_path": DATA_PATH, "video_path": VIDEO_PATH if self.video_codec is not None else None,
                 "features": self.features}
@@ -314,6 +433,7 @@ class LeRobotV3Writer:
                                       f"this writer's (fps {self.fps}) in {diff}; append only with the same fps, "
                                       f"state/action names and cameras, or write to a new root")
         self.chunks_size, self.data_files_size_in_mb = info["chunks_size"], info["data_files_size_in_mb"]
+        self.video_files_size_in_mb = info.get("video_files_size_in_mb", DEFAULT_VIDEO_FILE_SIZE_IN_MB)
         for path in sorted(self.root.glob("meta/episodes/chunk-*/file-*.parquet")):
             self._rows.extend(pq.read_table(path).to_pylist())
         if (self.root / TASKS_PATH).exists():
@@ -327,21 +447,68 @@ class LeRobotV3Writer:
                 f"{self.root} is inconsistent: info.json claims {info['total_episodes']} episodes / "
                 f"{info['total_frames']} frames, the episodes parquet {len(self._rows)} / {self._n_frames}, the "
                 f"data files hold {n_rows} rows; they must agree before episodes can be appended")
+        self._published = len(self._rows)
         if self._rows:
-            last = self._rows[-1]
-            self._chunk, self._file = last["data/chunk_index"], last["data/file_index"]
-            # read back as this writer builds tables (parquet names a list's item "element", the in-memory one
-            # "item"; one chunk per episode, since the parquet encoder's dictionary and page choices follow the
-            # chunks): the file rewritten after a resume is then the same bytes as one written without a break
-            table = _canonical(pq.read_table(self.root / DATA_PATH.format(chunk_index=self._chunk,
-                                                                          file_index=self._file)))
-            here = [r for r in self._rows if (r["data/chunk_index"], r["data/file_index"]) == (self._chunk, self._file)]
-            first = here[0]["dataset_from_index"]
-            self._current = pa.concat_tables([table.slice(r["dataset_from_index"] - first, r["length"])
-                                              for r in here])
             self._stats = _fold([self._row_stats(r) for r in self._rows])
+            self._reopen(self._rows[-1])
         log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
                  len(self._tasks))
+
+    def _reopen(self, last: dict) -> None:
+        """Continue the last data and video files: their content is copied to new open files (row group by row
+        group, packet by packet), which then end as the same bytes as if the writer had never stopped."""
+        chunk, file = last["data/chunk_index"], last["data/file_index"]
+        source = pq.ParquetFile(self.root / DATA_PATH.format(chunk_index=chunk, file_index=file))
+        # read back as this writer builds tables (parquet names a list's item "element", the in-memory one "item")
+        groups = [_canonical(source.read_row_group(i)) for i in range(source.num_row_groups)]
+        self._data = _OpenData(self.root, chunk, file, groups[0].schema)
+        for group in groups:
+            self._data.append(group)
+        for key, ft in self.features.items():
+            if ft["dtype"] == "video":
+                path = self.root / VIDEO_PATH.format(video_key=key, chunk_index=last[f"videos/{key}/chunk_index"],
+                                                     file_index=last[f"videos/{key}/file_index"])
+                self._videos[key] = self._open_video(key, last[f"videos/{key}/chunk_index"],
+                                                     last[f"videos/{key}/file_index"], path)
+                self._videos[key].append(path, self.fps, shift=False)
+
+    def _open_video(self, key: str, chunk: int, file: int, template_path: Path) -> _OpenVideo:
+        import av
+
+        with av.open(str(template_path)) as container:
+            return _OpenVideo(self.root, key, chunk, file, container.streams.video[0])
+
+    def _replay(self) -> None:
+        """Append the journaled episodes a killed writer added after the last close (none after a clean close)."""
+        pending = self.root / PENDING_DIR
+        if not pending.is_dir():
+            return
+        entries = {int(p.name[8:14]): p for p in pending.glob("episode-??????.arrow")}
+        for path in sorted(pending.iterdir()):  # an episode killed before its entry was complete, or published
+            index = int(path.name[8:14]) if path.name[8:14].isdigit() else -1
+            if index not in entries or index < self._published:
+                path.unlink()
+        if not entries.keys() - set(range(self._published)):
+            shutil.rmtree(pending)
+            return
+        replayed = 0
+        for e in sorted(i for i in entries if i >= self._published):
+            if e != len(self._rows):
+                raise LeRobotDatasetError(f"{pending} journals episode {e} but the dataset holds {len(self._rows)} "
+                                          f"episodes; a journaled episode is missing, so the root cannot be resumed")
+            with pa.ipc.open_file(entries[e]) as reader:
+                table = reader.read_all()
+            meta = json.loads(table.schema.metadata[b"gendex"])
+            stats = {k: {s: np.asarray(v) for s, v in d.items()} for k, d in meta["stats"].items()}
+            self._append(table.replace_schema_metadata(None), meta["instruction"], stats, self._segments(e))
+            replayed += 1
+        if replayed:
+            log.warning("%s: a writer was killed before closing; %d journaled episodes appended again", self.root,
+                        replayed)
+
+    def _segments(self, e: int) -> dict[str, Path]:
+        return {k: self.root / PENDING_DIR / f"episode-{e:06d}.{k}.mp4" for k, ft in self.features.items()
+                if ft["dtype"] == "video"}
 
     def _row_stats(self, row: dict) -> dict[str, dict[str, np.ndarray]]:
         return {k: {s: np.asarray(row[f"stats/{k}/{s}"]) for s in STAT_NAMES} for k in self.features}
@@ -382,13 +549,13 @@ class LeRobotV3Writer:
             log.debug("%s: cameras %s are not declared and are not exported", who, extra)
 
     def add_episode(self, ep: Episode) -> int:
-        """Append ``ep`` (its ``T`` actions become ``T`` frames) and rewrite the meta; returns its episode_index."""
+        """Append ``ep`` (its ``T`` actions become ``T`` frames); returns its episode_index. It is journaled before
+        this returns, and in the dataset's visible files once the writer is closed."""
         if self._closed:
             raise LeRobotDatasetError(f"the writer of {self.root} is closed; open a new LeRobotV3Writer to append")
         self._validate(ep)
         t, e, start = ep.length, len(self._rows), self._n_frames
-        tasks = dict(self._tasks)
-        task_index = tasks.setdefault(ep.instruction, len(tasks))
+        task_index = self._tasks.get(ep.instruction, len(self._tasks))
         done = np.zeros(t, bool)
         done[-1] = True
         numeric = {"observation.state": np.asarray(ep.state[:t], np.float32),
@@ -400,12 +567,11 @@ class LeRobotV3Writer:
                    "task_index": np.full(t, task_index, np.int64)}
         if self.environment_state_names:
             numeric["observation.environment_state"] = np.asarray(ep.environment_state[:t], np.float32)
-        columns, ep_stats, videos = {}, {}, []
+        columns, ep_stats, videos = {}, {}, {}
         for key, ft in self.features.items():
-            if ft["dtype"] == "video":  # one MP4 per episode; frame k at k / fps
+            if ft["dtype"] == "video":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
-                ep_stats[key] = _image_stats(images)
-                videos.append((key, images))
+                ep_stats[key], videos[key] = _image_stats(images), images
             elif ft["dtype"] == "image":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
                 columns[key], ep_stats[key] = _png_column(images), _image_stats(images)
@@ -414,60 +580,107 @@ class LeRobotV3Writer:
                 columns[key] = _vectors(arr) if arr.ndim == 2 else pa.array(arr, _ARROW[ft["dtype"]])
                 ep_stats[key] = _array_stats(arr)
         table = pa.table(columns)
-
-        chunk, file, current = self._chunk, self._file, self._current
-        if current is not None and current.num_rows and self._file_full(chunk, file, current.num_rows, t):
-            chunk, file = (chunk + 1, 0) if file + 1 >= self.chunks_size else (chunk, file + 1)
-            current = None
-        current = table if current is None else pa.concat_tables([current, table])
-        row = {"episode_index": e, "tasks": [ep.instruction], "length": t, "data/chunk_index": chunk,
-               "data/file_index": file, "dataset_from_index": start, "dataset_to_index": start + t,
-               "meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0}
-        vchunk, vfile = divmod(e, self.chunks_size)
-        for key, _ in videos:
-            row.update({f"videos/{key}/chunk_index": vchunk, f"videos/{key}/file_index": vfile,
-                        f"videos/{key}/from_timestamp": 0.0, f"videos/{key}/to_timestamp": t / self.fps})
-        row.update({f"stats/{k}/{s}": (np.asarray(v).astype(np.int64) if s == "count" else v).tolist()
-                    for k, d in ep_stats.items() for s, v in d.items()})
-        rows = [*self._rows, row]
-        stats = ep_stats if self._stats is None else _aggregate([self._stats, ep_stats])
-        info = self._info(len(rows), start + t, tasks)
-        r = self.root
+        # the journal entry: each camera's frames as their own video, then the rows and stats (its commit point)
+        segments = self._segments(e)
+        (self.root / PENDING_DIR).mkdir(parents=True, exist_ok=True)
         try:
-            movies = [(r / VIDEO_PATH.format(video_key=k, chunk_index=vchunk, file_index=vfile), frames)
-                      for k, frames in videos]
-            self._commit_episode(r, chunk, file, current, tasks, rows, stats, info, movies)
+            for key, path in segments.items():
+                encode(videos[key], path, self.fps, self.video_codec)
+            meta = {"instruction": ep.instruction, "stats": _jsonable(ep_stats)}
+            entry = table.replace_schema_metadata({"gendex": json.dumps(meta)})
+            sink = pa.BufferOutputStream()
+            with pa.ipc.new_file(sink, entry.schema) as ipc:
+                ipc.write_table(entry)
+            write_bytes(self.root / PENDING_DIR / f"episode-{e:06d}.arrow", sink.getvalue().to_pybytes())
         except BaseException:
-            if (r / JOURNAL_PATH).exists():  # committed but not fully applied: only a new writer may go on
-                self._closed = True
-                log.error("%s: commit of episode %d was interrupted; open a new writer to finish it", r, e)
+            for path in segments.values():
+                path.unlink(missing_ok=True)
             raise
-        self._rows, self._tasks, self._stats, self._n_frames = rows, tasks, stats, start + t
-        self._chunk, self._file, self._current = chunk, file, current
-        log.debug("%s: wrote episode %d (%d frames) to data chunk %d file %d", r, e, t, chunk, file)
+        self._append(table, ep.instruction, ep_stats, segments)
+        log.debug("%s: wrote episode %d (%d frames) to data chunk %d file %d", self.root, e, t, self._data.chunk,
+                  self._data.file)
         return e
 
-    def _commit_episode(self, r: Path, chunk, file, current, tasks, rows, stats, info, movies) -> None:
-        encoded = [(path, lambda p, f=frames: encode(f, p, self.fps, self.video_codec)) for path, frames in movies]
-        _commit(r, [*encoded,
-                    (r / DATA_PATH.format(chunk_index=chunk, file_index=file), lambda p: pq.write_table(current, p)),
-                    (r / TASKS_PATH, lambda p: pq.write_table(_tasks_table(tasks), p)),
-                    (r / EPISODES_PATH.format(chunk_index=0, file_index=0),
-                     lambda p: pq.write_table(pa.Table.from_pylist(rows), p)),
-                    (r / STATS_PATH, lambda p: _write_json(_jsonable(stats), p)),
-                    (r / INFO_PATH, lambda p: _write_json(info, p))])
+    def _append(self, table: pa.Table, instruction: str, ep_stats: dict, segments: dict[str, Path]) -> None:
+        """Add a journaled episode to the open data and video files (new ones when a size limit would be passed)."""
+        e, t, start, r = len(self._rows), table.num_rows, self._n_frames, self.root
+        try:
+            data = self._data
+            if data is not None and data.rows and \
+                    data.size * (1 + t / data.rows) >= self.data_files_size_in_mb * 1024 * 1024:
+                self._finished.append(data.finish())
+                self._data = _OpenData(r, *_next_file(data.chunk, data.file, self.chunks_size), table.schema)
+            elif data is None:
+                self._data = _OpenData(r, 0, 0, table.schema)
+            self._data.append(table)
+            row = {"episode_index": e, "tasks": [instruction], "length": t, "data/chunk_index": self._data.chunk,
+                   "data/file_index": self._data.file, "dataset_from_index": start, "dataset_to_index": start + t,
+                   "meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0}
+            for key, segment in segments.items():
+                video, size = self._videos.get(key), _packet_bytes(segment)
+                if video is None:
+                    video = self._videos[key] = self._open_video(key, 0, 0, segment)
+                elif video.frames and video.size + size >= self.video_files_size_in_mb * 1024 * 1024:
+                    self._finished.append(video.finish())
+                    video = self._videos[key] = self._open_video(
+                        key, *_next_file(video.chunk, video.file, self.chunks_size), segment)
+                first = video.frames
+                video.append(segment, self.fps)
+                row.update({f"videos/{key}/chunk_index": video.chunk, f"videos/{key}/file_index": video.file,
+                            f"videos/{key}/from_timestamp": first / self.fps,
+                            f"videos/{key}/to_timestamp": video.frames / self.fps})
+        except BaseException:
+            self._abandon()
+            log.error("%s: appending episode %d was interrupted; it is journaled: open a new writer to go on", r, e)
+            raise
+        row.update({f"stats/{k}/{s}": (np.asarray(v).astype(np.int64) if s == "count" else np.asarray(v)).tolist()
+                    for k, d in ep_stats.items() for s, v in d.items()})
+        self._rows.append(row)
+        self._tasks.setdefault(instruction, len(self._tasks))
+        self._stats = ep_stats if self._stats is None else _aggregate([self._stats, ep_stats])
+        self._n_frames = start + t
 
-    def _file_full(self, chunk: int, file: int, n_rows: int, n_new: int) -> bool:
-        """True when adding ``n_new`` rows (at the current file's bytes per row) reaches the size limit."""
-        size = (self.root / DATA_PATH.format(chunk_index=chunk, file_index=file)).stat().st_size
-        return size * (1 + n_new / n_rows) >= self.data_files_size_in_mb * 1024 * 1024
+    def _abandon(self) -> None:
+        """Stop without publishing: close the open files and remove every unpublished one (the journal stays)."""
+        self._closed = True
+        opened = ([self._data] if self._data is not None else []) + list(self._videos.values())
+        for f in opened:
+            try:
+                f.finish()
+            except Exception:  # a half-written temp file is removed below either way
+                pass
+        for path in [*self._finished, *(f.final for f in opened)]:
+            _tmp(path).unlink(missing_ok=True)
+        self._data, self._videos, self._finished = None, {}, []
 
     def close(self) -> None:
-        """Stop writing. Everything is already on disk and consistent after each ``add_episode``."""
-        if not self._closed:
-            self._closed = True
-            self._current = None
-            log.info("closed %s: %d episodes, %d frames", self.root, len(self._rows), self._n_frames)
+        """Publish the episodes added since the writer was opened (data and video files, meta) in one journaled
+        commit, and clear the journal. After it the dataset is complete and readable by lerobot."""
+        if self._closed:
+            return
+        if len(self._rows) == self._published:
+            self._abandon()
+            return
+        self._closed = True
+        r = self.root
+        try:
+            files = [*self._finished, *([self._data.finish()] if self._data is not None else []),
+                     *(v.finish() for v in self._videos.values())]
+            self._data, self._videos, self._finished = None, {}, []
+            rows, tasks, stats = self._rows, self._tasks, self._stats
+            info = self._info(len(rows), self._n_frames, tasks)
+            _commit(r, [*((f, None) for f in files),
+                        (r / TASKS_PATH, lambda p: pq.write_table(_tasks_table(tasks), p)),
+                        (r / EPISODES_PATH.format(chunk_index=0, file_index=0),
+                         lambda p: pq.write_table(pa.Table.from_pylist(rows), p)),
+                        (r / STATS_PATH, lambda p: _write_json(_jsonable(stats), p)),
+                        (r / INFO_PATH, lambda p: _write_json(info, p))])
+        except BaseException:
+            log.error("%s: closing was interrupted; the episodes are journaled: a new writer publishes them", r)
+            raise
+        shutil.rmtree(r / PENDING_DIR, ignore_errors=True)
+        self._published = len(rows)
+        log.info("closed %s: %d episodes, %d frames", r, len(rows), self._n_frames)
 
     finalize = close
 

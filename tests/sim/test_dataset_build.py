@@ -15,7 +15,7 @@ def test_building_the_smoke_manifest_reproduces_its_recorded_checksums(tmp_path)
     built = CliRunner().invoke(app, ["dataset", "build", "gendex-smoke", "--out", str(out), "--workers", "2"])
     assert built.exit_code == 0, built.output
     recorded = load_manifest("gendex-smoke").checksums
-    assert len(recorded) >= 10 and f"{len(recorded)} files match the manifest" in built.output
+    assert len(recorded) >= 8 and f"{len(recorded)} files match the manifest" in built.output
     video = next(out.rglob("*.mp4"))
     video.write_bytes(video.read_bytes()[:-1] + b"\x00")
     checked = CliRunner().invoke(app, ["dataset", "verify", str(out)])

@@ -221,7 +221,44 @@ def test_stray_temp_file_is_ignored_and_removed(dataset):
     assert_consistent(dataset)
 
 
-def test_crash_before_commit_leaves_old_dataset(dataset, monkeypatch):
+def test_a_killed_add_episode_changes_nothing_and_the_writer_goes_on(dataset, monkeypatch):
+    """Killed before its journal entry is complete, an episode is not in the dataset and the writer is still usable."""
+    before = meta(dataset)[0]
+
+    def die(path, data, **kw):
+        raise KeyboardInterrupt("killed while journaling")
+
+    w = writer(dataset)
+    monkeypatch.setattr(lv3, "write_bytes", die)
+    with pytest.raises(KeyboardInterrupt):
+        w.add_episode(make_episode(4, 6))
+    monkeypatch.undo()
+    assert w.total_episodes == 3 and not list((dataset / lv3.PENDING_DIR).iterdir())
+    assert w.add_episode(make_episode(4, 6)) == 3
+    w.close()
+    assert meta(dataset)[0]["total_episodes"] == 4 and meta(dataset)[0] != before
+    assert not (dataset / lv3.PENDING_DIR).exists()
+    assert_consistent(dataset)
+
+
+def test_added_episodes_are_published_at_close_and_a_killed_writer_loses_none(dataset):
+    """Until close() the visible files are the last closed dataset's (consistent and readable); the new episodes are
+    journaled, and a writer opened after a kill publishes them with the same bytes as an uninterrupted writer."""
+    files = {p: p.read_bytes() for p in dataset.rglob("*") if p.is_file()}
+    w = writer(dataset)
+    w.add_episode(make_episode(4, 6))
+    w.add_episode(make_episode(3, 7))
+    assert {p: p.read_bytes() for p in dataset.rglob("*") if p.is_file() and lv3.PENDING_DIR not in str(p)
+            and not p.name.endswith(".tmp")} == files
+    assert_consistent(dataset)
+    del w  # killed: never closed
+    with writer(dataset) as w2:
+        assert (w2.total_episodes, w2.total_frames) == (5, 23)
+    assert_consistent(dataset)
+    assert not (dataset / lv3.PENDING_DIR).exists() and not list(dataset.rglob(".*.tmp"))
+
+
+def test_a_writer_killed_while_closing_before_the_commit_point_leaves_the_old_dataset(dataset, monkeypatch):
     before = meta(dataset)[0]
     real = lv3._write_json
 
@@ -232,12 +269,14 @@ def test_crash_before_commit_leaves_old_dataset(dataset, monkeypatch):
 
     monkeypatch.setattr(lv3, "_write_json", die_on_info)
     w = writer(dataset)
+    w.add_episode(make_episode(4, 6))
     with pytest.raises(KeyboardInterrupt):
-        w.add_episode(make_episode(4, 6))
+        w.close()
     assert meta(dataset)[0] == before
     assert_consistent(dataset)
     monkeypatch.setattr(lv3, "_write_json", real)
-    assert w.add_episode(make_episode(4, 6)) == 3  # the writer is still usable
+    with writer(dataset) as w2:  # the journaled episode is published by the next writer
+        assert w2.total_episodes == 4
     assert_consistent(dataset)
 
 
@@ -249,19 +288,20 @@ def test_crash_mid_commit_is_rolled_forward(dataset, monkeypatch):
             raise KeyboardInterrupt("killed between data and meta")
         real(src, dst)
 
-    monkeypatch.setattr(lv3.os, "replace", die_after_data_rename)
     w = writer(dataset)
+    w.add_episode(make_episode(4, 7))
+    monkeypatch.setattr(lv3.os, "replace", die_after_data_rename)
     with pytest.raises(KeyboardInterrupt):
-        w.add_episode(make_episode(4, 7))
+        w.close()
     monkeypatch.setattr(lv3.os, "replace", real)
-    with pytest.raises(LeRobotDatasetError, match="closed"):  # its in-memory state is stale now
+    with pytest.raises(LeRobotDatasetError, match="closed"):
         w.add_episode(make_episode(2, 8))
     assert (dataset / "meta/.commit.json").exists()
     info, _, _ = meta(dataset)
     assert (info["total_frames"], read_episode_frames(dataset).num_rows) == (16, 20)  # never claims missing rows
     with writer(dataset) as w2:  # reopening finishes the commit
         assert (w2.total_episodes, w2.total_frames) == (4, 20)
-    assert not (dataset / "meta/.commit.json").exists()
+    assert not (dataset / "meta/.commit.json").exists() and not (dataset / lv3.PENDING_DIR).exists()
     assert_consistent(dataset)
 
 
@@ -318,32 +358,77 @@ def _smooth_episode(t: int, seed: int, h: int = 16, w: int = 24) -> Episode:
 
 @pytest.mark.parametrize("codec", ["libsvtav1", "libx264"])
 def test_camera_images_as_video_files_in_the_v3_layout(tmp_path, codec):
-    """With a video codec, camera frames go to videos/<key>/chunk-000/file-<episode>.mp4 (one file per episode,
-    frame k at k/fps), the feature is declared as video, the episode rows say where each episode's frames are, and
-    the same episodes give the same bytes."""
+    """With a video codec, camera frames go to videos/<key>/chunk-000/file-000.mp4, episode after episode (frame k of
+    an episode at from_timestamp + k/fps), the feature is declared as video, the episode rows say where each
+    episode's frames are, and the same episodes give the same bytes, also when the writer was closed and reopened
+    or killed between episodes."""
     from gendex_envs.video import decode
 
-    eps = [_smooth_episode(6, 1), _smooth_episode(4, 2)]
-    roots = [tmp_path / "a", tmp_path / "b"]
-    for root in roots:
-        with writer(root, cameras={"front": (16, 24)}, video_codec=codec) as w:
-            for e in eps:
-                w.add_episode(e)
+    eps = [_smooth_episode(6, 1), _smooth_episode(4, 2), _smooth_episode(5, 3)]
+    roots = [tmp_path / "a", tmp_path / "b", tmp_path / "c"]
+
+    def open_writer(root):
+        return writer(root, cameras={"front": (16, 24)}, video_codec=codec)
+
+    with open_writer(roots[0]) as w:
+        for e in eps:
+            w.add_episode(e)
+    with open_writer(roots[1]) as w:
+        w.add_episode(eps[0])
+    with open_writer(roots[1]) as w:
+        for e in eps[1:]:
+            w.add_episode(e)
+    w = open_writer(roots[2])
+    w.add_episode(eps[0])
+    w.add_episode(eps[1])
+    del w  # killed
+    with open_writer(roots[2]) as w:
+        w.add_episode(eps[2])
     info, stats, rows = meta(roots[0])
     key = "observation.images.front"
     assert info["video_path"] == lv3.VIDEO_PATH and info["features"][key]["dtype"] == "video"
     assert info["features"][key]["info"]["video.codec"] == {"libsvtav1": "av1", "libx264": "h264"}[codec]
     assert key not in read_episode_frames(roots[0]).column_names  # not inside the parquet
     assert np.asarray(stats[key]["mean"]).shape == (3, 1, 1)
-    for k, (e, row) in enumerate(zip(eps, rows.to_pylist(), strict=True)):
-        path = roots[0] / info["video_path"].format(video_key=key, chunk_index=row[f"videos/{key}/chunk_index"],
-                                                    file_index=row[f"videos/{key}/file_index"])
-        assert path.name == f"file-{k:03d}.mp4"
-        assert row[f"videos/{key}/from_timestamp"] == 0.0 and row[f"videos/{key}/to_timestamp"] == e.length / FPS
-        frames = decode(path)
-        assert frames.shape == (e.length, 16, 24, 3)  # T frames: one per action, like the parquet rows
-        assert np.abs(frames.astype(int) - e.images["front"][:e.length]).mean() < 12
-        assert path.read_bytes() == (roots[1] / path.relative_to(roots[0])).read_bytes()
+    path = roots[0] / "videos" / key / "chunk-000/file-000.mp4"
+    assert [p.name for p in path.parent.iterdir()] == ["file-000.mp4"]
+    frames, start = decode(path), 0
+    assert len(frames) == sum(e.length for e in eps)  # T frames per episode: one per action, like the parquet rows
+    for e, row in zip(eps, rows.to_pylist(), strict=True):
+        assert (row[f"videos/{key}/chunk_index"], row[f"videos/{key}/file_index"]) == (0, 0)
+        assert row[f"videos/{key}/from_timestamp"] == start / FPS
+        assert row[f"videos/{key}/to_timestamp"] == (start + e.length) / FPS
+        assert np.abs(frames[start:start + e.length].astype(int) - e.images["front"][:e.length]).mean() < 12
+        start += e.length
+    for root in roots[1:]:
+        files = sorted(p.relative_to(roots[0]) for p in roots[0].rglob("*") if p.is_file())
+        assert files == sorted(p.relative_to(root) for p in root.rglob("*") if p.is_file())
+        for f in files:
+            assert (roots[0] / f).read_bytes() == (root / f).read_bytes(), (root, f)
+
+
+def test_video_files_are_split_at_the_size_limit(tmp_path):
+    """A new video file (then a new chunk after chunks_size files) is started when the next episode would pass
+    video_files_size_in_mb; each episode's frames are in one file."""
+    from gendex_envs.video import decode
+
+    root = tmp_path / "split"
+    eps = [_smooth_episode(4, s) for s in range(5)]
+    with writer(root, cameras={"front": (16, 24)}, video_codec="libx264", chunks_size=2,
+                video_files_size_in_mb=2e-3) as w:  # about two episodes per file
+        for e in eps:
+            w.add_episode(e)
+    info, _, rows = meta(root)
+    assert info["video_files_size_in_mb"] == 2e-3
+    key = "observation.images.front"
+    where = [(r[f"videos/{key}/chunk_index"], r[f"videos/{key}/file_index"]) for r in rows.to_pylist()]
+    assert where[0] == (0, 0) and where[-1] > (0, 1) and len(set(where)) < len(where)
+    for (chunk, file) in sorted(set(where)):
+        here = [r for r, w in zip(rows.to_pylist(), where, strict=True) if w == (chunk, file)]
+        frames = decode(root / lv3.VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file))
+        assert len(frames) == sum(r["length"] for r in here) == round(here[-1][f"videos/{key}/to_timestamp"] * FPS)
+        assert here[0][f"videos/{key}/from_timestamp"] == 0.0
+    assert_consistent(root)
 
 
 def test_the_encoder_never_sees_uninitialised_row_padding(tmp_path):
