@@ -62,11 +62,18 @@ def test_known_defects_are_registered_versions_that_are_not_rewordings():
 
 
 def test_a_reworded_version_is_checked_through_its_source():
+    """Through its source, and once a run when the source is in the run too."""
     versions = registered_tasks()
     reworded = sorted(i for i, v in versions.items() if "reword" in v.provenance())
     assert reworded, "the library has reworded versions"
     source = versions[reworded[0]].provenance()["reword"]["source"]
     assert check.check_env_target(reworded[0], versions[reworded[0]]) == source in versions
+    alone = check.check_version(reworded[0])
+    assert alone.ok and alone.checks[2] == f"check_env (through {source})", alone
+    both = list(check.run_checks([source, reworded[0]]))
+    assert [r.id for r in both] == [source, reworded[0]] and all(r.ok for r in both), both
+    assert both[0].checks[2] == "check_env"
+    assert both[1].checks[2] == f"check_env (through {source}, checked in this run)"
 
 
 def test_selection_options():
