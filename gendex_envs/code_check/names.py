@@ -28,6 +28,7 @@ from gendex_envs.code_check.rules import (
     ALLOWED_BUILTINS,
     ALLOWED_MODULES,
     ALLOWED_PACKAGES,
+    BUILTIN_REASONS,
     CONTAINER_MUTATORS,
     FORBIDDEN_NAMES,
     FRESH_BUILTINS,
@@ -64,7 +65,10 @@ class NameRules:
                     continue
                 use = self.find_use(table, name)
                 where = "" if table.get_type() == "module" else f" (in `{table.get_name()}`)"
-                if hasattr(builtins, name):
+                if name in BUILTIN_REASONS:
+                    self.add(use, f"the builtin `{name}` is not allowed in reward code{where}: "
+                             f"{BUILTIN_REASONS[name]}")
+                elif hasattr(builtins, name):
                     self.add(use, f"the builtin `{name}` is not allowed in reward code{where}; allowed builtins: "
                              f"{', '.join(sorted(ALLOWED_BUILTINS))}")
                 else:

@@ -202,14 +202,22 @@ REQUIRED_FUNCTIONS = {"evaluate": ("env",), "compute_dense_reward": ("env", "obs
 OPTIONAL_FUNCTIONS = {"_get_obs_extra": ("env", "info")}
 
 ALLOWED_BUILTINS = frozenset({
-    "abs", "all", "any", "bool", "dict", "divmod", "enumerate", "filter", "float", "frozenset", "int",
-    "isinstance", "len", "list", "map", "max", "min", "pow", "range", "reversed", "round", "set", "slice", "sorted",
+    "abs", "all", "any", "bool", "dict", "divmod", "enumerate", "filter", "float", "int",
+    "isinstance", "len", "list", "map", "max", "min", "pow", "range", "reversed", "round", "slice", "sorted",
     "str", "sum", "tuple", "zip", "getattr", "hasattr",
     "ArithmeticError", "AssertionError", "Exception", "IndexError", "KeyError", "LookupError",
     "NotImplementedError", "RuntimeError", "TypeError", "ValueError", "ZeroDivisionError",
 })
-"""Builtins reward code may use (``getattr``/``hasattr`` only with a literal attribute name)."""
+"""Builtins reward code may use (``getattr``/``hasattr`` only with a literal attribute name). Not ``set`` or
+``frozenset``: a set of strings iterates in an order that changes with each process's hash seed, so the same module
+would give other rewards in the sandbox's worker, in another run, or on another machine; tuples and lists keep
+their order."""
 
+BUILTIN_REASONS = {
+    "set": "sets iterate in an order that changes from process to process; use a tuple or a list",
+    "frozenset": "sets iterate in an order that changes from process to process; use a tuple",
+}
+"""Why some builtins outside :data:`ALLOWED_BUILTINS` are refused (others get the list of allowed ones)."""
 FORBIDDEN_NAMES = frozenset({
     "open", "exec", "eval", "compile", "__import__", "globals", "locals", "vars", "input", "breakpoint", "exit",
     "quit", "memoryview", "help", "setattr", "delattr", "print", "__builtins__",
@@ -257,7 +265,7 @@ ALLOWED_NODE_TYPES = frozenset({
     "AugAssign", "AnnAssign", "For", "While", "If", "With", "withitem", "Raise", "Assert", "Pass", "Break",
     "Continue",
     # expressions
-    "BoolOp", "BinOp", "UnaryOp", "Lambda", "IfExp", "Dict", "Set", "ListComp", "SetComp", "DictComp",
+    "BoolOp", "BinOp", "UnaryOp", "Lambda", "IfExp", "Dict", "ListComp", "DictComp",
     "GeneratorExp", "comprehension", "Compare", "Call", "keyword", "JoinedStr", "FormattedValue", "Constant",
     "Attribute", "Subscript", "Starred", "Name", "List", "Tuple", "Slice",
     # contexts and operators
@@ -269,6 +277,8 @@ ALLOWED_NODE_TYPES = frozenset({
 ``ClassDef``, ``Global``, ``Try``, ``NamedExpr``, ``Delete``, async, ``yield``, ``TypeAlias``...) is rejected."""
 
 REJECTED_NODE_REASONS = {
+    "Set": "sets iterate in an order that changes from process to process; use a tuple or a list",
+    "SetComp": "sets iterate in an order that changes from process to process; use a list comprehension",
     "ClassDef": "reward code defines plain functions only",
     "AsyncFunctionDef": "async code is not allowed in reward modules",
     "AsyncFor": "async code is not allowed in reward modules",
@@ -297,7 +307,7 @@ FRESH_METHODS = frozenset({
     "expand", "expand_as", "unsqueeze", "squeeze", "flatten", "transpose", "permute", "t", "detach", "repeat",
 })
 """``x.<m>(...)`` is new (``clone``) or shares memory only with ``x``: fresh when ``x`` is."""
-FRESH_BUILTINS = frozenset({"list", "dict", "set", "tuple", "sorted", "len", "float", "int", "bool", "range",
+FRESH_BUILTINS = frozenset({"list", "dict", "tuple", "sorted", "len", "float", "int", "bool", "range",
                             "enumerate", "zip", "abs", "round"})
 CONTAINER_MUTATORS = frozenset({
     "append", "extend", "insert", "remove", "pop", "popitem", "clear", "update", "setdefault", "discard", "add",

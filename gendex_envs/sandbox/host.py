@@ -405,6 +405,7 @@ class RemoteModule:
         self.functions: tuple[str, ...] = ()
         self.reward_max = 1.0
         self.graphs: dict[tuple, list[replay.Graph]] = {}
+        self.graph_worker: Worker | None = None  # the worker whose recordings self.graphs holds
         self.traces_left: dict[str, int] = {}
         self.replays: dict[str, int] = {}
         """Per function: calls replayed in this process, and (``worker_calls``) calls the worker served."""
@@ -455,6 +456,8 @@ class RemoteModule:
             return early[3]
         view = view_of(env)
         signature = None
+        if self.graphs and (self.graph_worker is not self.worker or self.worker is None or not self.worker.alive()):
+            self.graphs.clear()  # a recording is worth what the worker that made it is: not past its end
         if self.replay_off is None:
             signature = (fn, view.num_envs, view.table_height, tuple(view.object_names),
                          tuple(view.stage_targets), replay.signature(args))
@@ -523,8 +526,10 @@ class RemoteModule:
             compiled = replay.compile_graph(graph, view.num_envs, torch.device(view.device),
                                             lambda source: _source_reader(source, arity))
             start = time.perf_counter()
-            replayed = compiled.run(view, args)
-            self._timed(fn, time.perf_counter() - start)
+            try:
+                replayed = compiled.run(view, args)
+            finally:
+                self._timed(fn, time.perf_counter() - start)
         except (replay.GraphError, replay.Miss) as exc:
             log.debug("reward module %s: %s's recording is not replayed: %s", self.path, fn, exc)
             return
@@ -533,6 +538,9 @@ class RemoteModule:
         if not agree(replayed, value):
             log.debug("reward module %s: %s's replay differs from its call; the worker serves it", self.path, fn)
             return
+        if self.graph_worker is not self.worker:
+            self.graphs.clear()
+            self.graph_worker = self.worker
         kept = self.graphs.setdefault(signature, [])
         kept.insert(0, compiled)
         del kept[MAX_VARIANTS:]

@@ -35,6 +35,10 @@ NOT_REPLAYED = frozenset({
     "torch.linalg.eigvalsh", "torch.linalg.matrix_rank", "torch.linalg.matrix_power", "torch.linalg.matrix_exp",
     "torch.linalg.matrix_norm", "torch.linalg.cond", "torch.linalg.tensorinv", "torch.linalg.tensorsolve",
     "torch.linalg.lu", "torch.linalg.lu_factor", "torch.linalg.lu_solve",
+    # special functions whose work comes from an argument's value (series summed until they converge, a range as
+    # long as an argument): zeta loops about -q times for a negative q, mvlgamma builds arange(p)
+    "torch.special.zeta", "torch.polygamma", "torch.special.polygamma", "torch.mvlgamma",
+    "torch.special.multigammaln", "torch.special.gammainc", "torch.special.gammaincc",
 })
 """Allow-listed names a compiled call does not replay: a graph holding one is not compiled (the worker keeps
 serving that function)."""
@@ -107,6 +111,24 @@ OPS, NAMES = _build()
 """``OPS``: name -> the function a replay calls; ``NAMES``: function (as the tracer sees it) -> its first name."""
 SHAPE_FUNCTIONS = tuple(OPS[n] for n in sorted(SHAPE_ARGUMENTS) if n in OPS)
 """The functions of :data:`SHAPE_ARGUMENTS` (compared by function, so an alias of one is held the same way)."""
+
+
+GUARDS = frozenset({
+    "Tensor.__bool__", "Tensor.__float__", "Tensor.__int__", "Tensor.__index__", "Tensor.__len__", "Tensor.item",
+    "Tensor.size", "Tensor.dim", "Tensor.numel", "Tensor.nelement", "Tensor.shape", "Tensor.dtype", "Tensor.device",
+    "Tensor.ndim", "Tensor.is_cuda", "Tensor.is_floating_point", "Tensor.is_complex", "Tensor.equal",
+    "Tensor.allclose", "Tensor.type", "torch.equal", "torch.allclose", "torch.is_nonzero", "torch.is_tensor",
+    "torch.is_floating_point", "torch.is_complex", "torch.numel", "torch.result_type", "torch.can_cast",
+    "torch.promote_types", "torch.broadcast_shapes",
+})
+"""Operations whose result is a Python value (a guard of the recording); every other operation's result is a
+tensor or a sequence of tensors, whatever a graph states."""
+GUARD_FUNCTIONS = tuple(OPS[n] for n in sorted(GUARDS) if n in OPS)
+
+
+def is_guard(name: str) -> bool:
+    fn = OPS[name]
+    return any(fn == f for f in GUARD_FUNCTIONS)
 
 
 def takes_shape_arguments(name: str) -> bool:

@@ -24,7 +24,9 @@ value the recorded call depended on, such as ``bool(x.any())``) that comes out o
 
 from __future__ import annotations
 
+import logging
 import math
+import time
 from collections.abc import Callable, Mapping
 
 import torch
@@ -32,7 +34,11 @@ import torch
 from gendex_envs.sandbox import ops
 from gendex_envs.sandbox.protocol import DTYPES
 
-MAX_ENTRIES = 4096
+MAX_ENTRIES = 1024
+"""Leaves plus operations of a graph (committed reward functions make 20-150)."""
+SHAPE_CHECK_S = 0.5
+"""Wall-clock budget of the fake-tensor run that proves a graph's shapes (committed graphs: 10-60 ms; torch's
+one-time set-up of fake tensors, about 1 s, is done before it starts)."""
 MAX_NODE_ELEMENTS_PER_ENV = 4096
 """A result may hold this many elements per env (a committed reward function's largest is 18: ``[N, 6, 3]``)."""
 MAX_NODE_ELEMENTS = 1 << 16
@@ -49,7 +55,8 @@ MAX_CONST_BYTES = 1 << 20
 """Constant tensors of one graph (module-level constants the call used; the recorder sends at most as much)."""
 MAX_PATH = 16
 _DTYPES = {**DTYPES, "complex64": torch.complex64, "complex128": torch.complex128}
-FORBIDDEN_KEYWORDS = frozenset({"out", "inplace"})
+FORBIDDEN_KEYWORDS = frozenset({"out", "inplace", "pin_memory", "requires_grad", "layout", "memory_format", "names"})
+"""Keywords a replayed operation may not get: results into other tensors, autograd, memory placement."""
 
 
 class GraphError(ValueError):
@@ -128,7 +135,7 @@ class _Decoder:
             self.const_bytes += rest[0].numel() * rest[0].element_size()
             if self.const_bytes > MAX_CONST_BYTES:
                 raise GraphError(f"more than {MAX_CONST_BYTES} bytes of constant tensors")
-            return _Const(rest[0])
+            return _Const(rest[0].clone())  # its own storage, not a view that keeps the whole frame alive
         if tag in ("$l", "$u"):
             items = [self.value(v, depth + 1) for v in rest]
             return items if tag == "$l" else tuple(items)
@@ -231,8 +238,8 @@ def _resolve_device(value, device):
 class Graph:
     """A checked graph of one reward function's call: :meth:`run` replays it on the current state."""
 
-    def __init__(self, steps: list, out, leaves: int, ops_count: int):
-        self.steps, self._out, self.leaves, self.ops = steps, out, leaves, ops_count
+    def __init__(self, steps: list, out, leaves: int, ops_count: int, device):
+        self.steps, self._out, self.leaves, self.ops, self.device = steps, out, leaves, ops_count, device
 
     def run(self, view, args: tuple):
         """The function's value on the current state of ``view`` (the env's reward view) with the call's ``args``.
@@ -256,11 +263,29 @@ class Graph:
                 else:
                     check(out)
                 vals[i] = out
-            return self._out(vals)
+            value = self._out(vals)
+            if not _on(value, self.device):
+                raise Miss("a returned tensor is not on the env's device, or requires grad")
+            return value
         except Miss:
             raise
         except Exception as exc:  # an error the worker would report with the module's line: let it
             raise Miss(f"{type(exc).__name__}: {str(exc)[:200]}") from None
+
+
+def _on(value, device, depth: int = 0) -> bool:
+    """Every tensor in ``value`` lies on ``device`` and does not require grad."""
+    if isinstance(value, torch.Tensor):
+        here = value.device
+        return (here.type == device.type and (device.index is None or here.index == device.index)
+                and not value.requires_grad)
+    if depth > 16:
+        return False
+    if isinstance(value, dict):
+        return all(_on(v, device, depth + 1) for v in value.values())
+    if isinstance(value, list | tuple):
+        return all(_on(v, device, depth + 1) for v in value)
+    return True
 
 
 def _checker(spec_kind, spec, decoder: _Decoder):
@@ -295,9 +320,21 @@ def _checker(spec_kind, spec, decoder: _Decoder):
         return check
 
     def check(out):
-        if type(out) is not type(expected) or out != expected:
+        if not _exactly(out, expected):
             raise Miss(f"guard {str(expected)[:60]} came out {str(out)[:60]}")
     return check
+
+
+def _exactly(a, b) -> bool:
+    """``a`` is ``b`` as a value: the same type, floats bit for bit (``-0.0`` is not ``0.0``, NaN is NaN), inside
+    tuples and lists too."""
+    if type(a) is not type(b):
+        return False
+    if type(a) is float:
+        return a.hex() == b.hex() if not (math.isnan(a) and math.isnan(b)) else True
+    if isinstance(a, tuple | list) and not isinstance(a, torch.Size):
+        return len(a) == len(b) and all(_exactly(x, y) for x, y in zip(a, b, strict=True))
+    return a == b
 
 
 def _spec(raw) -> tuple:
@@ -321,8 +358,8 @@ def compile_graph(raw, num_envs: int, device, source_reader: Callable[[list], Ca
     """``raw`` (a decoded graph from the worker) checked and bound to ``device``; raises :class:`GraphError`.
     ``source_reader(source)`` gives the function ``(view, args) -> tensor`` that reads a leaf's source, and raises
     (``TypeError``/``ValueError``) for a source the parent would not read."""
-    if not (isinstance(raw, dict) and isinstance(raw.get("entries"), list) and "out" in raw):
-        raise GraphError("a graph is an object with entries and out")
+    if not (isinstance(raw, dict) and set(raw) == {"entries", "out"} and isinstance(raw["entries"], list)):
+        raise GraphError("a graph is an object with entries and out, and nothing else")
     entries = raw["entries"]
     if len(entries) > MAX_ENTRIES:
         raise GraphError(f"{len(entries)} entries; at most {MAX_ENTRIES}")
@@ -360,9 +397,20 @@ def compile_graph(raw, num_envs: int, device, source_reader: Callable[[list], Ca
             raise GraphError(f"{name}: bad arguments")
         if FORBIDDEN_KEYWORDS & set(kwargs):
             raise GraphError(f"{name}: keywords {sorted(FORBIDDEN_KEYWORDS & set(kwargs))} are not replayed")
+        if "device" in kwargs and kwargs["device"] is not _DEVICE:
+            raise GraphError(f"{name}: a device other than the env's")
+        if name in ("Tensor.to", "Tensor.type") and any(isinstance(a, str) for a in args[1:]):
+            raise GraphError(f"{name}: a device or type named by a string")
         if ops.takes_shape_arguments(name) and (_holds(args[1:], (_Ref, _Const)) or _holds(kwargs, (_Ref, _Const))):
             raise GraphError(f"{name}: its sizes must be constants, not tensors")
         kind, spec = _spec(entry[4])
+        if (kind == "V") != ops.is_guard(name):
+            raise GraphError(f"{name} states a {'Python value' if kind == 'V' else 'tensor'} result; it gives "
+                             f"{'a tensor' if kind == 'V' else 'a Python value'}")
+        if kind == "N" and name != "Tensor.__setitem__":
+            raise GraphError(f"{name} states no result")
+        if kwargs.get("rounding_mode") == "trunc" and not (kind == "T" and spec[0].is_floating_point):
+            raise GraphError(f"{name}: integer division rounding to zero is not replayed (its overflow traps)")
         if kind == "T":
             total += _elements(spec[1], node_cap)
             kinds.append(("T",))
@@ -397,7 +445,7 @@ def compile_graph(raw, num_envs: int, device, source_reader: Callable[[list], Ca
             spec = [(d, torch.Size(s)) for d, s in spec]
         steps.append((1, ops.OPS[name], _binder(args, device), _binder(kwargs, device) if kwargs else None, stated,
                       _checker(kind, spec, decoder)))
-    return Graph(steps, _binder(out, device), n_leaves, len(steps) - n_leaves)
+    return Graph(steps, _binder(out, device), n_leaves, len(steps) - n_leaves, torch.device(device))
 
 
 _SORTING = frozenset({"sort", "argsort", "msort", "median", "nanmedian", "quantile", "nanquantile", "kthvalue", "topk",
@@ -432,7 +480,7 @@ def _work(name: str, args, kwargs, kind: str, spec, parsed: list) -> int:
     walk(kwargs)
     inputs = sum(math.prod(sh) for sh in shapes)
     out = math.prod(spec[1]) if kind == "T" else sum(math.prod(sh) for _, sh in spec) if kind == "S" else 1
-    base = inputs + out
+    base = inputs + out + _broadcast(shapes)
     short = name.rsplit(".", 1)[-1]
     if short in _SORTING:
         return base * max(1, math.ceil(math.log2(max(2, inputs))))
@@ -444,6 +492,18 @@ def _work(name: str, args, kwargs, kind: str, spec, parsed: list) -> int:
     if short.startswith(("fft", "ifft", "rfft", "irfft", "hfft", "ihfft")):
         return base * max(1, math.ceil(math.log2(max(2, inputs))))
     return base
+
+
+def _broadcast(shapes: list[tuple]) -> int:
+    """Elements of the broadcast of the inputs (what an elementwise operation, a loss or an indexed assignment
+    touches inside, whatever its result's size), or of all inputs but the first (index tensors of a subscript)."""
+    for group in (shapes, shapes[1:]):
+        if len(group) > 1:
+            try:
+                return math.prod(torch.broadcast_shapes(*group))
+            except (RuntimeError, ValueError, TypeError):
+                continue
+    return 0
 
 
 def _elements(shape: tuple, cap: int) -> int:
@@ -462,8 +522,33 @@ def _shape_check(parsed: list, out) -> None:
 
     cpu = torch.device("cpu")
     vals: list = [None] * len(parsed)
-    with FakeTensorMode(allow_non_fake_inputs=False) as mode:
+    quiet = logging.getLogger("torch._subclasses.fake_tensor")
+    level = quiet.level
+    quiet.setLevel(logging.CRITICAL)  # a kernel that cannot run on fake tensors logs its whole traceback
+    try:
+        _warm_fake_tensors(FakeTensorMode)
+        deadline = time.monotonic() + SHAPE_CHECK_S
+        _shape_run(parsed, out, vals, cpu, deadline, FakeTensorMode)
+    finally:
+        quiet.setLevel(level)
+
+
+_WARM: list[bool] = []
+
+
+def _warm_fake_tensors(fake_mode) -> None:
+    """torch's first fake-tensor run in a process sets itself up (about 1 s): once, outside any graph's budget."""
+    if not _WARM:
+        with fake_mode():
+            (torch.empty(2, 3) + 1.0).sum(-1)
+        _WARM.append(True)
+
+
+def _shape_run(parsed: list, out, vals: list, cpu, deadline: float, fake_mode) -> None:
+    with fake_mode(allow_non_fake_inputs=False) as mode:
         for i, p in enumerate(parsed):
+            if time.monotonic() > deadline:
+                raise GraphError(f"proving the graph's shapes took more than {SHAPE_CHECK_S} s")
             if p[0] == "L":
                 vals[i] = torch.empty(p[3], dtype=p[2])
                 continue
@@ -488,6 +573,8 @@ def _shape_check(parsed: list, out) -> None:
                     raise GraphError(f"{name} states results it does not give")
             elif kind == "N" and result is not None:
                 raise GraphError(f"{name} states no result but gives one")
+            elif kind == "V" and _holds(result, torch.Tensor):
+                raise GraphError(f"{name} states a Python value but gives a tensor")
             vals[i] = result
         _binder(out, cpu, mode.from_tensor)(vals)
 
@@ -504,6 +591,8 @@ def signature(value, depth: int = 0):
         return ("d", tuple((k, signature(v, depth + 1)) for k, v in value.items()))
     if isinstance(value, list | tuple):
         return (type(value).__name__, tuple(signature(v, depth + 1) for v in value))
-    if value is None or isinstance(value, bool | int | float | str):
+    if type(value) is float:
+        return ("v", "float", value.hex())  # -0.0 and 0.0 differ; NaN equals NaN
+    if value is None or isinstance(value, bool | int | str):
         return ("v", type(value).__name__, value)
     return ("o", type(value).__name__)

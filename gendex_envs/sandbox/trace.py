@@ -20,7 +20,7 @@ from torch.overrides import TorchFunctionMode
 
 from gendex_envs.sandbox.ops import NAMES
 
-MAX_ENTRIES = 4096
+MAX_ENTRIES = 1024
 """Leaves plus operations of one recorded call (a committed reward function makes 20-150 torch calls)."""
 MAX_CONST_BYTES = 1 << 20
 """Tensors the call uses that it did not read or compute (module-level constants) travel with the graph."""
