@@ -21,8 +21,8 @@ ALLOWED: dict[tuple[str, str], str] = {
     # The LeRobot writer commits several files at once: each is staged as .<name>.tmp, a journal lists the renames,
     # and a reopened writer rolls a committed journal forward and deletes stray .tmp files. The renames are that
     # protocol's, not a single-file write.
-    ("gendex/data/lerobot_v3.py", "_roll_forward"): "journaled multi-file commit",
-    ("gendex/data/lerobot_v3.py", "_commit"): "journaled multi-file commit",
+    ("gendex/data/lerobot_files.py", "_roll_forward"): "journaled multi-file commit",
+    ("gendex/data/lerobot_files.py", "_commit"): "journaled multi-file commit",
     # A pulled dataset is merged file by file into an --out folder that may hold other tasks already; the work
     # folder is complete before any file moves, and removed afterwards.
     ("gendex/data/datasets.py", "_move_into"): "merge of a finished pull into an existing folder",

@@ -16,6 +16,7 @@ import pytest
 import yaml
 from PIL import Image
 
+from gendex.data import lerobot_files
 from gendex.data import lerobot_v3 as lv3
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.lerobot_v3 import LeRobotDatasetError, LeRobotV3Writer, read_episode_frames, write_dataset_card
@@ -290,10 +291,10 @@ def test_crash_mid_commit_is_rolled_forward(dataset, monkeypatch):
 
     w = writer(dataset)
     w.add_episode(make_episode(4, 7))
-    monkeypatch.setattr(lv3.os, "replace", die_after_data_rename)
+    monkeypatch.setattr(lerobot_files.os, "replace", die_after_data_rename)
     with pytest.raises(KeyboardInterrupt):
         w.close()
-    monkeypatch.setattr(lv3.os, "replace", real)
+    monkeypatch.setattr(lerobot_files.os, "replace", real)
     with pytest.raises(LeRobotDatasetError, match="closed"):
         w.add_episode(make_episode(2, 8))
     assert (dataset / "meta/.commit.json").exists()
