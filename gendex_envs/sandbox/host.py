@@ -445,7 +445,12 @@ class RemoteModule:
         reward right after the extras, in the same round trip and from the same snapshot; the following
         ``compute_dense_reward`` call returns it if it comes next for the same env, the same ``info`` (the same
         tensor objects under the same keys) and the same ``elapsed_steps``, else it runs as usual. Two round
-        trips a step instead of three."""
+        trips a step instead of three.
+
+        Before any of that, a call whose function and argument signature have a kept recording is replayed in this
+        process (:mod:`gendex_envs.sandbox.replay`; up to :data:`MAX_VARIANTS` graphs, tried in turn); a call the
+        worker serves is recorded (at most :data:`MAX_TRACES` times per function) and the recording kept when it
+        passes :meth:`_keep`. Replays are audited against the worker (:data:`AUDIT_AT`, :data:`AUDIT_EVERY`)."""
         from gendex_envs.reward_view import view_of
 
         early, self.early = self.early, None
