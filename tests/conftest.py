@@ -98,6 +98,20 @@ def make_env():
         env.close()
 
 
+@pytest.fixture(scope="module")
+def reward_env():
+    """A bare PutAppleBowl env (state observations, no renderer) reset with seed 0, shared by a test file's tests
+    that call reward modules against it."""
+    from gendex_envs.registry import resolve_task
+    from gendex_envs.task_env import TaskEnv
+
+    e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
+                render_backend="none")
+    e.reset(seed=0)
+    yield e
+    e.close()
+
+
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository (for tests of its own files: docs, benchmarks, the source tree)."""

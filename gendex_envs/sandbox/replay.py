@@ -101,7 +101,6 @@ def _dtype(raw) -> torch.dtype:
 class _Decoder:
     def __init__(self, kinds: list):
         self.kinds = kinds  # per entry: ("T",) or ("S", n) or ("V",) / ("N",)
-        self.refs = 0
         self.const_bytes = 0
 
     def value(self, raw, depth: int = 0):
@@ -127,7 +126,6 @@ class _Decoder:
             if not (rest[1] is None and kind_of[0] == "T" or kind_of[0] == "S" and type(rest[1]) is int
                     and 0 <= rest[1] < kind_of[1]):
                 raise GraphError(f"reference {str(raw)[:100]} to a result that is not a tensor")
-            self.refs += 1
             return _Ref(rest[0], rest[1])
         if tag == "$c":
             if not (len(rest) == 1 and isinstance(rest[0], torch.Tensor)):
@@ -288,7 +286,7 @@ def _on(value, device, depth: int = 0) -> bool:
     return True
 
 
-def _checker(spec_kind, spec, decoder: _Decoder):
+def _checker(spec_kind, spec):
     """A function that raises :class:`Miss` unless a result matches its stated spec."""
     if spec_kind == "T":
         dtype, shape = spec
@@ -444,7 +442,7 @@ def compile_graph(raw, num_envs: int, device, source_reader: Callable[[list], Ca
         elif kind == "S":
             spec = [(d, torch.Size(s)) for d, s in spec]
         steps.append((1, ops.OPS[name], _binder(args, device), _binder(kwargs, device) if kwargs else None, stated,
-                      _checker(kind, spec, decoder)))
+                      _checker(kind, spec)))
     return Graph(steps, _binder(out, device), n_leaves, len(steps) - n_leaves, torch.device(device))
 
 

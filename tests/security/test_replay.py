@@ -17,7 +17,6 @@ import pytest
 import torch
 
 from gendex_envs import guard
-from gendex_envs.registry import resolve_task
 from gendex_envs.reward_module import load_reward_module
 from gendex_envs.sandbox import host, replay
 
@@ -213,14 +212,8 @@ def compute_dense_reward(env, obs, action, info):
 
 
 @pytest.fixture(scope="module")
-def env():
-    from gendex_envs.task_env import TaskEnv
-
-    e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
-                render_backend="none")
-    e.reset(seed=0)
-    yield e
-    e.close()
+def env(reward_env):
+    return reward_env
 
 
 @pytest.fixture

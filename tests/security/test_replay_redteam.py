@@ -27,7 +27,6 @@ import sapien
 import torch
 
 from gendex_envs import guard
-from gendex_envs.registry import resolve_task
 from gendex_envs.reward_module import load_reward_module
 from gendex_envs.sandbox import host, replay
 
@@ -319,14 +318,8 @@ def test_argument_leaves_are_copies_even_when_reached_by_index():
 
 # ---------------------------------------------------------------------------------------------- the whole path
 @pytest.fixture(scope="module")
-def env():
-    from gendex_envs.task_env import TaskEnv
-
-    e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
-                render_backend="none")
-    e.reset(seed=0)
-    yield e
-    e.close()
+def env(reward_env):
+    return reward_env
 
 
 def _put_apple(env, x=None, y=None) -> None:

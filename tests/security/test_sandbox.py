@@ -42,14 +42,8 @@ def _sandbox_host():
 
 
 @pytest.fixture(scope="module")
-def env():
-    from gendex_envs.task_env import TaskEnv
-
-    e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
-                render_backend="none")
-    e.reset(seed=0)
-    yield e
-    e.close()
+def env(reward_env):
+    return reward_env
 
 
 @pytest.fixture

@@ -74,14 +74,8 @@ def compute_dense_reward(env, obs, action, info):
 
 
 @pytest.fixture(scope="module")
-def env():
-    from gendex_envs.task_env import TaskEnv
-
-    e = TaskEnv(task=resolve_task("PutAppleBowl"), obs_mode="state", control_mode="pd_joint_delta_pos",
-                render_backend="none")
-    e.reset(seed=0)
-    yield e
-    e.close()
+def env(reward_env):
+    return reward_env
 
 
 def _put_apple(env, x: float) -> None:
