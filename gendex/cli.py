@@ -12,7 +12,6 @@ import gendex_envs.blas  # noqa: F401  (first: it pins OpenBLAS's kernels before
 
 import functools
 import logging
-import time
 from pathlib import Path
 
 import typer
@@ -562,42 +561,24 @@ def demo(out: Path = typer.Option(Path("out/demo"), "--out", help="Folder for re
          generate_n: int = typer.Option(1, "--generate", min=0,
                                         help="New tasks to generate with the offline author into OUT/generated_tasks.")
          ) -> None:
-    """The main job on embedded defaults: build every task, render its views, roll out random actions, generate a new
-    task with the offline author, then collect a few successful PutAppleBowl episodes with the stage executor into a
+    """The main job on embedded defaults: build the newest version of every task, render its views, roll out random
+    actions, lay the views out as one contact sheet (OUT/contact_sheet.png) and print a table; then generate a new
+    task with the offline author and collect a few successful PutAppleBowl episodes with the stage executor into a
     LeRobot v3.0 dataset."""
-    import gymnasium as gym
-    import numpy as np
-    from tqdm import tqdm
-
+    from gendex.demo import format_table, run_demo
     from gendex_envs.registry import registered_tasks
 
-    rows = []
-    for env_id in tqdm(sorted(registered_tasks()), desc="tasks", unit="task"):
-        paths = _render_views(env_id, out, seed)
-        env = gym.make(env_id, control_mode="pd_joint_delta_pos")
-        try:
-            env.reset(seed=seed)
-            env.action_space.seed(seed)
-            rewards, t0 = [], time.perf_counter()
-            for _ in range(steps):
-                _, reward, terminated, truncated, info = env.step(env.action_space.sample())
-                rewards.append(float(reward))
-                if terminated or truncated:
-                    env.reset()
-            rate = steps / (time.perf_counter() - t0)
-        finally:
-            env.close()
-        rows.append((env_id, rate, np.isfinite(rewards).all(), float(np.mean(rewards)), paths))
-    typer.echo("\nGenDex demo summary")
-    for env_id, rate, finite, mean_r, paths in rows:
-        typer.echo(f"  {env_id}: {steps} random steps at {rate:.0f} steps/s, reward finite={finite}, "
-                   f"mean reward {mean_r:.3f}")
-        for name, path in paths.items():
-            typer.echo(f"      {name:15s} {path}")
+    rows, sheet = run_demo(registered_tasks(), out, steps=steps, seed=seed)
+    typer.echo(f"\nGenDex demo: the newest version of {len(rows)} tasks, {steps} random steps each; "
+               f"views in {out}/<Task>-v<N>_<view>.png, contact sheet {sheet}")
+    for line in format_table(rows):
+        typer.echo(line)
     if generate_n:
         _demo_generate(out / "generated_tasks", generate_n, seed)
     if collect_n:
         _demo_collect(out / "PutAppleBowl_dataset", collect_n, seed)
+    if not all(r.rewards_finite for r in rows):
+        raise typer.Exit(code=1)
 
 
 def _demo_generate(out: Path, n: int, seed: int) -> None:
