@@ -85,18 +85,17 @@ def stage_episode(env: gym.Env, seed: int, reset: Callable[[gym.Env, object], No
 
 def executor_episode(env: gym.Env, seed: int, executor) -> dict:
     """One attempt of the stage executor, as ``gendex collect`` runs it."""
+    from gendex.episode_loop import Hooks
     from gendex.solve.attempt import run_attempt
 
     rotation: list[float] = []
     dropped = [False]
 
-    def step(action):
-        out = env.step(action)
-        rotation.append(math.degrees(float(out[-1]["rotation"])))
-        dropped[0] |= bool(out[-1]["fail"])
-        return out
+    def watch(step) -> None:
+        rotation.append(math.degrees(float(step.info["rotation"])))
+        dropped[0] |= bool(step.info["fail"])
 
-    outcome = run_attempt(env, executor, seed, step=step)
+    outcome = run_attempt(env, executor, seed, Hooks(on_step=watch))
     return dict(seed=seed, success_step=outcome.steps if outcome.succeeded else None,
                 dropped=dropped[0] and not outcome.succeeded, rotation=rotation,
                 failure=None if outcome.failure is None else str(outcome.failure))

@@ -277,7 +277,7 @@ def _attempt(env: gym.Env, recorder: EpisodeRecorder, solver: Solver, seed: int,
         for c in cameras:
             frames[c].append(_image(obs, c))
 
-    failure = run_attempt(env, solver, seed, begin=recorder.begin, step=recorder.step, on_obs=see).failure
+    failure = run_attempt(env, solver, seed, recorder.hooks(seed, see)).failure
     if recorder.steps == 0:
         return None, {}, failure or Failure("target_not_reached", detail="the solver took no step")
     return recorder.episode(), {c: np.stack(v) for c, v in frames.items()}, failure

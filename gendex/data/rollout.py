@@ -12,14 +12,16 @@ depends on except PhysX's internal caches (contacts, solver warm start) and the 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 import torch
 
 from gendex.data.episode import Episode, EpisodeError
+from gendex.episode_loop import Hooks, Step
 from gendex_envs import observation
 
 
@@ -158,26 +160,54 @@ def env_info(env: gym.Env) -> dict:
 
 
 class EpisodeRecorder:
-    """Record an episode step by step (closed-loop solvers): ``begin(seed)``, ``step(action)``..., ``episode()``."""
+    """Record an episode step by step (closed-loop solvers): as the hooks of one run of the episode loop
+    (:meth:`hooks`), or by hand: ``begin(seed)``, ``step(action)``..., then ``episode()``."""
 
     def __init__(self, env: gym.Env):
         self.env = env
         self._u = _base(env)
 
+    def hooks(self, seed: int, see: Callable[[Any], None] | None = None) -> Hooks:
+        """Hooks of :func:`gendex.episode_loop.run_episode` that record its episode from ``env.reset(seed=seed)``:
+        every action is stepped as float32 ``[A]`` and recorded; ``see`` sees every observation."""
+        def on_reset(obs, info) -> None:
+            self.start(seed)
+            if see is not None:
+                see(obs)
+
+        def on_step(step: Step) -> None:
+            self.record(step.action, step.reward, step.info)
+            if see is not None:
+                see(step.obs)
+
+        return Hooks(prepare=self.as_action, on_reset=on_reset, on_step=on_step)
+
     def begin(self, seed: int):
         """Reset with ``seed`` and record the initial state; returns the reset's (obs, info)."""
         out = self.env.reset(seed=int(seed))
+        self.start(seed)
+        return out
+
+    def start(self, seed: int) -> None:
+        """Record the initial state of an episode the env was just reset into with ``seed``."""
         self.seed = int(seed)
         self._states, self._env_states = [robot_state(self.env)], [flat_env_state(self.env)]
         self._world = [environment_state(self.env)]
         self._actions, self._rewards, self._success, self._fail = [], [], [], []
-        return out
+
+    def as_action(self, action) -> np.ndarray:
+        """``action`` as what is stepped and recorded: float32 ``[A]``."""
+        return np.asarray(action, dtype=np.float32).reshape(self.env.action_space.shape[-1:])
 
     def step(self, action):
         """Step ``action`` and record it; returns ``env.step``'s result."""
-        action = np.asarray(action, dtype=np.float32).reshape(self.env.action_space.shape[-1:])
+        action = self.as_action(action)
         out = self.env.step(action)
-        _, reward, _, _, step_info = out
+        self.record(action, out[1], out[4])
+        return out
+
+    def record(self, action: np.ndarray, reward, step_info: dict) -> None:
+        """Record a step the env just took with ``action`` (from :meth:`as_action`)."""
         self._actions.append(action.copy())
         self._rewards.append(_scalar(reward))
         self._success.append(bool(_scalar(step_info["success"])))
@@ -185,7 +215,6 @@ class EpisodeRecorder:
         self._states.append(robot_state(self.env))
         self._env_states.append(flat_env_state(self.env))
         self._world.append(environment_state(self.env))
-        return out
 
     @property
     def steps(self) -> int:

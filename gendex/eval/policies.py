@@ -23,6 +23,7 @@ from collections.abc import Callable
 import gymnasium as gym
 import numpy as np
 
+from gendex.episode_loop import SolverAgent
 from gendex_envs.errors import ExecutionError, GenDexError
 
 log = logging.getLogger(__name__)
@@ -70,17 +71,17 @@ class OraclePolicy(_Bound):
         from gendex.solve import SOLVERS
 
         super().bind(env)
-        self.solver = SOLVERS["stages"]()
-        self.inner = env.env  # the gym.make env under LeRobotObservation: what the executor drives
+        # the executor drives the gym.make env under LeRobotObservation and reads it, not the observation
+        self.solver = SolverAgent(SOLVERS["stages"](), env.env)
 
     def reset(self) -> None:
-        self.solver.reset(self.inner, None)
+        self.solver.reset()
         self.done = False
 
     def act(self, obs) -> np.ndarray:
         if not self.done:
             try:
-                action = self.solver.act(self.inner, None)
+                action = self.solver.act(None)
             except ExecutionError as exc:
                 log.info("oracle gave up: %s", exc)
                 action = None

@@ -25,6 +25,7 @@ from typing import Any, Protocol
 import gymnasium as gym
 import numpy as np
 
+from gendex.episode_loop import Hooks, bind, run_episode
 from gendex_envs.observation import LeRobotObservation
 from gendex_envs.registry import HISTORY_FREE
 
@@ -35,6 +36,8 @@ ACTION_TOL = 1e-4
 
 
 class Policy(Protocol):
+    """An :class:`gendex.episode_loop.Agent` acting on LeRobotObservation's dict, with the env's action space."""
+
     def reset(self) -> None: ...
 
     def act(self, obs: dict[str, np.ndarray]) -> np.ndarray: ...
@@ -88,45 +91,53 @@ def _check_action(action: Any, space: gym.spaces.Box) -> tuple[np.ndarray | None
     return np.clip(a, low, high), None
 
 
-def run_episode(env: gym.Env, policy: Policy, task: str, seed: int,
-                frames: list[np.ndarray] | None = None) -> EpisodeResult:
-    """One episode of ``policy`` from ``env.reset(seed=seed)`` until the time limit or termination (``frames``: a
-    list the rendered frame of every step is appended to)."""
-    t0 = time.perf_counter()
-    obs, _ = env.reset(seed=int(seed))
-    if frames is not None:
-        frames.append(np.asarray(env.render()))
-    failure = None
-    once = end = False
-    total, best, steps = 0.0, -np.inf, 0
-    try:
-        policy.reset()
-    except Exception as exc:  # the policy is the user's code: any error fails this episode only
-        failure = f"the policy's reset() raised {type(exc).__name__}: {exc}"
-    while failure is None:
+class PolicyFault(Exception):
+    """The policy made its episode fail (it raised, or gave a NaN or out-of-range action); the message says how."""
+
+
+class _Guarded:
+    """The user's policy as the loop's agent: whatever it raises, and an action it gives that is not finite or not
+    in the action space, becomes a :class:`PolicyFault` that fails the episode (an action is clipped into the
+    space)."""
+
+    def __init__(self, policy: Policy, space: gym.spaces.Box):
+        self.policy, self.space = policy, space
+
+    def reset(self) -> None:
+        self.fault: str | None = None
         try:
-            raw = policy.act(obs)
+            self.policy.reset()
+        except Exception as exc:  # the policy is the user's code: any error fails this episode only
+            self.fault = f"the policy's reset() raised {type(exc).__name__}: {exc}"
+
+    def act(self, obs) -> np.ndarray:
+        if self.fault is not None:
+            raise PolicyFault(self.fault)
+        try:
+            raw = self.policy.act(obs)
         except Exception as exc:  # as above
-            failure = f"the policy's act() raised {type(exc).__name__}: {exc}"
-            break
-        action, failure = _check_action(raw, env.action_space)
+            raise PolicyFault(f"the policy's act() raised {type(exc).__name__}: {exc}") from exc
+        action, failure = _check_action(raw, self.space)
         if failure is not None:
-            break
-        obs, reward, terminated, truncated, info = env.step(action)
-        if frames is not None:
-            frames.append(np.asarray(env.render()))
-        steps += 1
-        total += float(reward)
-        best = max(best, float(reward))
-        end = bool(np.asarray(info.get("success", False)).reshape(-1)[0])
-        once = once or end
-        if terminated or truncated:
-            break
+            raise PolicyFault(failure)
+        return action
+
+
+def evaluate_episode(env: gym.Env, policy: Policy, task: str, seed: int,
+                     frames: list[np.ndarray] | None = None) -> EpisodeResult:
+    """One episode of ``policy`` from ``env.reset(seed=seed)`` until the time limit or termination
+    (:func:`gendex.episode_loop.run_episode`; ``frames``: a list the rendered frame of every step is appended to)."""
+    t0 = time.perf_counter()
+    hooks = Hooks(catch=(PolicyFault,))
+    if frames is not None:
+        hooks = Hooks(on_reset=lambda obs, info: frames.append(np.asarray(env.render())),
+                      on_step=lambda step: frames.append(np.asarray(env.render())), catch=(PolicyFault,))
+    out = run_episode(env, _Guarded(policy, env.action_space), seed, hooks)
+    failure = None if out.error is None else str(out.error)
     if failure is not None:
         log.info("%s seed %d: %s", task, seed, failure)
-        end = False
-    return EpisodeResult(task, int(seed), once, end, total, best if steps else 0.0, steps,
-                         round(time.perf_counter() - t0, 3), failure)
+    return EpisodeResult(task, int(seed), out.success_once, out.success_at_end and failure is None, out.sum_reward,
+                         out.max_reward, out.steps, round(time.perf_counter() - t0, 3), failure)
 
 
 def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[int], *,
@@ -140,21 +151,20 @@ def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[
     env = make_eval_env(task, env_kwargs, max_episode_steps, render=videos > 0)
     try:
         policy = make_policy()
-        if hasattr(policy, "bind"):
-            try:
-                policy.bind(env)
-            except Exception as exc:  # the policy cannot act here: each episode fails with the reason
-                why = f"policy bind raised {type(exc).__name__}: {exc}"
-                log.info("%s: %s", task, why)
-                out = [EpisodeResult(task, int(seed), False, False, 0.0, 0.0, 0, 0.0, why) for seed in seeds]
-                for r in out:
-                    if progress is not None:
-                        progress(r)
-                return out
+        try:
+            bind(policy, env)
+        except Exception as exc:  # the policy cannot act here: each episode fails with the reason
+            why = f"policy bind raised {type(exc).__name__}: {exc}"
+            log.info("%s: %s", task, why)
+            out = [EpisodeResult(task, int(seed), False, False, 0.0, 0.0, 0, 0.0, why) for seed in seeds]
+            for r in out:
+                if progress is not None:
+                    progress(r)
+            return out
         out = []
         for k, seed in enumerate(seeds):
             frames = [] if k < videos and video_dir is not None else None
-            r = run_episode(env, policy, task, seed, frames)
+            r = evaluate_episode(env, policy, task, seed, frames)
             if frames:
                 video_dir.mkdir(parents=True, exist_ok=True)
                 path = video_dir / f"{task.split('/')[-1]}_{seed}.mp4"
@@ -169,4 +179,5 @@ def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[
         env.close()
 
 
-__all__ = ["ACTION_TOL", "EpisodeResult", "Policy", "evaluate_task", "make_eval_env", "run_episode"]
+__all__ = ["ACTION_TOL", "EpisodeResult", "Policy", "PolicyFault", "evaluate_episode", "evaluate_task",
+           "make_eval_env"]

@@ -328,7 +328,8 @@ def resave_trusted_checkpoint(path: Path | str, out: Path | str | None = None) -
 
 @dataclass
 class BCPolicy:
-    """A trained checkpoint as an evaluation policy: ``reset()``, ``act(obs)`` on LeRobotObservation's dict."""
+    """A trained checkpoint as an evaluation policy (an agent of :func:`gendex.episode_loop.run_episode`, which
+    ``gendex eval`` runs it in): ``bind(env)``, ``reset()``, ``act(obs)`` on LeRobotObservation's dict."""
 
     path: Path | str
     ckpt: dict = field(init=False, repr=False)

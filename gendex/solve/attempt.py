@@ -1,19 +1,18 @@
 """One attempt of a solver on a task: reset by seed, act until the solver finishes, gives up or the episode ends,
 and say whether it succeeded and, if not, why (:class:`~gendex.solve.failure.Failure`).
 
-``gendex collect`` records its attempts through this loop (its ``begin`` / ``step`` hooks record the episode); the
+The attempt is :func:`gendex.episode_loop.run_episode` with the solver as its agent
+(:class:`~gendex.episode_loop.SolverAgent`); an :class:`~gendex_envs.errors.ExecutionError` of the solver ends it as
+a failed attempt. ``gendex collect`` records its attempts through ``hooks`` (a recorder and camera frames); the
 generator's solvability gate runs it bare.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, replace
 
-import numpy as np
-
+from gendex.episode_loop import NO_HOOKS, Hooks, SolverAgent, run_episode, succeeded
 from gendex.solve.failure import Failure
 from gendex_envs.errors import ExecutionError
 
@@ -28,44 +27,18 @@ class AttemptOutcome:
     """Why it failed (None when it succeeded)."""
 
 
-def succeeded(info: dict) -> bool:
-    """The env's ``success`` of a single-env step info."""
-    value = info.get("success", False)
-    return bool(np.asarray(value.cpu() if hasattr(value, "cpu") else value).reshape(-1)[0])
-
-
-def run_attempt(env, solver, seed: int, begin: Callable[[int], tuple[Any, dict]] | None = None,
-                step: Callable[[Any], tuple] | None = None,
-                on_obs: Callable[[Any], None] | None = None) -> AttemptOutcome:
-    """Run ``solver`` on ``env`` from ``env.reset(seed=seed)`` (or ``begin(seed)``), stepping with ``env.step`` (or
-    ``step``); ``on_obs`` sees every observation."""
-    obs, info = begin(seed) if begin is not None else env.reset(seed=seed)
-    step = step if step is not None else env.step
-    solver.reset(env, obs)
-    if on_obs is not None:
-        on_obs(obs)
+def run_attempt(env, solver, seed: int, hooks: Hooks = NO_HOOKS) -> AttemptOutcome:
+    """Run ``solver`` on ``env`` from ``env.reset(seed=seed)`` until it returns None, raises ExecutionError or the
+    episode ends; ``hooks`` (:class:`~gendex.episode_loop.Hooks`, its ``catch`` replaced) see the episode."""
+    out = run_episode(env, SolverAgent(solver, env), seed, replace(hooks, catch=(ExecutionError,)))
     failure: Failure | None = None
-    terminated = truncated = False
-    steps = 0
-    while True:
-        try:
-            action = solver.act(env, obs)
-        except ExecutionError as exc:  # the solver gave up on this attempt: a failed attempt, not a crash
-            failure = Failure.of_error(exc)
-            log.info("attempt with seed %d: %s", seed, failure)
-            break
-        if action is None:
-            break
-        obs, _, terminated, truncated, info = step(action)
-        steps += 1
-        if on_obs is not None:
-            on_obs(obs)
-        if terminated or truncated:
-            break
-    ok = failure is None and succeeded(info)
+    if out.error is not None:  # the solver gave up on this attempt: a failed attempt, not a crash
+        failure = Failure.of_error(out.error)
+        log.info("attempt with seed %d: %s", seed, failure)
+    ok = failure is None and succeeded(out.info)
     if failure is None and not ok:
-        failure = Failure.of_ending(solver, env, bool(terminated), bool(truncated))
-    return AttemptOutcome(ok, steps, failure)
+        failure = Failure.of_ending(solver, env, out.terminated, out.truncated)
+    return AttemptOutcome(ok, out.steps, failure)
 
 
 __all__ = ["AttemptOutcome", "run_attempt", "succeeded"]

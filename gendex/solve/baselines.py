@@ -10,7 +10,10 @@ import numpy as np
 
 
 class Solver(Protocol):
-    """Drives one episode: ``reset`` after the env reset, then ``act`` until it returns None or the episode ends."""
+    """Drives one episode: ``reset`` after the env reset, then ``act`` until it returns None or the episode ends.
+
+    A solver reads the env: ``obs`` may be None (:class:`gendex.episode_loop.SolverAgent`, how the episode loop runs a
+    solver, resets it without one)."""
 
     name: str
 

@@ -25,6 +25,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from gendex.episode_loop import Hooks, SolverAgent, run_episode
 from gendex.fanout import Backend, ordered_map
 from gendex.solve.executor import StageExecutor
 from gendex.solve.policy import StagePolicy
@@ -165,8 +166,8 @@ def run_cell(version: TaskVersion, variant: str, budget: int, out: Path, *, seed
                 if states is not None:  # captured at this stage's success: the next stage's start states
                     states = dataclasses.replace(states, stage=spec.stages[i + 1].name)
         else:
-            cell.successes, cell.eval_steps = evaluate_task(version, policies, eval_episodes, seed=seed + 100_000,
-                                                            policy_stages="all" if all_rl else "rl")
+            cell.successes, cell.eval_steps = evaluate_executor(version, policies, eval_episodes, seed=seed + 100_000,
+                                                                policy_stages="all" if all_rl else "rl")
     cell.wall_s = time.perf_counter() - t0
     (run / "cell.json").write_text(json.dumps(cell.as_dict(), indent=2) + "\n")
     log.info("%s %s: %d/%d successes, %d train + %d collect steps, %.0f s", spec.name, variant, cell.successes,
@@ -174,34 +175,26 @@ def run_cell(version: TaskVersion, variant: str, budget: int, out: Path, *, seed
     return cell
 
 
-def evaluate_task(version: TaskVersion, policies: Artifacts, episodes: int, *, seed: int,
-                  policy_stages: str) -> tuple[int, int]:
-    """(successes, env steps) of the stage executor running the task with the policies of ``policies``."""
+def evaluate_executor(version: TaskVersion, policies: Artifacts, episodes: int, *, seed: int,
+                      policy_stages: str) -> tuple[int, int]:
+    """(successes, env steps) of the stage executor running the whole task with the policies of ``policies``; an
+    episode ends at its first success (:func:`gendex.episode_loop.run_episode`), when the executor gives up or is
+    done, or at the time limit."""
     from gendex_envs.registry import make_env
 
     spec = version.spec
     limit = max(spec.max_episode_steps, sum(s.horizon for s in spec.stages) + spec.success.hold_steps + 10)
     env = make_env(version, control_mode="pd_joint_pos", control_joint="both", max_episode_steps=limit)
-    ex = StageExecutor(policy_sources=[policies], policy_stages=policy_stages)
+    agent = SolverAgent(StageExecutor(policy_sources=[policies], policy_stages=policy_stages), env)
+    hooks = Hooks(stop=lambda step: step.success, catch=(ExecutionError,))
     successes = steps = 0
     try:
         for ep in range(episodes):
-            obs, _ = env.reset(seed=seed + ep)
-            ex.reset(env, obs)
-            done = ok = False
-            while not done:
-                try:
-                    action = ex.act(env, obs)
-                except ExecutionError as e:
-                    log.debug("episode %d: %s", ep, e)
-                    break
-                if action is None:
-                    break
-                obs, _, terminated, truncated, info = env.step(action)
-                steps += 1
-                ok = bool(info["success"])
-                done = ok or bool(terminated) or bool(truncated)
-            successes += ok
+            out = run_episode(env, agent, seed + ep, hooks)
+            if out.error is not None:
+                log.debug("episode %d: %s", ep, out.error)
+            steps += out.steps
+            successes += out.success_at_end
     finally:
         env.close()
     return successes, steps

@@ -2,7 +2,8 @@
 
 The executor runs stages ``0 .. K-1`` (motion planning, scripted primitives, or trained policies where the policy
 folder has them) and stops where stage K would begin; the state is kept when the executor finished those stages and
-stage K-1's own ``evaluate`` reports success.
+stage K-1's own ``evaluate`` reports success. Each attempt is one :func:`gendex.episode_loop.run_episode` that runs on
+past the task's own termination and time limit: only where the executor stops counts.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from dataclasses import dataclass
 
 from tqdm import tqdm
 
+from gendex.episode_loop import Hooks, SolverAgent, run_episode
 from gendex.solve.executor import StageExecutor
 from gendex_envs.errors import ExecutionError, StageError
 from gendex_envs.start_states import StartStates
@@ -44,20 +46,18 @@ def collect_executor_states(version: TaskVersion, stage: str | int, n: int, *, s
     prev = u.task_spec.stages[index - 1]
     judge = version.judge(prev.name)
     ex = StageExecutor(policy_sources=policy_sources, stop_before=index)
+    agent = SolverAgent(ex, env)
+    hooks = Hooks(catch=(ExecutionError,), stop_at_end=False)  # judged where the executor stops, not by the task
     rows, steps, attempts = [], 0, 0
     max_attempts = 3 * n if max_attempts is None else max_attempts
     bar = tqdm(total=n, desc=f"start states of {spec.name}", disable=not progress, leave=False)
     try:
         while len(rows) < n and attempts < max_attempts:
-            obs, _ = env.reset(seed=seed + attempts)
+            out = run_episode(env, agent, seed + attempts, hooks)
             attempts += 1
-            ex.reset(env, obs)
-            try:
-                while (action := ex.act(env, obs)) is not None:
-                    obs, _, _, _, _ = env.step(action)
-                    steps += 1
-            except ExecutionError as e:
-                log.debug("attempt %d: %s", attempts, e)
+            steps += out.steps
+            if out.error is not None:
+                log.debug("attempt %d: %s", attempts, out.error)
                 continue
             if ex.finished and bool(judge.evaluate(u)["success"][0]):
                 rows.append(StartStates.capture(u, spec.name, "executor"))

@@ -179,6 +179,7 @@ def test_the_arm_pressing_a_door_shut_leaves_a_standing_bottle_standing(seed):
     planned clear of the other objects too: the bottle stands until the hand takes it, and the task is done."""
     import yaml
 
+    from gendex.episode_loop import Hooks
     from gendex.solve.attempt import run_attempt
     from gendex_envs.spec import parse_task_spec
     from gendex_envs.task_env import TaskEnv
@@ -195,7 +196,8 @@ def test_the_arm_pressing_a_door_shut_leaves_a_standing_bottle_standing(seed):
                 w, x, y, z = env.obj("bottle").pose.q[0].tolist()
                 lowest.append(1 - 2 * (x * x + y * y))
 
-        out = run_attempt(env, executor, seed, on_obs=watch)
+        out = run_attempt(env, executor, seed, Hooks(on_reset=lambda obs, _info: watch(obs),
+                                                     on_step=lambda step: watch(step.obs)))
         assert min(lowest) > 0.95, f"the bottle tipped to {min(lowest):.2f} before the hand reached it"
         assert [s.name for s in spec.stages][:3] == ["reach_microwave", "close_microwave", "reach_bottle"]
         assert out.succeeded, out.failure
