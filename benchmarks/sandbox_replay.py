@@ -18,7 +18,6 @@ import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads)
 
 import argparse
 import random
-import shutil
 import sys
 import tempfile
 import time
@@ -102,7 +101,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="gendex_replay_") as tmp:
         for version in versions:
             copy = Path(tmp) / "tasks" / version.name / version.root.name
-            shutil.copytree(version.root, copy)
+            version.copy_to(copy)
             stages = [None] + (list(range(len(version.spec.stages))) if args.stages else [])
             for stage in stages:
                 try:

@@ -223,7 +223,6 @@ def timed_rate(sample, step, reset, steps: int) -> tuple[float, int]:
 
 def untrusted_comparison(args) -> None:
     """``--untrusted``: the committed task and an untrusted copy of its folder, interleaved (see the module doc)."""
-    import shutil
     import tempfile
     from pathlib import Path
 
@@ -233,7 +232,7 @@ def untrusted_comparison(args) -> None:
     version = resolve_task(args.task)
     with tempfile.TemporaryDirectory(prefix="gendex_step_rate_") as tmp:
         copy = Path(tmp) / "tasks" / version.name / version.root.name
-        shutil.copytree(version.root, copy, ignore=shutil.ignore_patterns("__pycache__"))
+        version.copy_to(copy)
         assert guard.is_trusted(version.root) and not guard.is_trusted(copy)
         envs = {"trusted": make_env(version, control_mode="pd_joint_delta_pos"),
                 "untrusted": make_env(copy, control_mode="pd_joint_delta_pos")}

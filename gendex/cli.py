@@ -22,6 +22,7 @@ from gendex.cli_common import backend_of, ray_address_option, ray_option
 from gendex.cli_common import die as _die
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
+from gendex.cli_store import store_app
 from gendex.cli_trust import trust_command
 from gendex_envs.registry import REFERENCE_TASKS
 
@@ -33,6 +34,7 @@ app.command("eval")(eval_command)
 app.add_typer(leaderboard_app, name="leaderboard")
 app.command("trust")(trust_command)
 app.command("check")(check_command)
+app.add_typer(store_app, name="store")
 log = logging.getLogger("gendex")
 
 
@@ -381,7 +383,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         _die(ValueError(f"--backend {name!r} is not one of {list(BACKEND_NAMES)}"))
     from gendex_envs.task_version import TaskLayout
 
-    files = [TaskLayout(t).transcript if t.is_dir() else t for t in (transcript or [])]
+    files = [TaskLayout(t).resolve(TaskLayout(t).transcript) if t.is_dir() else t for t in (transcript or [])]
     if name == "replay":
         if not files:
             _die(ValueError("--backend replay needs --transcript PATH (a recorded transcript or a task folder)"))

@@ -150,6 +150,25 @@ class TaskLayout:
         p = Path(path).resolve()
         return p.stem if p.parent == self.stage_rewards.resolve() and p.suffix == ".py" else None
 
+    def resolve(self, path: str | Path) -> Path:
+        """Where ``path`` (one of this layout's paths) is to be read: the folder's own file when present, else the
+        store object that ``tree.json`` lists for it (:mod:`gendex_envs.task_store`). The other paths of a layout are
+        where files are written and never lead into the shared store."""
+        from gendex_envs.task_store import resolve
+
+        path = Path(path)
+        try:
+            rel = path.relative_to(self.root).as_posix()
+        except ValueError:
+            return path
+        return resolve(self.root, rel)
+
+    def stored(self, sub: str, suffix: str) -> dict[str, Path]:
+        """Files ``<sub>/<stem><suffix>`` of the folder, its own and stored ones: stem -> where to read it."""
+        from gendex_envs.task_store import listing
+
+        return listing(self.root, sub, suffix)
+
     def relative(self, path: str | Path) -> str:
         """``path`` relative to the folder (as shown in messages), or unchanged when it lies elsewhere."""
         try:
@@ -181,24 +200,22 @@ class Artifacts:
 
     def policy(self, stage: str) -> PolicyFiles | None:
         """The policy of ``stage`` when both its model and record exist, else None."""
-        model, record = self.layout.policy(stage), self.layout.policy_record(stage)
+        model = self.layout.resolve(self.layout.policy(stage))
+        record = self.layout.resolve(self.layout.policy_record(stage))
         return PolicyFiles(stage, model, record) if model.is_file() and record.is_file() else None
 
     def policy_stages(self) -> list[str]:
         """Stages with a complete trained policy here."""
-        if not self.layout.policies.is_dir():
-            return []
-        return sorted(p.stem for p in self.layout.policies.glob("*.zip") if self.policy(p.stem) is not None)
+        return [s for s in self.layout.stored("policies", ".zip") if self.policy(s) is not None]
 
     def start_states(self, stage: str) -> StartStates | None:
         from gendex_envs.start_states import StartStates
 
-        path = self.layout.start_states(stage)
+        path = self.layout.resolve(self.layout.start_states(stage))
         return StartStates.load(path) if path.is_file() else None
 
     def start_state_stages(self) -> list[str]:
-        folder = self.layout.start_states_dir
-        return sorted(p.stem for p in folder.glob("*.npz")) if folder.is_dir() else []
+        return list(self.layout.stored("start_states", ".npz"))
 
 
 @dataclass(frozen=True)
@@ -302,6 +319,13 @@ class TaskVersion:
         _, st = self.stage(stage)
         return Judge.of_stage(self.spec, st, self.reward(st.name))
 
+    def copy_to(self, folder: str | Path, skip: tuple[str, ...] = ("__pycache__",)) -> Path:
+        """Write this whole version as a plain folder (``<root>/<Name>/v<N>`` of another task root): its stored files
+        (:mod:`gendex_envs.task_store`) are copied out of the store, so the copy needs none."""
+        from gendex_envs.task_store import export
+
+        return export(self.root, folder, skip)
+
     # ------------------------------------------------------------------ learned and recorded artifacts
     def policy(self, stage: str) -> PolicyFiles | None:
         return self.artifacts.policy(stage)
@@ -311,22 +335,23 @@ class TaskVersion:
 
     def renders(self) -> dict[str, Path]:
         """Rendered views by name (e.g. ``after_top_down``)."""
-        folder = self.files.renders
-        return {p.stem: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+        return self.files.stored("renders", ".png")
 
     def provenance(self) -> dict[str, dict]:
         """The JSON records present (generation, proposal, critique, promotion, ...), by kind."""
         out = {}
         for kind in RECORDS:
-            path = self.files.record(kind)
+            path = self.files.resolve(self.files.record(kind))
             if path.is_file():
                 out[kind] = json.loads(path.read_text())
         return out
 
     def file_digest(self) -> str:
         """SHA-256 over every file's relative path and bytes: equal digests mean an unchanged version. It covers
-        everything in the folder (spec, reward and stage reward modules, policies and their records, start states,
-        any other file, hidden ones included), so any change that could alter behaviour changes it; left out are the
+        everything in the whole version (spec, reward and stage reward modules, policies and their records, start
+        states, any other file, hidden ones included; a stored file, :mod:`gendex_envs.task_store`, counts by its path
+        in the version and its bytes, checked against its name, so a packed version digests as the whole folder it was
+        packed from), so any change that could alter behaviour changes it; left out are ``tree.json``, the
         ``solvability`` record, a measurement of the version (``gendex gate --write`` may add or renew it), not part
         of it, and ``__pycache__`` folders: nothing reads them (reward modules are compiled from their checked text,
         :func:`~gendex_envs.reward_module.load_reward_module`), and ``pip install`` of the wheel writes them beside
@@ -339,19 +364,18 @@ class TaskVersion:
         import hashlib
         import stat
 
+        from gendex_envs.task_store import files, read_object
+
         h = hashlib.sha256()
         skip = self.files.record("solvability").relative_to(self.root).as_posix()
-        entries: list[tuple[str, Path]] = []
-        for folder, dirs, names in os.walk(self.root, followlinks=False):
-            dirs[:] = [d for d in dirs if d != "__pycache__"]
-            here = Path(folder)
-            for n in names + [d for d in dirs if (here / d).is_symlink()]:
-                entries.append(((here / n).relative_to(self.root).as_posix(), here / n))
-        for rel, path in sorted(entries, key=lambda e: Path(e[0]).parts):
+        for rel, path, sha in files(self.root):
             if rel == skip:
                 continue
-            mode = path.lstat().st_mode
             h.update(rel.encode("utf-8", "surrogateescape") + b"\0")
+            if sha is not None:  # a stored file: its bytes, checked against the object's name
+                h.update(read_object(path, sha))
+                continue
+            mode = path.lstat().st_mode
             if stat.S_ISLNK(mode):
                 h.update(b"\0symlink\0" + os.fsencode(os.readlink(path)))
             elif stat.S_ISREG(mode):
@@ -420,6 +444,8 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
 
     One ``rename`` makes it appear: the whole ``<name>`` folder when the task is new, else the version folder inside
     it. ``required``: files (inside ``draft``) that must exist; :class:`PublishError` otherwise, nothing published.
+    In a root with a store (``<root>/.objects``, :mod:`gendex_envs.task_store`) the draft is packed first; a root
+    with a registration index (:mod:`gendex_envs.task_index`) records the new version in it.
     """
     root = Path(root)
     if not TASK_NAME_RE.fullmatch(name):
@@ -427,6 +453,10 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
     missing = [p.name for p in required if not p.is_file()]
     if missing:
         raise PublishError(f"task {name!r} is incomplete, not publishing it: missing {missing}")
+    from gendex_envs.task_store import OBJECTS, pack
+
+    if (root / OBJECTS).is_dir():  # a root with a store keeps its versions packed
+        pack(draft)
     for _ in range(100):
         version = next_version(root, name)
         wrapper = draft.parent / f"{draft.name}-publish"
@@ -450,7 +480,11 @@ def publish(root: str | Path, name: str, draft: Path, required: Iterable[Path] =
                 continue
             raise PublishError(f"could not publish task {name!r} into {root}: {exc}") from exc
         log.info("published %s", target_parent / f"v{version}")
-        return TaskVersion.at(target_parent / f"v{version}")
+        published = TaskVersion.at(target_parent / f"v{version}")
+        from gendex_envs.task_index import add_to_index
+
+        add_to_index(published)
+        return published
     raise PublishError(f"could not find a free version folder for {name!r} in {root}")
 
 

@@ -12,7 +12,6 @@ import gendex_envs.blas  # first: it pins OpenBLAS's kernels before numpy loads;
 
 import logging
 import os
-import shutil
 from pathlib import Path
 
 import gymnasium as gym
@@ -53,7 +52,7 @@ def task_copy(tmp_path):
         source = resolve_task(name)
         new_name = as_name or name
         folder = tmp_path / "tasks" / new_name / f"v{version}"
-        shutil.copytree(source.root, folder, ignore=shutil.ignore_patterns("__pycache__"))
+        source.copy_to(folder)
         if new_name != source.name:
             spec = TaskLayout(folder).spec
             spec.write_text(spec.read_text().replace(f"name: {source.name}\n", f"name: {new_name}\n"))

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -93,7 +92,7 @@ def _hostile_copy(root: Path, name: str, assets: dict[str, str]) -> Path:
     """A copy of :data:`SOURCE` as ``root/<name>/v0`` whose objects' assets are replaced (catalog id -> new name,
     written as a YAML double-quoted string so NUL and newline survive the file)."""
     folder = root / name / "v0"
-    shutil.copytree(resolve_task(SOURCE).root, folder, ignore=shutil.ignore_patterns("__pycache__"))
+    resolve_task(SOURCE).copy_to(folder)
     spec = TaskLayout(folder).spec
     text = spec.read_text().replace(f"name: {SOURCE}\n", f"name: {name}\n")
     for old, new in assets.items():

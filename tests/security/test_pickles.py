@@ -25,7 +25,7 @@ import torch
 from gendex.imitation.bc import BCPolicy, load_checkpoint, resave_trusted_checkpoint, save_checkpoint
 from gendex.solve.policy import StagePolicy, load_policy_network, read_policy_weights
 from gendex_envs.errors import GenDexError, PolicyError
-from gendex_envs.task_version import PolicyFiles
+from gendex_envs.task_version import PolicyFiles, TaskVersion
 
 COMMITTED = Path(__file__).resolve().parents[2] / "generated_tasks" / "RotateTennisBall"
 
@@ -42,8 +42,9 @@ class _WritesMarker:
 
 
 def _committed(version: str) -> PolicyFiles:
-    d = COMMITTED / version / "policies"
-    return PolicyFiles("rotate_ball", d / "rotate_ball.zip", d / "rotate_ball.json")
+    files = TaskVersion.at(COMMITTED / version).policy("rotate_ball")  # the model and record lie in the task store
+    assert files is not None
+    return files
 
 
 def _hostile_zip(tmp_path: Path, marker: Path, *, data: bool = False, weights: bool = False) -> PolicyFiles:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -21,7 +20,7 @@ def _shadow(root: Path, env_id: str = "GenDex/PutAppleBowl-v1") -> TaskVersion:
     """A copy of a committed version under the same id with another reward and spec."""
     name, version = env_id.split("/")[1].rsplit("-v", 1)
     folder = root / name / f"v{version}"
-    shutil.copytree(REPO_TASKS_DIR / name / f"v{version}", folder)
+    TaskVersion.at(REPO_TASKS_DIR / name / f"v{version}").copy_to(folder)
     reward = TaskLayout(folder).reward
     reward.write_text(reward.read_text() + "\n\ndef compute_dense_reward(env, obs, action, info):\n    return 0.0 * "
                       "action.sum(dim=-1) + 1.0\n")

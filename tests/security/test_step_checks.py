@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 import re
-import shutil
 from pathlib import Path
 
 import gymnasium as gym
@@ -43,7 +42,7 @@ def hostile(tmp_path_factory):
     def copy(payload: str) -> str:
         name = "Hostile" + "".join(w.capitalize() for w in payload.split("_"))
         folder = root / name / "v0"
-        shutil.copytree(source.root, folder, ignore=shutil.ignore_patterns("__pycache__"))
+        source.copy_to(folder)
         layout = TaskLayout(folder)
         layout.spec.write_text(layout.spec.read_text().replace(f"name: {SOURCE}\n", f"name: {name}\n"))
         layout.reward.write_text((PAYLOADS / f"{payload}.py").read_text())

@@ -6,7 +6,6 @@ library is the slow test."""
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 
 import pytest
@@ -103,7 +102,7 @@ def test_changed_since_lists_the_versions_whose_folders_differ(tmp_path, monkeyp
     git = ["git", "-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"]
     versions = {}
     for name, v in (("PutAppleBowl", 0), ("PutAppleBowl", 1), ("LiftApple", 0)):
-        shutil.copytree(task_version(name, v).root, root / name / f"v{v}", ignore=shutil.ignore_patterns("__pycache__"))
+        task_version(name, v).copy_to(root / name / f"v{v}")
         versions[f"GenDex/{name}-v{v}"] = TaskVersion.at(root / name / f"v{v}")
     subprocess.run([*git, "init", "-q", str(tmp_path / "repo")], check=True)
     subprocess.run([*git, "add", "-A"], cwd=tmp_path / "repo", check=True)

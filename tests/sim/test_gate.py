@@ -2,12 +2,11 @@
 cannot solve is dropped with its reason and the next proposal is asked for."""
 
 import json
-import shutil
 
 import pytest
 import yaml
 
-from gendex_envs.task_version import TaskLayout
+from gendex_envs.task_version import TaskLayout, TaskVersion
 from generator.backends.offline import OfflineBackend
 from generator.errors import GeneratorError
 from generator.pipeline import generate
@@ -24,7 +23,7 @@ def test_gate_seeds_are_stable_per_task_and_far_from_every_other_seed():
 def _far_apple(tmp_path, repo_root):
     """LiftApple-v0 asking for a 1.5 m lift, beyond the arm's reach: a task the solver cannot finish."""
     folder = tmp_path / "FarApple" / "v0"
-    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
+    TaskVersion.at(repo_root / "generated_tasks" / "LiftApple" / "v0").copy_to(folder)
     spec_path = TaskLayout(folder).spec
     spec = yaml.safe_load(spec_path.read_text())
     spec["name"] = "FarApple"
@@ -116,10 +115,9 @@ def test_gate_command_measures_a_committed_version_and_stores_the_record_without
     from typer.testing import CliRunner
 
     from gendex.cli import app
-    from gendex_envs.task_version import TaskVersion
 
     folder = tmp_path / "LiftApple" / "v0"
-    shutil.copytree(repo_root / "generated_tasks" / "LiftApple" / "v0", folder)
+    TaskVersion.at(repo_root / "generated_tasks" / "LiftApple" / "v0").copy_to(folder)
     version = TaskVersion.at(folder)
     digest = version.file_digest()
     r = CliRunner().invoke(app, ["gate", str(folder), "--attempts", "2", "--write"])

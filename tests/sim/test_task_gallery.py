@@ -14,7 +14,7 @@ def test_gallery_has_a_row_and_a_real_picture_per_task_and_shows_gate_results(tm
     # two copies of a library task: one without a solvability record, one with a given one
     src = next(v for v in registered_tasks().values() if v.name == "LiftApple")
     plain = tmp_path / "tasks" / "LiftApple" / "v0"
-    shutil.copytree(src.root, plain)
+    src.copy_to(plain)
     TaskLayout(plain).record("solvability").unlink(missing_ok=True)
     folder = tmp_path / "tasks" / "LiftAppleGated" / "v0"
     shutil.copytree(plain, folder)

@@ -529,7 +529,8 @@ def test_default_backend_name(monkeypatch):
 
 def test_a_format_1_transcript_is_refused_with_its_reason(task_version):
     """Transcripts recorded before the pipeline's requests named their step document a task but do not replay."""
-    committed = task_version("LiftApple", 0).files.transcript
+    files = task_version("LiftApple", 0).files
+    committed = files.resolve(files.transcript)
     with pytest.raises(TranscriptMismatchError, match=r"unsupported transcript format 'gendex-transcript' version 1; "
                                                       r"this reader knows 'gendex-transcript' version 2"):
         ReplayBackend(committed)

@@ -327,7 +327,11 @@ def test_suite_and_dataset_manifest_files_are_bounded_too(tmp_path, loader):
 
 
 def test_a_committed_transcript_still_replays():
-    path = next(iter(sorted((ROOT / "generated_tasks").glob("*/v*/transcript.jsonl"))), None)
+    from gendex_envs.registry import REPO_TASKS_DIR
+    from gendex_envs.task_version import versions_in
+
+    path = next((v.files.resolve(v.files.transcript) for v in versions_in(REPO_TASKS_DIR)
+                 if v.files.resolve(v.files.transcript).is_file()), None)
     assert path is not None, "the generated tasks ship their transcripts"
     assert len(ReplayBackend(path)) > 0
 

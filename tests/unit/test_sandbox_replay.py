@@ -4,7 +4,6 @@ and everything a replay cannot reproduce must go to the worker."""
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +36,7 @@ def _same(a, b) -> bool:
 def test_an_untrusted_copy_steps_exactly_as_the_committed_task(tmp_path, task):
     version = resolve_task(task)
     copy = tmp_path / "tasks" / version.name / version.root.name
-    shutil.copytree(version.root, copy)
+    version.copy_to(copy)
     trusted, untrusted = (make_env(p, control_mode="pd_joint_delta_pos") for p in (version.root, copy))
     try:
         assert _same(trusted.reset(seed=3), untrusted.reset(seed=3))
