@@ -156,7 +156,8 @@ def listing(folder: Path, sub: str, suffix: str) -> dict[str, Path]:
             found[rel[len(prefix):-len(suffix)]] = object_path(folder.parent.parent, entry.sha256)
     own = folder / sub
     if own.is_dir():
-        found.update({p.name[:-len(suffix)]: p for p in own.iterdir() if p.name.endswith(suffix) and p.is_file()})
+        # every entry, not only regular files: a link or a FIFO is listed, for the reader's own checks to refuse
+        found.update({p.name[:-len(suffix)]: p for p in own.iterdir() if p.name.endswith(suffix)})
     return dict(sorted(found.items()))
 
 

@@ -184,6 +184,13 @@ class PolicyFiles:
     stage: str
     model: Path
     record: Path
+    shown: Path | None = None
+    """The model's path in its version folder, to show and record (``model`` may lie in the task store); None: the
+    model's own path."""
+
+    @property
+    def where(self) -> Path:
+        return self.shown if self.shown is not None else self.model
 
     def meta(self) -> dict:
         return json.loads(self.record.read_text())
@@ -202,7 +209,8 @@ class Artifacts:
         """The policy of ``stage`` when both its model and record exist, else None."""
         model = self.layout.resolve(self.layout.policy(stage))
         record = self.layout.resolve(self.layout.policy_record(stage))
-        return PolicyFiles(stage, model, record) if model.is_file() and record.is_file() else None
+        return PolicyFiles(stage, model, record, self.layout.policy(stage)) if model.is_file() and record.is_file() \
+            else None
 
     def policy_stages(self) -> list[str]:
         """Stages with a complete trained policy here."""

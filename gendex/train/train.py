@@ -121,21 +121,21 @@ def warm_start(model, venv, init: PolicyFiles, control_joint: str, log_std_init:
     meta = read_policy_record(init.record)
     norm = meta["obs_norm"]
     if meta.get("control_joint") != control_joint or len(norm["mean"]) != venv.observation_space.shape[0]:
-        raise TrainingError(f"{init.model} drives {meta.get('control_joint')!r} from {len(norm['mean'])} "
+        raise TrainingError(f"{init.where} drives {meta.get('control_joint')!r} from {len(norm['mean'])} "
                             f"observations; this stage drives {control_joint!r} from "
                             f"{venv.observation_space.shape[0]}: it cannot start from it")
     weights = read_policy_weights(init.model)  # weights only: the zip's pickled `data` is never read
     try:
         model.policy.load_state_dict(weights, strict=True)
     except RuntimeError as exc:
-        raise TrainingError(f"{init.model}: its network does not match the preset's ({exc})") from None
+        raise TrainingError(f"{init.where}: its network does not match the preset's ({exc})") from None
     with torch.no_grad():
         model.policy.log_std.fill_(log_std_init)
     venv.obs_rms.mean = np.asarray(norm["mean"], dtype=np.float64)
     venv.obs_rms.var = np.asarray(norm["var"], dtype=np.float64)
     venv.obs_rms.count = float(meta.get("steps", 1))
-    log.info("warm start from %s (%s steps), log std reset to %.2f", init.model, meta.get("steps"), log_std_init)
-    model_path = init.model.resolve()
+    log.info("warm start from %s (%s steps), log std reset to %.2f", init.where, meta.get("steps"), log_std_init)
+    model_path = init.where.resolve()
     shown = model_path.relative_to(Path.cwd()) if model_path.is_relative_to(Path.cwd()) else model_path
     return dict(model=str(shown), steps=meta.get("steps"), source=meta.get("source"),
                 command=meta.get("command"))

@@ -597,8 +597,9 @@ def _stride_bomb(n: int) -> torch.Tensor:
 def test_a_policy_weight_that_is_a_strided_view_of_one_value_is_refused_at_once(tmp_path, n):
     """2**40 raised a bare RuntimeError (4 TB asked of the allocator); 2**31 took 37 s and 2 GB (``isfinite``)."""
     from gendex.solve.policy import read_policy_weights
+    from gendex_envs.task_version import TaskVersion
 
-    honest = sorted((REPO / "generated_tasks" / "RotateTennisBall").glob("v*/policies/*.zip"))[0]
+    honest = TaskVersion.at(REPO / "generated_tasks" / "RotateTennisBall" / "v0").policy("rotate_ball").model
     buf = io.BytesIO()
     torch.save({"mlp_extractor.policy_net.0.weight": _stride_bomb(n)}, buf)
     path = tmp_path / "bomb.zip"
