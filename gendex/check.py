@@ -315,5 +315,18 @@ def select(ids: Iterable[str] = (), *, changed_since_rev: str | None = None, ref
     return chosen
 
 
-__all__ = ["KNOWN_DEFECTS", "STEPS", "CheckResult", "CheckSelectionError", "changed_since", "check_env_target",
-           "check_version", "merge_base", "newest_reference_ids", "run_checks", "select", "write_report"]
+CI_SAMPLE, CI_SEED = 5, 0
+"""The fixed sample CI checks beside the changed and the newest reference versions."""
+
+
+def ci_selection() -> list[str]:
+    """What the default test suite checks of every per-version property, so that its cost does not grow with the
+    library: the versions changed since :func:`merge_base` (when git is here), the newest version of each reference
+    task and :data:`CI_SAMPLE` more drawn with :data:`CI_SEED` (``gendex check --changed-since REV --reference
+    --sample 5 --seed 0``)."""
+    return select(changed_since_rev=merge_base(), reference=True, sample=CI_SAMPLE, seed=CI_SEED)
+
+
+__all__ = ["CI_SAMPLE", "CI_SEED", "KNOWN_DEFECTS", "STEPS", "CheckResult", "CheckSelectionError", "changed_since",
+           "check_env_target", "check_version", "ci_selection", "merge_base", "newest_reference_ids", "run_checks",
+           "select", "write_report"]

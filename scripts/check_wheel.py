@@ -7,8 +7,9 @@ many ``GenDex/`` ids as the checkout does, from the library shipped in the wheel
 works on N random ids; ``gendex list`` lists them all; suites, dataset manifests and prompts load; the shipped trust
 record trusts the shipped reward modules, while a folder on ``$GENDEX_TASKS_PATH`` registers, is untrusted, and
 cannot take a shipped id. It also reports how many task versions' file digests (what suites and leaderboard results
-pin) differ from the checkout's: ``TaskVersion.file_digest`` counts ``__pycache__`` files, and ``pip install``
-compiles every shipped ``.py`` file (``pip install --no-compile`` does not).
+pin) differ from the checkout's (none should: ``TaskVersion.file_digest`` leaves out the ``__pycache__`` folders
+that ``pip install`` writes beside every shipped ``.py`` file, and stored files, :mod:`gendex_envs.task_store`, ship
+in the library's store).
 
 How, without downloading torch and ManiSkill again: the wheel is built (``pip wheel --no-deps
 --no-build-isolation``) from an export of the work tree (the files git tracks, as they are now, plus new files git

@@ -112,6 +112,16 @@ def reward_env():
 
 
 @pytest.fixture(scope="session")
+def library_sample() -> list[str]:
+    """The versions a default-suite test of an every-version property checks (:func:`gendex.check.ci_selection`:
+    the changed ones, the newest reference ones and a fixed sample), so its cost does not grow with the library;
+    its slow-marked variant checks them all."""
+    from gendex.check import ci_selection
+
+    return ci_selection()
+
+
+@pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository (for tests of its own files: docs, benchmarks, the source tree)."""
     return Path(__file__).resolve().parent.parent

@@ -12,28 +12,19 @@ import pytest
 from typer.testing import CliRunner
 
 from gendex import check
-from gendex.check import KNOWN_DEFECTS, CheckSelectionError, changed_since, merge_base, newest_reference_ids, select
+from gendex.check import KNOWN_DEFECTS, CheckSelectionError, changed_since, newest_reference_ids, select
 from gendex.cli import app
 from gendex_envs.registry import REFERENCE_TASKS, registered_tasks
 from gendex_envs.task_version import TaskVersion
-
-SAMPLE, SEED = 5, 0
-"""The fixed sample the default suite checks beside the newest reference versions and the changed ones."""
-
-
-def default_selection() -> list[str]:
-    """What the default suite checks: the versions changed since the merge base (when git is here), the newest
-    version of each reference task, and :data:`SAMPLE` more drawn with :data:`SEED`."""
-    return select(changed_since_rev=merge_base(), reference=True, sample=SAMPLE, seed=SEED)
 
 
 def run(args: list[str]):
     return CliRunner().invoke(app, ["check", *args], catch_exceptions=False)
 
 
-def test_the_sample_and_the_changed_versions_pass_gendex_check(tmp_path):
-    ids = default_selection()
-    assert set(newest_reference_ids()) <= set(ids) and len(ids) >= len(REFERENCE_TASKS) + SAMPLE
+def test_the_sample_and_the_changed_versions_pass_gendex_check(tmp_path, library_sample):
+    ids = library_sample
+    assert set(newest_reference_ids()) <= set(ids) and len(ids) >= len(REFERENCE_TASKS) + check.CI_SAMPLE
     out = run([*ids, "--report", str(tmp_path / "report.json")])
     report = json.loads((tmp_path / "report.json").read_text())
     assert out.exit_code == 0 and report["ok"], out.output

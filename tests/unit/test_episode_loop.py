@@ -1,5 +1,5 @@
 """The episode loop alone, on a scripted env: the order it calls agent and hooks in, when it stops, which errors it
-keeps; and a guard that the applications run no episode loop of their own (tests/sim/test_episode_loop.py checks
+keeps; and a guard that the applications run no episode loop of their own (tests/sim/test_episode_loop_users.py checks
 that they really run this one)."""
 
 from __future__ import annotations
