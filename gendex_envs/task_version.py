@@ -35,7 +35,7 @@ import shutil
 import stat
 import uuid
 from collections.abc import Callable, Collection, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -184,8 +184,8 @@ class PolicyFiles:
     stage: str
     model: Path
     record: Path
-    shown: Path | None = None
-    """The model's path in its version folder, to show and record (``model`` may lie in the task store); None: the
+    shown: Path | None = field(default=None, compare=False)
+    """The model's path in its version folder, to show and record, when ``model`` lies in the task store; None: the
     model's own path."""
 
     @property
@@ -209,8 +209,10 @@ class Artifacts:
         """The policy of ``stage`` when both its model and record exist, else None."""
         model = self.layout.resolve(self.layout.policy(stage))
         record = self.layout.resolve(self.layout.policy_record(stage))
-        return PolicyFiles(stage, model, record, self.layout.policy(stage)) if model.is_file() and record.is_file() \
-            else None
+        if not (model.is_file() and record.is_file()):
+            return None
+        named = self.layout.policy(stage)
+        return PolicyFiles(stage, model, record, named if named != model else None)
 
     def policy_stages(self) -> list[str]:
         """Stages with a complete trained policy here."""
