@@ -80,13 +80,17 @@ def unpack_command(folder: Path = typer.Argument(..., help="A version folder (<r
 def check_command(root: Path = _ROOT) -> None:
     """Exit 1 unless every version is packed, every object matches its name and is listed, and the index matches
     the folders."""
+    from gendex_envs.errors import GenDexError
     from gendex_envs.task_index import stale_entries
     from gendex_envs.task_store import unpacked_files, verify
 
     root = _root(root)
-    problems = verify(root)
-    problems += [f"{rel}: data file not packed" for rel in unpacked_files(root)]
-    problems += [f"index: {k}: {why}" for k, why in sorted(stale_entries(root).items())]
+    try:
+        problems = verify(root)
+        problems += [f"{rel}: data file not packed" for rel in unpacked_files(root)]
+        problems += [f"index: {k}: {why}" for k, why in sorted(stale_entries(root).items())]
+    except GenDexError as exc:  # a tree or spec that does not load: the refusal, not a traceback
+        die(exc)
     for p in problems:
         typer.echo(p)
     if problems:

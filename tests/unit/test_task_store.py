@@ -247,3 +247,15 @@ def test_a_derived_version_published_into_a_packed_root_adds_only_what_changed(t
                                                           "stage_rewards", "task.yaml", TREE_NAME]
     assert new.renders().keys() == source.renders().keys() and new.provenance()["reword"]["reason"] == "test"
     assert task_index.stale_entries(root) == {}  # publishing recorded it in the index
+
+
+def test_store_check_refuses_a_hostile_tree_by_name_without_a_traceback(tmp_path):
+    from typer.testing import CliRunner
+
+    from gendex.cli import app
+
+    root = _whole_root(tmp_path, ("PutAppleBowl", 1))
+    tree = root / "PutAppleBowl" / "v1" / TREE_NAME
+    tree.write_text(json.dumps({"format": 1, "files": {"renders/../../x.png": {"sha256": "0" * 64, "bytes": 1}}}))
+    out = CliRunner().invoke(app, ["store", "check", str(root)])
+    assert out.exit_code != 0 and "not a plain relative path" in out.output and "Traceback" not in out.output
