@@ -17,6 +17,7 @@ the output folder and the repository):
 from __future__ import annotations
 
 import copy
+import hashlib
 import logging
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -24,7 +25,15 @@ from pathlib import Path
 
 from gendex_envs.spec import GOAL_TARGET, TaskSpec
 from generator.catalog_view import asset_dict
-from generator.stats import STAGE_TASK_SKILLS, TASK_SKILLS, condition_skill, embed, part_of, task_skills
+from generator.stats import (
+    STAGE_TASK_SKILLS,
+    TASK_SKILLS,
+    condition_skill,
+    embed,
+    embedding_source,
+    part_of,
+    task_skills,
+)
 
 log = logging.getLogger(__name__)
 
@@ -72,8 +81,35 @@ def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:
     from generator.stats import latest_versions
 
     found = discover_tasks([r for r in roots if Path(r).is_dir()])
-    return [ExistingTask(env_id, spec_signature(v.spec), v.spec.instruction)
-            for env_id, v in sorted(latest_versions(found).items())]
+    return [ExistingTask(env_id, *_spec_facts(v)) for env_id, v in sorted(latest_versions(found).items())]
+
+
+_FACTS: dict[str, tuple[Signature, str]] = {}
+"""(signature, instruction) by the SHA-256 of a spec's bytes: a process generating several batches parses each
+library spec once, not once a batch (the catalog the signatures read is fixed for a process)."""
+
+_EMBEDDINGS: dict[str, object] = {}
+"""Instruction embeddings by text, for the same reason."""
+
+
+def _spec_facts(version) -> tuple[Signature, str]:
+    key = hashlib.sha256(version.files.spec.read_bytes()).hexdigest()
+    hit = _FACTS.get(key)
+    if hit is None:
+        hit = _FACTS[key] = (spec_signature(version.spec), version.spec.instruction)
+    return hit
+
+
+def _embed(texts: list[str]):
+    """:func:`generator.stats.embed` of ``texts`` (vectors and the model's source), each text encoded once a
+    process."""
+    import numpy as np
+
+    todo = list(dict.fromkeys(t for t in texts if t not in _EMBEDDINGS))
+    if todo:
+        vectors, _ = embed(todo)
+        _EMBEDDINGS.update(zip(todo, vectors, strict=True))
+    return np.stack([_EMBEDDINGS[t] for t in texts]), embedding_source()
 
 
 class Novelty:
@@ -86,7 +122,7 @@ class Novelty:
         self.embedding = "not loaded"
         if self.existing:
             try:
-                self._emb, self.embedding = embed([t.instruction for t in self.existing])
+                self._emb, self.embedding = _embed([t.instruction for t in self.existing])
             except ImportError as exc:
                 self.embedding = f"none ({exc.name} missing: the optional 'stats' extra)"
                 log.info("near-duplicate test by skills and object kinds only: %s", self.embedding)

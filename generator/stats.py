@@ -141,6 +141,11 @@ def _minilm():
     return model, f"all-MiniLM-L6-v2 ({MODEL_PACKAGE} {getattr(model_pkg, '__version__', '?')})"
 
 
+def embedding_source() -> str:
+    """Where the sentence encoder :func:`embed` uses came from; ImportError as :func:`embed` raises it."""
+    return _minilm()[1]
+
+
 def embed(texts: list[str]):
     """Unit-length all-MiniLM-L6-v2 embeddings of ``texts`` (``[len(texts), 384]`` numpy) and the model's source;
     ImportError (with ``name`` set) when the optional ``stats`` extra is not installed."""
@@ -228,5 +233,5 @@ def format_stats(s: dict) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["DIVERSITY_GOAL", "PUBLISHED_DIVERSITY", "TASK_SKILLS", "condition_skill", "embed", "format_stats",
-           "instruction_diversity", "library_stats", "part_of", "task_skills"]
+__all__ = ["DIVERSITY_GOAL", "PUBLISHED_DIVERSITY", "TASK_SKILLS", "condition_skill", "embed", "embedding_source",
+           "format_stats", "instruction_diversity", "library_stats", "part_of", "task_skills"]

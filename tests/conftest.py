@@ -121,6 +121,19 @@ def library_sample() -> list[str]:
     return ci_selection()
 
 
+@pytest.fixture
+def no_renders(monkeypatch):
+    """Renders stand-in for generation tests that do not look at the renders (a third of a task's generation time
+    goes to rendering; ``tests/sim/test_generate.py``'s offline run and its critic test check the real renders)."""
+    from generator.render import VIEWS
+
+    def views(spec, *, seed=0, resolution=None):
+        return {view: f"{spec.name}:{view}:{seed}".encode() for view in VIEWS}
+
+    monkeypatch.setattr("generator.pipeline.render_spec", views)
+    monkeypatch.setattr("generator.steps.refine.render_spec", views)
+
+
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository (for tests of its own files: docs, benchmarks, the source tree)."""

@@ -110,7 +110,8 @@ def test_pull_without_a_hook_stalls_and_ends_the_attempt(cabinet_env, monkeypatc
 
 
 @pytest.mark.parametrize(("task", "start", "done"), [("OpenDrawer", 0.0, lambda f: f >= 0.8),
-                                                     ("CloseDrawer", 0.9, lambda f: f < 0.1)])
+                                                     pytest.param("CloseDrawer", 0.9, lambda f: f < 0.1,
+                                                                  marks=pytest.mark.slow)])
 def test_a_drawer_is_hooked_and_slid_open_or_shut(task_version, task, start, done):
     """Sliding joints: the hook grasp goes over the drawer's bar (fingers down), the palm follows the slide."""
     env = gym.make(task_version(task).env_id, control_mode="pd_joint_pos", control_joint="both")

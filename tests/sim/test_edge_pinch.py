@@ -80,6 +80,7 @@ def test_only_a_ring_the_finger_passes_through_is_hooked(asset, hooked):
     assert hole > PAD_RADIUS_M["ff"] if hooked else hole < PAD_RADIUS_M["ff"]
 
 
+@pytest.mark.slow
 def test_the_wrench_is_tried_five_ways_and_hinged_across_its_ring_past_the_edge():
     """The wrench (0.15 kg, its weight 7.7 cm from the ring) slipped out of the clamp across its ring's far side in
     most attempts; it is pinched across the ring level with it instead, the pads below the table top past its edge,
@@ -113,6 +114,7 @@ def _lift_wrench(seed: int):
         checker.close()
 
 
+@pytest.mark.slow
 def test_a_wrench_lying_along_the_edge_is_turned_before_the_drag():
     """Dev seed 787003: the wrench lies along the side edge it is dragged to. The wedged finger keeps the tool's heading
     while it drags, so it reached the edge lying along it and went over it whole. Turned first by the hand about the

@@ -44,19 +44,6 @@ def test_a_task_the_solver_cannot_finish_fails_the_gate_and_stops_early(tmp_path
     assert sum(r.failures.values()) == 3, r.failures
 
 
-@pytest.fixture
-def no_renders(monkeypatch):
-    """Renders stand-in for the tests whose gate verdicts are scripted: about half of a task's generation time is
-    rendering, which these tests do not look at (tests/sim/test_generate.py checks the real renders)."""
-    from generator.render import VIEWS
-
-    def views(spec, *, seed=0, resolution=None):
-        return {view: f"{spec.name}:{view}:{seed}".encode() for view in VIEWS}
-
-    monkeypatch.setattr("generator.pipeline.render_spec", views)
-    monkeypatch.setattr("generator.steps.refine.render_spec", views)
-
-
 def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_committed(tmp_path, monkeypatch,
                                                                                         no_renders):
     """The gate's verdicts are scripted here (the real gate runs in tests/sim/test_generate.py's offline run): the
@@ -138,6 +125,7 @@ def test_a_task_that_solves_itself_fails_the_gate(repo_root):
     assert apple.passed and (apple.null_attempts, apple.null_successes) == (1, 0)
 
 
+@pytest.mark.slow  # ~100 s: the gate's eleven attempts twice over; the ordering is tests/unit/test_fanout.py's
 def test_the_gate_on_two_worker_processes_gives_the_single_process_result(tmp_path, repo_root):
     """`gendex generate --workers 2`: the gate's attempts run in two processes and are judged in seed order with
     the same early stop, so the record is the one a single process writes (the failing task stops after its 3rd

@@ -78,17 +78,17 @@ def test_offline_task_is_committed_complete_and_passes_check_env(offline_run):
 def test_replayed_transcript_reproduces_the_task_files(offline_run, tmp_path):
     root, summaries = offline_run
     src = summaries[0].committed
-    replay = generate(lambda: ReplayBackend(src.files.transcript), tmp_path, n=1, seed=0, command="test")
-    # every file but the gate's measurement is byte-identical; the measurement is re-taken and passes again (its
-    # env step counts vary by a few steps between processes: the solver's physics is not yet bit-reproducible
-    # across processes, which the datasets issue tracks)
+    replay = generate(lambda: ReplayBackend(src.files.transcript), tmp_path, n=1, seed=0, command="test",
+                      gate_attempts=0)
+    # every file the transcript decides is byte-identical; the gate's measurement is not replayed (the replay is
+    # told to skip it: the offline run above measured it, tests/sim/test_gate.py measures the gate itself)
     gate = TaskLayout(".").record("solvability").name
     a, b = _tree(replay[0].committed.root), _tree(src.root)
-    assert {k: v for k, v in a.items() if k != gate} == {k: v for k, v in b.items() if k != gate}
-    assert json.loads(a[gate])["passed"] and json.loads(b[gate])["passed"]
+    assert gate not in a and json.loads(b[gate])["passed"]
+    assert a == {k: v for k, v in b.items() if k != gate}
 
 
-def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path):
+def test_human_instruction_grab_the_apple_gives_an_apple_grasp_task(tmp_path, no_renders):
     [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction="grab the apple", command="test", gate_attempts=0)
     spec = s.committed.provenance()["proposal"]
     assert [o["asset"] for o in spec["objects"]] == ["apple"]
@@ -147,14 +147,14 @@ def test_hallucinated_asset_is_rejected_with_its_name_and_nothing_is_committed(t
     _assert_nothing_committed(tmp_path)
 
 
-def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path):
+def test_malformed_scene_yaml_is_rejected_and_nothing_is_committed(tmp_path, no_renders):
     b = Scripted(propose=_LEMON % UNLIFTED, scene="```yaml\nname: LiftTheLemon\nobjects: [\n  - {name: lemon\n```")
     with pytest.raises(RetriesExhaustedError, match="not valid YAML"):
         generate(lambda: b, tmp_path, n=1, command="test", gate_attempts=0)
     _assert_nothing_committed(tmp_path)
 
 
-def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path):
+def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path, no_renders):
     bad = ("```python\nimport os\n\ndef evaluate(env):\n    os.remove('x')\n\n"
            "def compute_dense_reward(env, obs, action, info):\n    return 0\n```")
     b = Scripted(propose=_LEMON % UNLIFTED, reward=bad)
@@ -163,7 +163,7 @@ def test_reward_code_importing_os_is_rejected_and_nothing_is_committed(tmp_path)
     _assert_nothing_committed(tmp_path)
 
 
-def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path):
+def test_reward_code_returning_nan_is_fed_back_and_the_fix_is_committed(tmp_path, no_renders):
     nan = ("```python\nimport torch\n\ndef evaluate(env):\n    z = torch.zeros(env.num_envs, dtype=torch.bool, "
            "device=env.device)\n    return {'fail': z}\n\n"
            "def compute_dense_reward(env, obs, action, info):\n"

@@ -155,7 +155,7 @@ def test_a_start_in_collision_is_left_without_going_deeper(apple_env):
     assert min(model.clearance(q) for q in path) >= depth - 0.0021
 
 
-@pytest.mark.parametrize("seed", [0, 7])
+@pytest.mark.parametrize("seed", [0, pytest.param(7, marks=pytest.mark.slow)])
 def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed):
     env = apple_env.unwrapped
     executor = StageExecutor()
@@ -169,7 +169,7 @@ def test_synthesized_grasp_lifts_the_apple_10cm_and_holds_it_2s(apple_env, seed)
     assert forces[0] > 0.3 and (forces[1:5] > 0.3).sum() >= 2  # held by the thumb against the fingers
 
 
-@pytest.mark.parametrize("seed", [0, 7])
+@pytest.mark.parametrize("seed", [0, pytest.param(7, marks=pytest.mark.slow)])
 def test_synthesized_grasp_lifts_the_bottle_10cm_and_holds_it_2s(bottle_env, seed):
     env = bottle_env.unwrapped
     executor = StageExecutor()
