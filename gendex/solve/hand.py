@@ -35,6 +35,9 @@ _FLEX = (("th", "THJ0", -1.0), ("ff", "FFJ1", 1.0), ("mf", "MFJ1", 1.0), ("rf", 
 IK_TOL_M = 0.002
 """A finger IK answer counts when its pad point is within this of the target."""
 _SAMPLES = 2500
+_SAMPLED: dict[tuple, dict[tuple[str, float], tuple[np.ndarray, cKDTree]]] = {}
+"""Pad samples by hand kinematics (:meth:`HandModel._kinematics_key`): every solver of a process shares them, read
+only (2.5 s a hand to compute; a solver is made per task and per attempt)."""
 DIFF_STEP = 1e-4
 """Finite-difference step (relative, rad) of the fingertip pinch's least-squares solves (:mod:`gendex.solve.tip_pinch`).
 Forward kinematics comes in float32 poses: at scipy's default step (~1e-8) a derivative is rounding noise, solves
@@ -92,15 +95,33 @@ class HandModel:
         self._hand_links = sorted({*self._sphere_link.tolist(), *self._tips, self._palm})
         self.tip_end = _tip_ends(robot)
         """Distance of each distal capsule's far end-cap centre along its link's z axis (th, ff, mf, rf, lf)."""
+        key = self._kinematics_key()
+        self._samples = _SAMPLED.get(key)
+        if self._samples is None:
+            self._samples = _SAMPLED[key] = self._sample_pads()
+
+    def _kinematics_key(self) -> tuple:
+        """What the pad samples depend on: the model's names and limits and where its pads are at two probe
+        configurations (a hand whose kinematics differ in any way gets samples of its own)."""
+        probe = {j: 0.5 * (lo + hi) for f in FINGERS for j, lo, hi in zip(actuated(f), *self.bounds(actuated(f)),
+                                                                               strict=True)}
+        return (tuple(self.names), tuple(self.ik.link_names), self.ik.limits.tobytes(), self.pads({}).tobytes(),
+                self.pads(probe).tobytes(), self.pads(probe, TIP_ALONG_M).tobytes())
+
+    def _sample_pads(self) -> dict[tuple[str, float], tuple[np.ndarray, cKDTree]]:
+        """Per finger and pad point, :data:`_SAMPLES` random joint configurations (seeded) and a KD-tree of where the
+        point is at each (palm frame): :meth:`finger_ik`'s starts and :meth:`reach_gap`'s test."""
         rng = np.random.default_rng(0)
-        self._samples: dict[tuple[str, float], tuple[np.ndarray, cKDTree]] = {}
+        samples = {}
         for f in FINGERS:
             js = actuated(f)
             lo, hi = self.bounds(js)
             qs = rng.uniform(lo, hi, size=(_SAMPLES, len(js)))
+            qs.flags.writeable = False  # shared between solvers
             for along in (PAD_ALONG_M, TIP_ALONG_M):
                 pts = np.array([self.pads(dict(zip(js, q, strict=True)), along)[FINGERS.index(f)] for q in qs])
-                self._samples[f, along] = (qs, cKDTree(pts))
+                samples[f, along] = (qs, cKDTree(pts))
+        return samples
 
     # ------------------------------------------------------------------ forward kinematics
     def vector(self, hand: dict[str, float]) -> np.ndarray:
@@ -133,11 +154,18 @@ class HandModel:
             frames[i] = inv @ model.get_link_pose(i).to_transformation_matrix()
         return frames
 
+    def _tip_frames(self, hand: dict[str, float]) -> list[np.ndarray]:
+        """The distal links' entries of :meth:`_link_frames` (th, ff, mf, rf, lf), computed alone: the same numbers,
+        without the other links' transforms (the pad of a finger IK solve or of the samples needs only these)."""
+        model = self.ik.model
+        model.compute_forward_kinematics(self.vector(hand))
+        inv = np.linalg.inv(model.get_link_pose(self._palm).to_transformation_matrix())
+        return [inv @ model.get_link_pose(i).to_transformation_matrix() for i in self._tips]
+
     def pads(self, hand: dict[str, float], along: float = PAD_ALONG_M) -> np.ndarray:
         """[5, 3] pad points (th, ff, mf, rf, lf) in the palm frame: ``along`` the distal links' axes (the pads, or
         with :data:`TIP_ALONG_M` the fingertips' ends)."""
-        _, frames = self._link_frames(hand)
-        return np.array([frames[i][:3, :3] @ [0.0, 0.0, along] + frames[i][:3, 3] for i in self._tips])
+        return np.array([f[:3, :3] @ [0.0, 0.0, along] + f[:3, 3] for f in self._tip_frames(hand)])
 
     def pad_normals(self, hand: dict[str, float], eps: float = 1e-3, along: float = PAD_ALONG_M) -> np.ndarray:
         """[5, 3] unit directions the pads face (palm frame): where each pad moves when its finger's last joint

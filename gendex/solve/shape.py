@@ -152,6 +152,9 @@ class Footprint:
         return np.array([-self.axis[1], self.axis[0]])
 
 
+_MAX, _MIN = np.maximum.reduce, np.minimum.reduce
+
+
 class PosedShape:
     """An :class:`ObjectShape` at one pose, in world coordinates."""
 
@@ -172,18 +175,20 @@ class PosedShape:
         real, ``direction`` unit) is inside material."""
         o, d = np.asarray(origin, float), np.asarray(direction, float)
         spans = []
-        for p in self.parts:
-            num = -(p.normals @ o + p.offsets)  # n·(o + t d) + b <= 0  <=>  t (n·d) <= num
-            den = p.normals @ d
-            with np.errstate(divide="ignore", invalid="ignore"):
+        # one errstate for all parts and the ufuncs' own reductions: this runs tens of thousands of times a grasp
+        # search, where numpy's per-call wrappers cost more than the arithmetic (the same numbers either way)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for p in self.parts:
+                num = -(p.normals @ o + p.offsets)  # n·(o + t d) + b <= 0  <=>  t (n·d) <= num
+                den = p.normals @ d
                 t = num / den
-            parallel = np.abs(den) < 1e-12
-            if np.any(parallel & (num < 0)):
-                continue  # parallel to a face and outside it
-            t_in = np.max(t[(den < 0) & ~parallel], initial=-np.inf)
-            t_out = np.min(t[(den > 0) & ~parallel], initial=np.inf)
-            if t_in < t_out:
-                spans.append((float(t_in), float(t_out)))
+                parallel = np.abs(den) < 1e-12
+                if (parallel & (num < 0)).any():
+                    continue  # parallel to a face and outside it
+                t_in = _MAX(t[(den < 0) & ~parallel], initial=-np.inf)
+                t_out = _MIN(t[(den > 0) & ~parallel], initial=np.inf)
+                if t_in < t_out:
+                    spans.append((float(t_in), float(t_out)))
         spans.sort()
         merged: list[tuple[float, float]] = []
         for a, b in spans:

@@ -43,6 +43,54 @@ def golf():
     s.env.close()
 
 
+def test_pads_and_shared_samples_are_the_numbers_a_full_pass_gives(golf):
+    """The solver's speed-ups change no number: a pad from the distal frames alone equals the one from every link's
+    frame, and a hand model made later shares the first one's pad samples, equal to samples computed afresh."""
+    from gendex.solve import hand as hand_mod
+
+    h = golf.hand
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        q = {j: float(rng.uniform(*h.bounds([j]))[0]) for f in ("th", "ff", "lf") for j in actuated(f)}
+        _, frames = h._link_frames(q)
+        full = np.array([frames[i][:3, :3] @ [0.0, 0.0, 0.016] + frames[i][:3, 3] for i in h._tips])
+        assert np.array_equal(h.pads(q, 0.016), full)
+    again = HandModel(golf.ik, golf.env.agent.robot)
+    assert again._samples is h._samples and again._samples is hand_mod._SAMPLED[h._kinematics_key()]
+    fresh = h._sample_pads()
+    for key, (qs, tree) in fresh.items():
+        assert np.array_equal(qs, h._samples[key][0]) and np.array_equal(tree.data, h._samples[key][1].data), key
+    assert not h._samples["ff", 0.016][0].flags.writeable
+
+
+def test_ray_intervals_match_a_face_by_face_reference(bowl):
+    """Where the line is inside each convex part, merged: the fast loop against the plain definition."""
+    rng = np.random.default_rng(3)
+    shape = bowl.shape
+    for _ in range(200):
+        o = shape.vertices.mean(axis=0) + rng.normal(0, 0.05, 3)
+        d = rng.normal(size=3)
+        d /= np.linalg.norm(d)
+        spans = []
+        for part in shape.parts:
+            num, den = -(part.normals @ o + part.offsets), part.normals @ d
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ts = num / den
+            par = np.abs(den) < 1e-12
+            if np.any(par & (num < 0)):
+                continue
+            lo, hi = np.max(ts[(den < 0) & ~par], initial=-np.inf), np.min(ts[(den > 0) & ~par], initial=np.inf)
+            if lo < hi:
+                spans.append((float(lo), float(hi)))
+        merged = []
+        for a, b in sorted(spans):
+            if merged and a <= merged[-1][1] + 1e-6:
+                merged[-1] = (merged[-1][0], max(merged[-1][1], b))
+            else:
+                merged.append((a, b))
+        assert shape.ray_intervals(o, d) == merged
+
+
 def test_rays_find_both_walls_of_a_bowl_and_one_solid_ball(bowl, golf):
     fp = bowl.shape.footprint()
     assert fp.length == pytest.approx(0.15, abs=0.005) and fp.height == pytest.approx(0.063, abs=0.003)
