@@ -1,6 +1,9 @@
 """PPO learns: on a short stage (PickUpBottle's 60-step arm approach, 6 joints), a few thousand env steps of the
 ``cpu`` preset raise the mean evaluation return well above the untrained policy's, on the same evaluation seeds.
-About a minute on two cores; not marked slow, so CI runs it with the default suite."""
+About a minute alone: marked slow (`scripts/test.sh --slow`), as a measurement of learning; the default suite trains
+and promotes a policy through the same code (tests/sim/test_promote.py) and runs one (tests/rl/test_stage_policy.py)."""
+
+import pytest
 
 from gendex.train.train import progress_rows, train_stage
 from gendex_envs.task_version import Artifacts
@@ -8,6 +11,7 @@ from gendex_envs.task_version import Artifacts
 STEPS = 16384
 
 
+@pytest.mark.slow
 def test_ppo_raises_the_stage_return(task_version, tmp_path):
     bottle = task_version("PickUpBottle", 0)
     before = bottle.file_digest()

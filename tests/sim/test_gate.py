@@ -70,6 +70,7 @@ def test_a_task_failing_the_gate_is_dropped_with_its_reason_and_the_next_is_comm
     assert json.loads(s.committed.files.record("proposal").read_text())["name"] == second
 
 
+@pytest.mark.slow  # the same three failing verdicts as the batch test below, without `failed` given
 def test_when_every_proposal_fails_the_gate_nothing_is_committed_and_every_reason_is_given(tmp_path, monkeypatch,
                                                                                            no_renders):
     monkeypatch.setattr("generator.pipeline.run_gate",

@@ -100,7 +100,13 @@ def _run(folder: Path, tmp_path: Path, trust: bool = False, static_check: bool =
     return out
 
 
-@pytest.mark.parametrize("case", sorted(ATTACKS))
+DEFAULT_CASES = ("open", "torch_save", "numpy_dump", "rt_torch")
+"""One deferred case per fence in the default suite (restricted builtins, reward code's torch copy, the audit hook,
+a module's torch reached through another); every case under --slow (each is an interpreter of its own)."""
+
+
+@pytest.mark.parametrize("case", [c if c in DEFAULT_CASES else pytest.param(c, marks=pytest.mark.slow)
+                                  for c in sorted(ATTACKS)])
 def test_deferred_hostile_reward_code_is_stopped_when_it_acts(task_copy, tmp_path, case):
     attack, reason = ATTACKS[case]
     marker = tmp_path / "pwned"
