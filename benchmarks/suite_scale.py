@@ -1,0 +1,141 @@
+"""Does the default test suite's cost grow with the task library? (issue 44, item 3: flat within 10 % when the
+library doubles.)
+
+Two clones of the checkout's HEAD are made side by side: one as it is, one whose library is ``--factor`` times as
+large. Each task of the doubled clone gets ``factor - 1`` twins (``<Name>Twin``, ``<Name>Twin2`` …): whole copies of
+every one of its versions, renamed in their spec, packed into the clone's task store, indexed and recorded as trusted,
+then committed, and the clone's ``origin/main`` is moved to that commit, so the twins are part of the library the
+suite starts from (a change that touches versions checks those; this measures the steady state). Both clones share
+the checkout's ``.venv`` (a link; ``PYTHONPATH`` points every process at its own clone's code and library).
+
+``bash scripts/test.sh --junitxml=…`` then runs in each clone, one after the other, and the wall time, the summed test
+times by file and the outcome counts are compared.
+
+Run: ``.venv/bin/python benchmarks/suite_scale.py [--factor 2] [--workdir DIR] [--json PATH]`` (about twice the
+suite's time; run it on an otherwise idle machine). ``--prepare-only`` makes the clones and stops.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+TWIN_SCRIPT = """
+import json, re, sys
+from pathlib import Path
+from gendex_envs.registry import discover_tasks
+from gendex_envs.task_version import TaskLayout
+
+root, factor = Path(sys.argv[1]), int(sys.argv[2])
+made = []
+for env_id, version in sorted(discover_tasks([root]).items()):
+    for k in range(1, factor):
+        name = version.name + ("Twin" if k == 1 else f"Twin{k}")
+        dest = root / name / version.root.name
+        spec = TaskLayout(version.copy_to(dest)).spec
+        spec.write_text(re.sub(r"(?m)^name: .*$", f"name: {name}", spec.read_text(), count=1))
+        made.append(str(dest))
+print(json.dumps(made))
+"""
+
+
+def _run(cmd: list[str], cwd: Path, env: dict | None = None) -> str:
+    out = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed in {cwd}:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
+    return out.stdout
+
+
+def _env(clone: Path) -> dict:
+    env = {k: v for k, v in os.environ.items() if k != "GENDEX_TASKS_PATH"}
+    env["PYTHONPATH"] = str(clone)
+    return env
+
+
+def make_clone(dest: Path, factor: int) -> dict:
+    """A clone of HEAD at ``dest`` whose library is ``factor`` times the checkout's, committed (see the module)."""
+    if dest.exists():
+        shutil.rmtree(dest)
+    _run(["git", "clone", "--quiet", str(ROOT), str(dest)], ROOT)
+    (dest / ".venv").symlink_to(ROOT / ".venv")
+    py, env = str(ROOT / ".venv" / "bin" / "python"), _env(dest)
+    twins: list[str] = []
+    if factor > 1:
+        twins = json.loads(_run([py, "-c", TWIN_SCRIPT, str(dest / "generated_tasks"), str(factor)], dest, env))
+        for cmd in (["store", "pack"], ["store", "index"], ["trust", *twins]):
+            _run([py, "-m", "gendex.cli", *cmd], dest, env)
+        _run(["git", "add", "generated_tasks"], dest)
+        _run(["git", "-c", "user.name=suite-scale", "-c", "user.email=suite-scale@localhost", "commit", "--quiet",
+              "-m", f"synthetic library: {factor}x the tasks"], dest)
+    _run(["git", "update-ref", "refs/remotes/origin/main", "HEAD"], dest)
+    ids = _run([py, "-c", "import gymnasium as gym, gendex_envs; "
+                          "print(sum(i.startswith('GenDex/') for i in gym.registry))"], dest, env)
+    return {"path": str(dest), "factor": factor, "twin_versions": len(twins), "registered": int(ids.strip())}
+
+
+def run_suite(clone: Path, junit: Path) -> dict:
+    """``scripts/test.sh`` in ``clone``: wall seconds, outcome counts and test seconds by file."""
+    t = time.perf_counter()
+    proc = subprocess.run(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
+                          cwd=clone, env=_env(clone), capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    counts: collections.Counter = collections.Counter()
+    by_file: collections.Counter = collections.Counter()
+    failed = []
+    for case in ET.parse(junit).iter("testcase"):
+        by_file[case.get("classname")] += float(case.get("time", 0))
+        kind = next((c.tag for c in case if c.tag in ("failure", "error", "skipped")), "passed")
+        counts[kind] += 1
+        if kind in ("failure", "error"):
+            failed.append(f"{case.get('classname')}::{case.get('name')}")
+    return {"wall_s": wall, "returncode": proc.returncode, "counts": dict(counts), "failed": failed,
+            "test_s": sum(by_file.values()), "by_file_s": dict(by_file.most_common()),
+            "tail": proc.stdout[-1500:]}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--factor", type=int, default=2)
+    ap.add_argument("--workdir", type=Path, default=Path("/tmp/gendex-suite-scale"))
+    ap.add_argument("--json", type=Path)
+    ap.add_argument("--prepare-only", action="store_true")
+    args = ap.parse_args()
+    if args.factor < 2:
+        raise SystemExit(f"--factor must be at least 2 (got {args.factor})")
+    head = _run(["git", "rev-parse", "HEAD"], ROOT).strip()
+    clones = {"base": make_clone(args.workdir / "base", 1),
+              f"x{args.factor}": make_clone(args.workdir / f"x{args.factor}", args.factor)}
+    print(json.dumps(clones, indent=1), flush=True)
+    if args.prepare_only:
+        return
+    runs = {}
+    for key, info in clones.items():
+        runs[key] = run_suite(Path(info["path"]), args.workdir / f"{key}.xml")
+        print(key, json.dumps({k: v for k, v in runs[key].items() if k != "by_file_s"}), flush=True)
+    base, big = runs["base"], runs[f"x{args.factor}"]
+    files = sorted(set(base["by_file_s"]) | set(big["by_file_s"]),
+                   key=lambda f: -abs(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0)))
+    record = {"commit": head, "factor": args.factor, "clones": clones, "runs": runs,
+              "wall_ratio": big["wall_s"] / base["wall_s"], "test_time_ratio": big["test_s"] / base["test_s"],
+              "largest_changes_s": {f: round(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0), 1)
+                                    for f in files[:15]},
+              "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
+                          "load_avg_after": os.getloadavg()}}
+    print(json.dumps({k: record[k] for k in ("wall_ratio", "test_time_ratio", "largest_changes_s")}, indent=1))
+    if args.json:
+        args.json.write_text(json.dumps(record, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
