@@ -102,13 +102,12 @@ def _spec_facts(version) -> tuple[Signature, str]:
 
 def _embed(texts: list[str]):
     """:func:`generator.stats.embed` of ``texts`` (vectors and the model's source), each text encoded once a
-    process."""
+    process and on its own (as a proposal's instruction is): a text's vector does not depend on which texts were
+    encoded with it or before it."""
     import numpy as np
 
-    todo = list(dict.fromkeys(t for t in texts if t not in _EMBEDDINGS))
-    if todo:
-        vectors, _ = embed(todo)
-        _EMBEDDINGS.update(zip(todo, vectors, strict=True))
+    for text in dict.fromkeys(t for t in texts if t not in _EMBEDDINGS):
+        _EMBEDDINGS[text] = embed([text])[0][0]
     return np.stack([_EMBEDDINGS[t] for t in texts]), embedding_source()
 
 

@@ -135,6 +135,15 @@ def no_renders(monkeypatch):
 
 
 @pytest.fixture(scope="session")
+def committed_tasks() -> dict[str, TaskVersion]:
+    """The committed library (``discover_tasks`` of ``generated_tasks/``, whatever else this process registered),
+    found once a process so that each spec is parsed once however many tests read it. Read it; do not change it."""
+    from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
+
+    return discover_tasks([REPO_TASKS_DIR])
+
+
+@pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository (for tests of its own files: docs, benchmarks, the source tree)."""
     return Path(__file__).resolve().parent.parent

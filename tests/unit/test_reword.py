@@ -10,7 +10,6 @@ import pytest
 import yaml
 
 from gendex_envs import task_store
-from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dicts
 from generator.instruction import SYNONYMS
@@ -127,9 +126,9 @@ def test_a_reworded_task_is_published_as_the_next_version_and_the_source_is_unto
     assert not list((source.tasks_root / ".drafts").glob("*"))  # nothing half-written left behind
 
 
-def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse():
+def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse(committed_tasks):
     # the library as it was before its rewording: the latest version of each task that is not a rewording
-    unworded = {k: v for k, v in discover_tasks([REPO_TASKS_DIR]).items() if "reword" not in v.provenance()}
+    unworded = {k: v for k, v in committed_tasks.items() if "reword" not in v.provenance()}
     candidates = {k: v for k, v in latest_versions(unworded).items()
                   if v.name.startswith(("Lift", "Put", "SetFoam", "Close"))}
     # a fixed number of them (the kept task and the first others by id), so the test does not grow with the library
@@ -158,8 +157,8 @@ def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse(
     assert pairs.max() < MAX_PAIR_COSINE  # no two tasks framed so that they read as one
 
 
-def test_the_offline_author_words_a_proposal_least_like_the_library(task_version):
-    library = [v.spec.instruction for v in latest_versions(discover_tasks([REPO_TASKS_DIR])).values()]
+def test_the_offline_author_words_a_proposal_least_like_the_library(task_version, committed_tasks):
+    library = [v.spec.instruction for v in latest_versions(committed_tasks).values()]
     spec = task_version("PutPlumInPot").spec
     proposal = {"name": "PutPlumInPot", "description": spec.instruction,
                 "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
@@ -188,10 +187,10 @@ def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     assert float(e[0] @ e[1]) < MAX_PAIR_COSINE, chosen
 
 
-def test_the_committed_library_reads_as_varied_as_the_issue_asks():
+def test_the_committed_library_reads_as_varied_as_the_issue_asks(committed_tasks):
     """The library's instruction diversity (mean pairwise MiniLM cosine of the latest versions) meets the task
     library issue's goal of <= 0.19 (RoboGen 0.191; before the rewording 0.299)."""
-    texts = [v.spec.instruction for v in latest_versions(discover_tasks([REPO_TASKS_DIR])).values()]
+    texts = [v.spec.instruction for v in latest_versions(committed_tasks).values()]
     assert len(texts) >= 60 and _mean_cos(texts) <= 0.19
     e = embed(texts)[0]
     pairs = e @ e.T
@@ -219,10 +218,10 @@ def test_a_version_that_is_not_a_folder_of_the_library_is_not_touched_by_a_faile
     assert not list((source.tasks_root / ".drafts").glob("*"))
 
 
-def test_a_reworded_version_differs_from_its_source_only_in_its_instruction():
+def test_a_reworded_version_differs_from_its_source_only_in_its_instruction(committed_tasks):
     """What lets the environment checks test a reworded version through its source: every committed rewording
     is its source's folder byte for byte, but for the spec's instruction (and its reword record)."""
-    found = discover_tasks([REPO_TASKS_DIR])
+    found = committed_tasks
     reworded = {e: v for e, v in found.items() if "reword" in v.provenance()}
     assert len(reworded) >= 70
     for env_id, v in reworded.items():

@@ -6,7 +6,6 @@ import pytest
 from typer.testing import CliRunner
 
 from gendex.cli import app
-from gendex_envs.registry import REPO_TASKS_DIR, discover_tasks
 from generator.phrasing import split
 from generator.stats import TASK_SKILLS, instruction_diversity, jaccard, library_stats, task_skills
 
@@ -20,8 +19,8 @@ EXPECTED = {
 
 
 @pytest.fixture(scope="module")
-def tasks():
-    return discover_tasks([REPO_TASKS_DIR])  # the committed library, whatever else this process registered
+def tasks(committed_tasks):
+    return committed_tasks  # the committed library, whatever else this process registered
 
 
 def test_each_reference_task_is_counted_under_its_skill(tasks):
