@@ -16,7 +16,6 @@ import pytest
 from gendex.fanout import Backend
 from generator.backends.registry import make_backend
 from generator.pipeline import BatchState, generate
-from generator.render import VIEWS
 from generator.steps.gate import GateResult
 
 
@@ -48,15 +47,9 @@ def _two_ahead(make_worker, jobs, backend=None, *, ahead=None):
         yield worker(pending.popleft())
 
 
-def _stub_views(spec, *, seed=0, resolution=None):
-    """Renders stand-in (half a task's generation time goes to rendering; these tests are about the batch)."""
-    return {view: f"{spec.name}:{view}:{seed}".encode() for view in VIEWS}
-
-
-def test_a_wrong_guess_is_generated_again_and_the_batch_equals_one_process(tmp_path, monkeypatch, caplog):
+def test_a_wrong_guess_is_generated_again_and_the_batch_equals_one_process(tmp_path, monkeypatch, caplog,
+                                                                           no_renders):
     factory = functools.partial(make_backend, "offline", seed=4242)
-    monkeypatch.setattr("generator.pipeline.render_spec", _stub_views)
-    monkeypatch.setattr("generator.steps.refine.render_spec", _stub_views)
     dropped: set[str] = set()
     sequential: list[str] = []
     monkeypatch.setattr("generator.pipeline.run_gate", _scripted_gate(dropped, sequential))

@@ -88,14 +88,19 @@ def _task(task_copy, tmp_path: Path, name: str, attack: str) -> Path:
     return version.root
 
 
+def _result(proc: subprocess.CompletedProcess) -> dict:
+    """The JSON a child script printed after ``RESULT ``."""
+    line = next((x for x in proc.stdout.splitlines() if x.startswith("RESULT ")), None)
+    assert line, proc.stdout[-2000:] + proc.stderr[-3000:]
+    return json.loads(line[7:])
+
+
 def _run(folder: Path, tmp_path: Path, trust: bool = False, static_check: bool = False) -> dict:
     user_file = tmp_path / "user.txt"
     proc = subprocess.run([sys.executable, "-c", SCRIPT, str(folder), "trust" if trust else "no", str(user_file),
                            "static-check" if static_check else "skip-static-check"],
                           capture_output=True, text=True, timeout=600, cwd=REPO)
-    line = next((x for x in proc.stdout.splitlines() if x.startswith("RESULT ")), None)
-    assert line, proc.stdout[-2000:] + proc.stderr[-3000:]
-    out = json.loads(line[7:])
+    out = _result(proc)
     assert user_file.read_text() == "user" and out["user_wrote"]
     return out
 
@@ -142,9 +147,7 @@ def test_untrusted_hostile_modules_are_rejected_when_the_env_is_made(task_copy, 
                                    attack.format(marker=marker))), marker)
     proc = subprocess.run([sys.executable, "-c", STATIC_SCRIPT, json.dumps([f for f, _ in folders.values()])],
                           capture_output=True, text=True, timeout=600, cwd=REPO)
-    line = next((x for x in proc.stdout.splitlines() if x.startswith("RESULT ")), None)
-    assert line, proc.stdout[-2000:] + proc.stderr[-3000:]
-    out = json.loads(line[7:])
+    out = _result(proc)
     for case, (folder, marker) in folders.items():
         error = out[folder]
         assert error.startswith("RewardModuleError") and "static check rejected" in error and "was rejected" in \
