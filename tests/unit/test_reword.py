@@ -12,6 +12,7 @@ import yaml
 from gendex_envs import task_store
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dicts
+from generator.embedding import embed, embed_each
 from generator.instruction import SYNONYMS
 from generator.novelty import NEAR_DUPLICATE_COSINE
 from generator.phrasing import (
@@ -40,7 +41,7 @@ from generator.reword import (
     replace_instruction,
     spec_frames,
 )
-from generator.stats import embed, latest_versions
+from generator.stats import latest_versions
 
 ASSETS = {a["id"]: a for a in asset_dicts()}
 PLANNED = 24
@@ -165,7 +166,7 @@ def test_the_offline_author_words_a_proposal_least_like_the_library(task_version
                 "steps": [], "success": {"type": "inside", "object": "plum", "target": "pot"}}
     worded = ProposalWording()(proposal, library)
     options = candidates_for("PutPlumInPot", spec.instruction, spec_frames(spec))
-    sims = embed(options)[0] @ embed(library)[0].T
+    sims = embed_each(options)[0] @ embed_each(library)[0].T
     apart = [k for k in range(len(options)) if sims[k].max() < MAX_PAIR_COSINE]
     assert apart  # some framing reads like no task of the library
     assert worded["description"] == options[min(apart, key=lambda k: sims[k].mean())]
@@ -183,7 +184,7 @@ def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     options = framings(command, Frame("cold", "open"), Frame("cold", "open"), "table")
     assert any(o.startswith("The butter is needed") for o in options)
     chosen = LibraryWording(library)(options)
-    e = embed([chosen, right])[0]
+    e = embed_each([chosen, right])[0]
     assert float(e[0] @ e[1]) < MAX_PAIR_COSINE, chosen
 
 
