@@ -8,11 +8,17 @@ then committed, and the clone's ``origin/main`` is moved to that commit, so the 
 suite starts from (a change that touches versions checks those; this measures the steady state). Both clones share
 the checkout's ``.venv`` (a link; ``PYTHONPATH`` points every process at its own clone's code and library).
 
-``bash scripts/test.sh --junitxml=…`` then runs in each clone, one after the other, and the wall time, the summed test
-times by file and the outcome counts are compared.
+``bash scripts/test.sh --junitxml=…`` then runs in each clone, and the wall time, the summed test times by file and
+the outcome counts are compared. By default the two suites run one after the other; on a shared machine whose load
+drifts (this one ran the same clone 32 % slower forty minutes later) pass ``--together``: both suites run at the
+same time, each on its usual two workers, so whatever else the machine does slows both alike and the ratio is a
+paired one (each suite's own time is then about twice its time alone). Each clone gets a fresh, empty
+``GENDEX_CACHE`` (as a new CI machine has), so caches built by one run do not serve the other; a twin's instruction
+is its original's, so the doubled clone embeds no more distinct instructions than the base
+(:mod:`generator.embedding` encodes a new instruction once a machine).
 
-Run: ``.venv/bin/python benchmarks/suite_scale.py [--factor 2] [--workdir DIR] [--json PATH]`` (about twice the
-suite's time; run it on an otherwise idle machine). ``--prepare-only`` makes the clones and stops.
+Run: ``.venv/bin/python benchmarks/suite_scale.py [--factor 2] [--together] [--workdir DIR] [--json PATH]`` (about
+twice the suite's time either way). ``--prepare-only`` makes the clones and stops.
 """
 
 from __future__ import annotations
@@ -60,6 +66,7 @@ def _run(cmd: list[str], cwd: Path, env: dict | None = None) -> str:
 def _env(clone: Path) -> dict:
     env = {k: v for k, v in os.environ.items() if k != "GENDEX_TASKS_PATH"}
     env["PYTHONPATH"] = str(clone)
+    env["GENDEX_CACHE"] = str(clone.parent / f"{clone.name}-cache")
     return env
 
 
@@ -84,12 +91,19 @@ def make_clone(dest: Path, factor: int) -> dict:
     return {"path": str(dest), "factor": factor, "twin_versions": len(twins), "registered": int(ids.strip())}
 
 
-def run_suite(clone: Path, junit: Path) -> dict:
-    """``scripts/test.sh`` in ``clone``: wall seconds, outcome counts and test seconds by file."""
-    t = time.perf_counter()
-    proc = subprocess.run(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
-                          cwd=clone, env=_env(clone), capture_output=True, text=True)
-    wall = time.perf_counter() - t
+def start_suite(clone: Path, junit: Path) -> tuple[subprocess.Popen, float]:
+    """``scripts/test.sh`` started in ``clone`` (with a fresh cache folder), and when it started."""
+    env = _env(clone)
+    shutil.rmtree(env["GENDEX_CACHE"], ignore_errors=True)
+    proc = subprocess.Popen(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
+                            cwd=clone, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    return proc, time.perf_counter()
+
+
+def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
+    """Wall seconds, outcome counts and test seconds by file of a suite :func:`start_suite` started."""
+    stdout, _ = proc.communicate()
+    wall = time.perf_counter() - started
     counts: collections.Counter = collections.Counter()
     by_file: collections.Counter = collections.Counter()
     failed = []
@@ -101,7 +115,7 @@ def run_suite(clone: Path, junit: Path) -> dict:
             failed.append(f"{case.get('classname')}::{case.get('name')}")
     return {"wall_s": wall, "returncode": proc.returncode, "counts": dict(counts), "failed": failed,
             "test_s": sum(by_file.values()), "by_file_s": dict(by_file.most_common()),
-            "tail": proc.stdout[-1500:]}
+            "tail": stdout[-1500:]}
 
 
 def main() -> None:
@@ -110,6 +124,7 @@ def main() -> None:
     ap.add_argument("--workdir", type=Path, default=Path("/tmp/gendex-suite-scale"))
     ap.add_argument("--json", type=Path)
     ap.add_argument("--prepare-only", action="store_true")
+    ap.add_argument("--together", action="store_true", help="run both suites at the same time (a paired ratio)")
     args = ap.parse_args()
     if args.factor < 2:
         raise SystemExit(f"--factor must be at least 2 (got {args.factor})")
@@ -119,19 +134,26 @@ def main() -> None:
     print(json.dumps(clones, indent=1), flush=True)
     if args.prepare_only:
         return
-    runs = {}
-    for key, info in clones.items():
-        runs[key] = run_suite(Path(info["path"]), args.workdir / f"{key}.xml")
-        print(key, json.dumps({k: v for k, v in runs[key].items() if k != "by_file_s"}), flush=True)
+    runs, load_before = {}, os.getloadavg()
+    if args.together:
+        started = {key: start_suite(Path(info["path"]), args.workdir / f"{key}.xml") for key, info in clones.items()}
+        for key, (proc, t0) in started.items():
+            runs[key] = finish_suite(proc, t0, args.workdir / f"{key}.xml")
+    else:
+        for key, info in clones.items():
+            runs[key] = finish_suite(*start_suite(Path(info["path"]), args.workdir / f"{key}.xml"),
+                                     args.workdir / f"{key}.xml")
+    for key, run in runs.items():
+        print(key, json.dumps({k: v for k, v in run.items() if k != "by_file_s"}), flush=True)
     base, big = runs["base"], runs[f"x{args.factor}"]
     files = sorted(set(base["by_file_s"]) | set(big["by_file_s"]),
                    key=lambda f: -abs(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0)))
-    record = {"commit": head, "factor": args.factor, "clones": clones, "runs": runs,
+    record = {"commit": head, "factor": args.factor, "together": args.together, "clones": clones, "runs": runs,
               "wall_ratio": big["wall_s"] / base["wall_s"], "test_time_ratio": big["test_s"] / base["test_s"],
               "largest_changes_s": {f: round(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0), 1)
                                     for f in files[:15]},
               "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                          "load_avg_after": os.getloadavg()}}
+                          "load_avg_before": load_before, "load_avg_after": os.getloadavg()}}
     print(json.dumps({k: record[k] for k in ("wall_ratio", "test_time_ratio", "largest_changes_s")}, indent=1))
     if args.json:
         args.json.write_text(json.dumps(record, indent=1) + "\n")
