@@ -8,14 +8,14 @@ then committed, and the clone's ``origin/main`` is moved to that commit, so the 
 suite starts from (a change that touches versions checks those; this measures the steady state). Both clones share
 the checkout's ``.venv`` (a link; ``PYTHONPATH`` points every process at its own clone's code and library).
 
-``bash scripts/test.sh --junitxml=…`` then runs in each clone, and the wall time, the summed test times by file and
-the outcome counts are compared. By default the two suites run one after the other; on a shared machine whose load
-drifts (this one ran the same clone 32 % slower forty minutes later) pass ``--together``: both suites run at the
-same time, each on its usual two workers, so whatever else the machine does slows both alike and the ratio is a
-paired one (each suite's own time is then about twice its time alone). Each clone gets a fresh, empty
-``GENDEX_CACHE`` (as a new CI machine has), so caches built by one run do not serve the other; a twin's instruction
-is its original's, so the doubled clone embeds no more distinct instructions than the base
-(:mod:`generator.embedding` encodes a new instruction once a machine).
+``bash scripts/test.sh --junitxml=…`` then runs in each clone (one after the other, or with ``--together`` both at
+once), and the CPU seconds, wall seconds, summed test seconds by file and outcome counts are compared. **CPU seconds
+are the measure of growth**: on this shared 2-core machine wall seconds drift (the same clone ran 32 % slower forty
+minutes later) and, run together, single tests took 5 to 20 times longer in one suite than in the other, while
+the CPU a suite's processes use barely depends on what else runs. Each clone gets a fresh, empty ``GENDEX_CACHE``
+(as a new CI machine has), so caches built by one run do not serve the other; a twin's instruction is its
+original's, so the doubled clone embeds no more distinct instructions than the base (:mod:`generator.embedding`
+encodes a new instruction once a machine, ~0.03 s).
 
 Run: ``.venv/bin/python benchmarks/suite_scale.py [--factor 2] [--together] [--workdir DIR] [--json PATH]`` (about
 twice the suite's time either way). ``--prepare-only`` makes the clones and stops.
@@ -95,14 +95,21 @@ def start_suite(clone: Path, junit: Path) -> tuple[subprocess.Popen, float]:
     """``scripts/test.sh`` started in ``clone`` (with a fresh cache folder), and when it started."""
     env = _env(clone)
     shutil.rmtree(env["GENDEX_CACHE"], ignore_errors=True)
-    proc = subprocess.Popen(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
-                            cwd=clone, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    with open(junit.with_suffix(".log"), "w") as log:
+        proc = subprocess.Popen(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
+                                cwd=clone, env=env, stdout=log, stderr=subprocess.STDOUT)
     return proc, time.perf_counter()
 
 
 def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
-    """Wall seconds, outcome counts and test seconds by file of a suite :func:`start_suite` started."""
-    stdout, _ = proc.communicate()
+    """Wall seconds, CPU seconds, outcome counts and test seconds by file of a suite :func:`start_suite` started.
+
+    CPU seconds (user + system of the suite's process tree: pytest and the workers and children it waited for, from
+    ``wait4``) hardly change with what else the machine runs, where wall and test seconds do: on this shared
+    2-core machine single tests took 5 to 20 times longer in one run than in the other. They are the measure of
+    growth; wall seconds say what a user waits on an idle machine."""
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - started
     counts: collections.Counter = collections.Counter()
     by_file: collections.Counter = collections.Counter()
@@ -113,9 +120,9 @@ def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
         counts[kind] += 1
         if kind in ("failure", "error"):
             failed.append(f"{case.get('classname')}::{case.get('name')}")
-    return {"wall_s": wall, "returncode": proc.returncode, "counts": dict(counts), "failed": failed,
-            "test_s": sum(by_file.values()), "by_file_s": dict(by_file.most_common()),
-            "tail": stdout[-1500:]}
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "returncode": proc.returncode,
+            "counts": dict(counts), "failed": failed, "test_s": sum(by_file.values()),
+            "by_file_s": dict(by_file.most_common()), "tail": junit.with_suffix(".log").read_text()[-1500:]}
 
 
 def main() -> None:
@@ -149,12 +156,14 @@ def main() -> None:
     files = sorted(set(base["by_file_s"]) | set(big["by_file_s"]),
                    key=lambda f: -abs(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0)))
     record = {"commit": head, "factor": args.factor, "together": args.together, "clones": clones, "runs": runs,
-              "wall_ratio": big["wall_s"] / base["wall_s"], "test_time_ratio": big["test_s"] / base["test_s"],
+              "cpu_ratio": big["cpu_s"] / base["cpu_s"], "wall_ratio": big["wall_s"] / base["wall_s"],
+              "test_time_ratio": big["test_s"] / base["test_s"],
               "largest_changes_s": {f: round(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0), 1)
                                     for f in files[:15]},
               "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                           "load_avg_before": load_before, "load_avg_after": os.getloadavg()}}
-    print(json.dumps({k: record[k] for k in ("wall_ratio", "test_time_ratio", "largest_changes_s")}, indent=1))
+    keys = ("cpu_ratio", "wall_ratio", "test_time_ratio", "largest_changes_s")
+    print(json.dumps({k: record[k] for k in keys}, indent=1))
     if args.json:
         args.json.write_text(json.dumps(record, indent=1) + "\n")
 
