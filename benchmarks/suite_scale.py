@@ -95,9 +95,13 @@ def start_suite(clone: Path, junit: Path) -> tuple[subprocess.Popen, float]:
     """``scripts/test.sh`` started in ``clone`` (with a fresh cache folder), and when it started."""
     env = _env(clone)
     shutil.rmtree(env["GENDEX_CACHE"], ignore_errors=True)
+    env["PYTHONPATH"] += os.pathsep + str(clone / "benchmarks")  # the per-test CPU plugin
+    env["GENDEX_CPU_JSON"] = str(junit.with_suffix(".cpu"))
+    for old in junit.parent.glob(junit.with_suffix(".cpu").name + ".*.json"):
+        old.unlink()
     with open(junit.with_suffix(".log"), "w") as log:
-        proc = subprocess.Popen(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider"],
-                                cwd=clone, env=env, stdout=log, stderr=subprocess.STDOUT)
+        proc = subprocess.Popen(["bash", "scripts/test.sh", f"--junitxml={junit}", "-q", "-p", "no:cacheprovider",
+                                 "-p", "cpu_per_test"], cwd=clone, env=env, stdout=log, stderr=subprocess.STDOUT)
     return proc, time.perf_counter()
 
 
@@ -109,6 +113,9 @@ def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
     2-core machine single tests took 5 to 20 times longer in one run than in the other. They are the measure of
     growth; wall seconds say what a user waits on an idle machine."""
     _, status, usage = os.wait4(proc.pid, 0)
+    cpu_by_test: dict[str, float] = {}
+    for part in junit.parent.glob(junit.with_suffix(".cpu").name + ".*.json"):
+        cpu_by_test.update(json.loads(part.read_text()))
     proc.returncode = os.waitstatus_to_exitcode(status)
     wall = time.perf_counter() - started
     counts: collections.Counter = collections.Counter()
@@ -120,9 +127,22 @@ def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
         counts[kind] += 1
         if kind in ("failure", "error"):
             failed.append(f"{case.get('classname')}::{case.get('name')}")
-    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "returncode": proc.returncode,
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "cpu_by_test_s": cpu_by_test,
+            "returncode": proc.returncode,
             "counts": dict(counts), "failed": failed, "test_s": sum(by_file.values()),
             "by_file_s": dict(by_file.most_common()), "tail": junit.with_suffix(".log").read_text()[-1500:]}
+
+
+def cpu_changes(base: dict, big: dict, top: int = 15) -> dict:
+    """Per-test CPU seconds of two suites compared: the sums over the tests both ran, and the tests whose CPU
+    changed most."""
+    a, b = base["cpu_by_test_s"], big["cpu_by_test_s"]
+    both = sorted(set(a) & set(b), key=lambda t: -abs(b[t] - a[t]))
+    total_a, total_b = sum(a[t] for t in both), sum(b[t] for t in both)
+    return {"per_test_cpu": {"tests": len(both), "base_s": round(total_a, 1), "big_s": round(total_b, 1),
+                             "ratio": total_b / total_a if total_a else None,
+                             "only_in_one": len(set(a) ^ set(b))},
+            "largest_cpu_changes_s": {t: [round(a[t], 1), round(b[t], 1)] for t in both[:top]}}
 
 
 def main() -> None:
@@ -151,18 +171,14 @@ def main() -> None:
             runs[key] = finish_suite(*start_suite(Path(info["path"]), args.workdir / f"{key}.xml"),
                                      args.workdir / f"{key}.xml")
     for key, run in runs.items():
-        print(key, json.dumps({k: v for k, v in run.items() if k != "by_file_s"}), flush=True)
+        print(key, json.dumps({k: v for k, v in run.items() if not k.startswith(("by_", "cpu_by"))}), flush=True)
     base, big = runs["base"], runs[f"x{args.factor}"]
-    files = sorted(set(base["by_file_s"]) | set(big["by_file_s"]),
-                   key=lambda f: -abs(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0)))
     record = {"commit": head, "factor": args.factor, "together": args.together, "clones": clones, "runs": runs,
               "cpu_ratio": big["cpu_s"] / base["cpu_s"], "wall_ratio": big["wall_s"] / base["wall_s"],
-              "test_time_ratio": big["test_s"] / base["test_s"],
-              "largest_changes_s": {f: round(big["by_file_s"].get(f, 0) - base["by_file_s"].get(f, 0), 1)
-                                    for f in files[:15]},
+              "test_time_ratio": big["test_s"] / base["test_s"], **cpu_changes(base, big),
               "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                           "load_avg_before": load_before, "load_avg_after": os.getloadavg()}}
-    keys = ("cpu_ratio", "wall_ratio", "test_time_ratio", "largest_changes_s")
+    keys = ("cpu_ratio", "wall_ratio", "test_time_ratio", "per_test_cpu", "largest_cpu_changes_s")
     print(json.dumps({k: record[k] for k in keys}, indent=1))
     if args.json:
         args.json.write_text(json.dumps(record, indent=1) + "\n")
