@@ -54,9 +54,11 @@ class RewordError(ValueError):
 
 class LibraryWording:
     """Chooses, of the sentences offered, the one least like a fixed set of instructions (lowest mean
-    all-MiniLM-L6-v2 cosine). Each sentence is embedded on its own and remembered
+    all-MiniLM-L6-v2 cosine). The library's instructions are embedded each on its own and remembered
     (:func:`generator.embedding.embed_each`): a library that grows by one task costs one new embedding, not the whole
-    library's again. ImportError when the ``stats`` extra is missing."""
+    library's again. The sentences offered (a proposal's framings, dozens, each asked once) are embedded in one
+    call: one by one they cost ~10x the CPU on a machine that has not seen them, as on every fresh CI machine.
+    ImportError when the ``stats`` extra is missing."""
 
     def __init__(self, instructions: Iterable[str]):
         texts = list(instructions)
@@ -67,7 +69,7 @@ class LibraryWording:
             raise ValueError("no sentences to choose from")
         if self._emb is None or len(candidates) == 1:
             return candidates[0]
-        sims = embed_each(candidates)[0] @ self._emb.T
+        sims = embed(candidates)[0] @ self._emb.T
         return candidates[_least_alike(sims, np.arange(len(candidates)))]
 
 

@@ -166,7 +166,7 @@ def test_the_offline_author_words_a_proposal_least_like_the_library(task_version
                 "steps": [], "success": {"type": "inside", "object": "plum", "target": "pot"}}
     worded = ProposalWording()(proposal, library)
     options = candidates_for("PutPlumInPot", spec.instruction, spec_frames(spec))
-    sims = embed_each(options)[0] @ embed_each(library)[0].T
+    sims = embed(options)[0] @ embed_each(library)[0].T
     apart = [k for k in range(len(options)) if sims[k].max() < MAX_PAIR_COSINE]
     assert apart  # some framing reads like no task of the library
     assert worded["description"] == options[min(apart, key=lambda k: sims[k].mean())]
