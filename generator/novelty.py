@@ -81,6 +81,7 @@ _FACTS: dict[str, tuple[Signature, str]] = {}
 """(signature, instruction) by the SHA-256 of a spec's bytes: a process generating several batches parses each
 library spec once, not once a batch (the catalog the signatures read is fixed for a process)."""
 
+
 def _spec_facts(version) -> tuple[Signature, str]:
     key = hashlib.sha256(version.files.spec.read_bytes()).hexdigest()
     hit = _FACTS.get(key)
