@@ -9,13 +9,15 @@ suite starts from (a change that touches versions checks those; this measures th
 the checkout's ``.venv`` (a link; ``PYTHONPATH`` points every process at its own clone's code and library).
 
 ``bash scripts/test.sh --junitxml=…`` then runs in each clone (one after the other, or with ``--together`` both at
-once), and the CPU seconds, wall seconds, summed test seconds by file and outcome counts are compared. **CPU seconds
-are the measure of growth**: on this shared 2-core machine wall seconds drift (the same clone ran 32 % slower forty
-minutes later) and, run together, single tests took 5 to 20 times longer in one suite than in the other, while
-the CPU a suite's processes use barely depends on what else runs. Each clone gets a fresh, empty ``GENDEX_CACHE``
-(as a new CI machine has), so caches built by one run do not serve the other; a twin's instruction is its
-original's, so the doubled clone embeds no more distinct instructions than the base (:mod:`generator.embedding`
-encodes a new instruction once a machine, ~0.03 s).
+once), and the per-test CPU seconds (``benchmarks/cpu_per_test.py``), CPU and wall seconds of each suite, summed test
+seconds by file and outcome counts are compared. Wall seconds on this shared 2-core machine drift (the same clone ran
+32 % slower forty minutes later) and, run together, single tests took 5 to 20 times longer in one suite than in the
+other. CPU seconds drift less but still do (13 % between two sequential runs: oversubscribed cores do the same work
+in more CPU time), so the measure of growth is each test's CPU against the median ratio over all tests
+(:func:`cpu_changes`): a test whose cost grows with the library stands out above that common drift. Each clone gets
+a fresh, empty ``GENDEX_CACHE`` (as a new CI machine has), so caches built by one run do not serve the other; a
+twin's instruction is its original's, so the doubled clone embeds no more distinct instructions than the base
+(:mod:`generator.embedding` encodes a new instruction once a machine, ~0.2 CPU s under load).
 
 Run: ``.venv/bin/python benchmarks/suite_scale.py [--factor 2] [--together] [--workdir DIR] [--json PATH]`` (about
 twice the suite's time either way). ``--prepare-only`` makes the clones and stops.
@@ -108,10 +110,8 @@ def start_suite(clone: Path, junit: Path) -> tuple[subprocess.Popen, float]:
 def finish_suite(proc: subprocess.Popen, started: float, junit: Path) -> dict:
     """Wall seconds, CPU seconds, outcome counts and test seconds by file of a suite :func:`start_suite` started.
 
-    CPU seconds (user + system of the suite's process tree: pytest and the workers and children it waited for, from
-    ``wait4``) hardly change with what else the machine runs, where wall and test seconds do: on this shared
-    2-core machine single tests took 5 to 20 times longer in one run than in the other. They are the measure of
-    growth; wall seconds say what a user waits on an idle machine."""
+    CPU seconds: user + system of the suite's process tree (pytest and the workers and children it waited for, from
+    ``wait4``); per test, from the ``cpu_per_test`` plugin's files. Wall seconds say what a user waits."""
     _, status, usage = os.wait4(proc.pid, 0)
     cpu_by_test: dict[str, float] = {}
     for part in junit.parent.glob(junit.with_suffix(".cpu").name + ".*.json"):

@@ -18,14 +18,9 @@ EXPECTED = {
 }
 
 
-@pytest.fixture(scope="module")
-def tasks(committed_tasks):
-    return committed_tasks  # the committed library, whatever else this process registered
-
-
-def test_each_reference_task_is_counted_under_its_skill(tasks):
+def test_each_reference_task_is_counted_under_its_skill(committed_tasks):
     latest = {}
-    for v in tasks.values():
+    for v in committed_tasks.values():
         if v.name in EXPECTED and v.version >= latest.get(v.name, (-1, None))[0]:
             latest[v.name] = (v.version, v)
     assert set(latest) == set(EXPECTED)
@@ -33,7 +28,8 @@ def test_each_reference_task_is_counted_under_its_skill(tasks):
         assert task_skills(v.spec) == EXPECTED[name], name
 
 
-def test_library_numbers_add_up(tasks):
+def test_library_numbers_add_up(committed_tasks):
+    tasks = committed_tasks
     s = library_stats(tasks, diversity=False)
     names = {v.name for v in tasks.values()}
     assert s["tasks"] == len(names) and s["versions"] == "latest"
