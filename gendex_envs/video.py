@@ -5,11 +5,13 @@ videos of evaluations.
 exactly (time base ``1/fps``), so lerobot's decoder finds each frame at its timestamp. The default codec is
 lerobot's own default, AV1 by SVT-AV1 (``libsvtav1``, yuv420p, a key frame every 2 frames, CRF 30); ``libx264``
 (H.264) is the alternative for players without AV1. Encoding is deterministic: the same frames give the same bytes
-(a dataset build can be verified against its manifest's checksums). :func:`decode` reads every frame back.
+(a dataset build can be verified against its manifest's checksums; :func:`_encoder_options` says what that
+takes for x264). :func:`decode` reads every frame back.
 """
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -43,12 +45,34 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
     with av.open(str(path), "w", format="mp4") as container:
         stream = container.add_stream(codec, rate=int(fps))
         stream.width, stream.height, stream.pix_fmt = w, h, PIX_FMT
-        stream.options = dict(CODECS[codec][1])
+        stream.options = _encoder_options(codec)
         for frame in frames:
             for packet in stream.encode(_yuv_frame(frame)):
                 container.mux(packet)
         for packet in stream.encode():
             container.mux(packet)
+
+
+def _encoder_options(codec: str) -> dict[str, str]:
+    """The encoder options of ``codec``; on a CPU with AVX-512, x264 is kept to its AVX2 kernels.
+
+    With its AVX-512 kernels, x264 (one thread, the same options and the same input planes, padding included) encoded
+    the same frames to different bytes about once in 850 encodes while the machine was under CPU load, and not once
+    in 3 150 restricted to AVX2 (records in ``benchmarks/results/video.md``). The two give the same bytes whenever the
+    AVX-512 run does not stray, so the restriction changes no checksum. Every AVX-512 CPU has AVX2, so the
+    restriction never names an instruction set the CPU lacks."""
+    options = dict(CODECS[codec][1])
+    if codec == "libx264" and _cpu_has_avx512():
+        options["x264-params"] = "asm=AVX2"
+    return options
+
+
+@functools.cache
+def _cpu_has_avx512() -> bool:
+    """Whether the CPU reports AVX-512 Foundation (Linux; elsewhere assumed not)."""
+    from gendex_envs.blas import cpu_flags
+
+    return "avx512f" in cpu_flags()
 
 
 def _yuv_frame(rgb: np.ndarray):
