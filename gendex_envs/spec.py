@@ -24,12 +24,24 @@ from typing import Any, Literal, get_args
 import numpy as np
 import yaml
 
+from gendex_envs.conditions import (  # noqa: F401 - the spec's names for them
+    CONDITION_DEFAULTS,
+    CONDITION_FIELDS,
+    CONDITION_TYPES,
+    REGIONS,
+    RELATIONS,
+    ConditionSpec,
+    ConditionType,
+    Part,
+    condition_problems,
+)
 from gendex_envs.errors import StageError, TaskSpecError, suggest
 from gendex_envs.typed_yaml import (
     MAX_CONDITIONS,
     MAX_INPUT_BYTES,
     MAX_JOINT_STATES,
     MAX_OBJECTS,
+    MAX_POSITION_M,
     MAX_STAGES,
     MAX_STEPS,
     MAX_STRING_CHARS,
@@ -48,16 +60,12 @@ Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
 Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient"]
-ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
-                        "hand_at", "fingertips_near", "hand_open"]
-Part = Literal["handle"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
 STAGE_METHODS: tuple[str, ...] = get_args(StageMethod)
 CONTROL_JOINT_MODES: tuple[str, ...] = get_args(ControlJoint)
 SKILLS: tuple[str, ...] = get_args(Skill)
-CONDITION_TYPES: tuple[str, ...] = get_args(ConditionType)
 
 SKILL_MEANINGS: dict[str, str] = {
     "reach": "bring the open hand to where the next skill starts (a pre-grasp pose, a handle)",
@@ -84,11 +92,6 @@ TASK_NAME_RE = re.compile(r"\A[A-Z][A-Za-z0-9]*\Z")
 SNAKE_NAME_RE = re.compile(r"\A[a-z][a-z0-9_]*\Z")
 """An object or stage name: ASCII snake_case, the whole string."""
 
-MAX_POSITION_M = 20.0
-"""Bound (m) on every position coordinate and length of a spec: objects' ``pos_m``, ``goal.pos_m``,
-``robot.base_pos_m``, the goal's radius and the conditions' distances. A finite but absurd value (1e30) would go into
-PhysX as a pose. The committed library's largest is 0.8 m (the table is 1.6 m x 1.2 m); the asset tests lay every
-articulated model out on one grid, 5.2 m across, and larger catalogs will need more."""
 MAX_RANDOMIZE_M = 1.0
 """Bound (m) on a randomization half-range (``randomize.xy_m``); the committed library's largest is 0.13 m."""
 MAX_ANGLE_DEG = 360.0
@@ -178,83 +181,6 @@ class GoalSpec:
     """World position of the goal (m); z measured from the table top."""
     radius_m: float = 0.05
     """Radius of the goal sphere (m), > 0."""
-
-
-@dataclass(frozen=True, kw_only=True)
-class ConditionSpec:
-    """One success condition. ``type`` says which other fields it takes (:data:`CONDITION_FIELDS`); a field that
-    does not apply to the type is an error. Optional fields left out take :data:`CONDITION_DEFAULTS`."""
-
-    type: ConditionType
-    """Condition kind; one of CONDITION_TYPES."""
-    object: str | None = None
-    """Name of the object the condition is about (every type but ``hand_open``)."""
-    target: str | None = None
-    """inside: the container; near: an object or 'goal'; over: the object to be above."""
-    negate: bool = False
-    """True: the condition must *not* hold (e.g. ``grasped`` negated: the hand has let go)."""
-    part: Part | None = None
-    """grasped, released, hand_at, fingertips_near: 'handle' = the handle of an articulated object's joint instead
-    of the object itself."""
-    joint: str | None = None
-    """joint_open, or with ``part: handle``: the joint (default: the asset's main joint)."""
-    min_height_m: float | None = None
-    """lifted: required rise above the object's height at reset (m), > 0."""
-    min_fraction: float | None = None
-    """joint_open: required opening as a fraction of the joint range, in (0, 1]."""
-    max_dist_m: float | None = None
-    """near: object to target; hand_at: palm to the point; fingertips_near: mean fingertip distance (m), > 0."""
-    min_deg: float | None = None
-    """rotated: twist about world z since reset, degrees, counter-clockwise seen from above (negative: clockwise),
-    non-zero; the twist must reach it."""
-    min_fingers: int | None = None
-    """grasped: fingers other than the thumb that must touch (1-4; default 2)."""
-    thumb: bool | None = None
-    """grasped: the thumb must touch too (default true)."""
-    min_force_n: float | None = None
-    """grasped: a link group touches when its mean contact force exceeds this (N, > 0; default 0.3)."""
-    max_palm_force_n: float | None = None
-    """grasped: the palm may press with at most this mean force (N, > 0); unset: no limit."""
-    max_force_n: float | None = None
-    """released: no finger, thumb or palm group presses with more than this (N, > 0; default 0.3)."""
-    max_xy_m: float | None = None
-    """over: horizontal distance of the object from the target (m), > 0."""
-    min_dz_m: float | None = None
-    """over: least height of the object above the target's origin (m)."""
-    max_dz_m: float | None = None
-    """over: greatest height of the object above the target's origin (m), > min_dz_m."""
-    ring_radius_m: float | None = None
-    """hand_at: the point lies on a ring of this radius about the object's vertical axis, on the side the palm is
-    (m, >= 0; default 0: on the axis)."""
-    above_m: float | None = None
-    """hand_at: height of the point above the object's origin (m; default 0)."""
-    min_spread_m: float | None = None
-    """hand_open: mean fingertip distance from the palm (m), > 0."""
-
-
-CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_force_n": 0.3, "max_force_n": 0.3,
-                                      "ring_radius_m": 0.0, "above_m": 0.0}
-"""Values of optional condition fields left out."""
-
-CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
-    "lifted": (("object", "min_height_m"), (), "the object has risen at least min_height_m since reset"),
-    "inside": (("object", "target"), (), "the object rests inside the container target"),
-    "near": (("object", "target", "max_dist_m"), (), "the object is within max_dist_m of target (or the goal)"),
-    "joint_open": (("object", "min_fraction"), ("joint",), "the joint is open at least min_fraction of its range"),
-    "rotated": (("object", "min_deg"), (), "the object has turned min_deg about world z since reset"),
-    "grasped": (("object",), ("part", "joint", "min_fingers", "thumb", "min_force_n", "max_palm_force_n"),
-                "the thumb and at least min_fingers fingers touch the object (or its handle)"),
-    "released": (("object",), ("part", "joint", "max_force_n"), "no part of the hand presses on the object"),
-    "over": (("object", "target", "max_xy_m", "min_dz_m", "max_dz_m"), (),
-             "the object is above target: within max_xy_m horizontally, min_dz_m..max_dz_m higher"),
-    "hand_at": (("object", "max_dist_m"), ("part", "joint", "ring_radius_m", "above_m"),
-                "the palm is within max_dist_m of a point by the object (its origin, a ring about it, its handle)"),
-    "fingertips_near": (("object", "max_dist_m"), ("part", "joint"),
-                        "the fingertips are on average within max_dist_m of the object's origin (or its handle)"),
-    "hand_open": (("min_spread_m",), (), "the fingertips are on average at least min_spread_m from the palm"),
-}
-"""Condition type -> (required fields, optional fields, meaning). ``type`` and ``negate`` apply to every type."""
-assert set(CONDITION_FIELDS) == set(CONDITION_TYPES)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -367,54 +293,6 @@ def _leaf_problems(spec: TaskSpec) -> list[str]:
     return p
 
 
-_POSITIVE = {"min_height_m", "max_dist_m", "min_force_n", "max_palm_force_n", "max_force_n", "max_xy_m",
-             "min_spread_m"}
-
-
-def _condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
-    """Problems of one condition at path ``at``; ``ref(value, path, allow_goal)`` checks an object reference."""
-    required, optional, meaning = CONDITION_FIELDS[c.type]
-    p: list[str] = []
-    fields = required + optional
-    for f in dataclasses.fields(ConditionSpec):
-        if f.name in ("type", "negate") or f.name in fields or getattr(c, f.name) is None:
-            continue
-        p.append(f"{at}.{f.name} = {quote(getattr(c, f.name))} does not apply to type {c.type!r} ({meaning}); its "
-                 f"fields: {', '.join(fields)}")
-    for name in required:
-        if getattr(c, name) is None:
-            p.append(f"{at}.{name} is required for type {c.type!r} ({meaning})")
-
-    def bad(name: str, allowed: str) -> None:
-        p.append(f"{at}.{name} = {quote(getattr(c, name))} is not allowed; must be {allowed}")
-
-    for name in _POSITIVE & set(fields):
-        if getattr(c, name) is not None and not getattr(c, name) > 0:
-            bad(name, "> 0")
-    if c.min_fraction is not None and not 0 < c.min_fraction <= 1:
-        bad("min_fraction", "a fraction in (0, 1]")
-    if c.min_deg is not None and c.min_deg == 0:
-        bad("min_deg", "non-zero (positive: counter-clockwise seen from above)")
-    if c.min_fingers is not None and not 1 <= c.min_fingers <= 4:
-        bad("min_fingers", "between 1 and 4 (fingers other than the thumb)")
-    if c.ring_radius_m is not None and c.ring_radius_m < 0:
-        bad("ring_radius_m", ">= 0")
-    for f in dataclasses.fields(ConditionSpec):
-        v = getattr(c, f.name)
-        if f.name.endswith("_m") and v is not None and not abs(v) <= MAX_POSITION_M:
-            bad(f.name, f"within +/-{MAX_POSITION_M} m (MAX_POSITION_M)")
-    if c.min_dz_m is not None and c.max_dz_m is not None and not c.max_dz_m > c.min_dz_m:
-        bad("max_dz_m", f"> min_dz_m ({c.min_dz_m})")
-    if c.object is not None:
-        ref(c.object, f"{at}.object")
-    if c.target is not None:
-        if c.target == c.object:
-            bad("target", "another object's name, not the condition's own object")
-        else:
-            ref(c.target, f"{at}.target", allow_goal=c.type == "near")
-    return p
-
-
 def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> list[str]:
     p: list[str] = []
 
@@ -514,7 +392,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
             need(len(s.success) >= 1, f"{at}.success", [], "leave it out (the stage then succeeds with the task) "
                  "or give at least one condition")
             for j, c in enumerate(s.success):
-                p += _condition_problems(c, f"{at}.success[{j}]", ref)
+                p += condition_problems(c, f"{at}.success[{j}]", ref)
                 not_distractor(c.object, f"{at}.success[{j}].object")
                 not_distractor(c.target, f"{at}.success[{j}].target")
 
@@ -524,7 +402,7 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
          f"must be >= 0 and <= {MAX_STEPS} (MAX_STEPS)")
     need(len(spec.success.conditions) >= 1, "success.conditions", [], "at least one condition is required")
     for i, c in enumerate(spec.success.conditions):
-        p += _condition_problems(c, f"success.conditions[{i}]", ref)
+        p += condition_problems(c, f"success.conditions[{i}]", ref)
         not_distractor(c.object, f"success.conditions[{i}].object")
         not_distractor(c.target, f"success.conditions[{i}].target")
     return p

@@ -41,6 +41,14 @@ SET_DOWN_CONDITIONS = ("inside", "over", "near")
 the solver sets it down before letting go, and the generator's scene step has it let go and settled."""
 THUMB, PALM = 0, 5
 """Rows of the hand's contact-force groups (thumb, index, middle, ring, little, palm)."""
+REGION_AHEAD_M = 0.9
+"""The table's regions (``placed``, ``in_region``) are measured from the point this far ahead of the robot's base:
+x = 0.1 with the base at x = -0.8, the middle of where the library's objects stand (80 % of them at x 0.01-0.58)."""
+REGION_MARGIN_M = 0.1
+"""An object is in a side region (left, right, near, far) from this far off that point towards it; in the centre
+within this of it both ways."""
+_REGION_PARTS = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}
+"""Region word -> (axis: 0 forward, 1 left; sign)."""
 
 
 def _param(c: ConditionSpec, name: str):
@@ -69,8 +77,56 @@ def rest_point(env: TaskEnv, name: str) -> torch.Tensor:
     return box_rest_point(pose.p, pose.q, lo, hi)
 
 
+def robot_axes(env: TaskEnv, like: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The robot's view of the table as [2] tensors (dtype and device of ``like``): its base's xy, the direction it
+    faces (forward: away from it) and its left."""
+    robot = env.task_spec.robot
+    yaw = math.radians(robot.base_yaw_deg)
+    as_t = lambda v: torch.tensor(v, dtype=like.dtype, device=like.device)  # noqa: E731
+    return (as_t(robot.base_pos_m[:2]), as_t([math.cos(yaw), math.sin(yaw)]),
+            as_t([-math.sin(yaw), math.cos(yaw)]))
+
+
+def _placed(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
+    """[N] where the object lies (:func:`rest_point`) against the relation, seen from the robot."""
+    p = rest_point(env, c.object)[:, :2]
+    base, fwd, left = robot_axes(env, p)
+    if c.relation == "in_region":
+        d = p - (base + REGION_AHEAD_M * fwd)
+        along = (d @ fwd, d @ left)
+        if c.region == "centre":
+            return (along[0].abs() <= REGION_MARGIN_M) & (along[1].abs() <= REGION_MARGIN_M)
+        ok = torch.ones(p.shape[0], dtype=torch.bool, device=p.device)
+        for part in c.region.split("_"):
+            axis, sign = _REGION_PARTS[part]
+            ok = ok & (sign * along[axis] >= REGION_MARGIN_M)
+        return ok
+    lo, offset = _param(c, "min_gap_m"), _param(c, "max_offset_m")
+    a = rest_point(env, c.target)[:, :2]
+    d = p - a
+    if c.relation == "between":
+        u = rest_point(env, c.other)[:, :2] - a
+        length = torch.linalg.norm(u, dim=-1).clamp_min(1e-9)
+        u = u / length[:, None]
+        t = (d * u).sum(-1)
+        across = (d[:, 0] * u[:, 1] - d[:, 1] * u[:, 0]).abs()
+        return (t >= lo) & (length - t >= lo) & (across <= offset)
+    hi = _param(c, "max_gap_m")
+    if c.relation == "next_to":
+        r = torch.linalg.norm(d, dim=-1)
+        return (r >= lo) & (r <= hi)
+    axis = {"left_of": left, "right_of": -left, "behind": fwd, "in_front_of": -fwd}[c.relation]
+    side = fwd if c.relation in ("left_of", "right_of") else left
+    along = d @ axis
+    return (along >= lo) & (along <= hi) & ((d @ side).abs() <= offset)
+
+
 def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     t = c.type
+    if t == "placed":
+        return _placed(env, c)
+    if t == "joint_at":
+        return (env.joint_open_fraction(c.object, c.joint) - c.fraction).abs() <= _param(c, "max_error")
     if t == "lifted":
         return env.obj_height(c.object) >= c.min_height_m
     if t == "joint_open":

@@ -79,6 +79,11 @@ MAX_JOINT_STATES = 64
 """Entries of one object's ``joint_state``."""
 MAX_STEPS = 100_000
 """Ceiling on ``max_episode_steps``, a stage's ``horizon`` and ``hold_steps``: buffers are sized from them."""
+MAX_POSITION_M = 20.0
+"""Bound (m) on every position coordinate and length of a spec: objects' ``pos_m``, ``goal.pos_m``,
+``robot.base_pos_m``, the goal's radius and the conditions' distances. A finite but absurd value (1e30) would go into
+PhysX as a pose. The committed library's largest is 0.8 m (the table is 1.6 m x 1.2 m); the asset tests lay every
+articulated model out on one grid, 5.2 m across, and larger catalogs will need more."""
 
 MAX_TRANSCRIPT_BYTES = 256_000_000
 """Largest transcript (JSONL) read for replay; recorded runs are about 0.5 MB."""
