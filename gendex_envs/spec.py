@@ -6,8 +6,9 @@ problem is reported as one :class:`~gendex_envs.errors.TaskSpecError` naming the
 (``objects[1].scale``), the bad value and what is allowed. Lengths are in metres, angles in degrees. The table top is
 the world plane z = 0. See ``docs/task_spec.md`` for the field reference and a full example.
 
-Success is declared here and nowhere else: ``success.conditions`` for the whole task and ``stages[k].success`` for a
-stage (a stage that declares none succeeds when the task does). :mod:`gendex_envs.success` evaluates them.
+Success is declared here and nowhere else: ``success.conditions`` (after the steps of ``success.sequence``, in
+order) for the whole task and ``stages[k].success`` for a stage (a stage that declares none succeeds when the task
+does). :mod:`gendex_envs.success` evaluates them; :mod:`gendex_envs.conditions` defines the condition types.
 """
 
 from __future__ import annotations
@@ -207,6 +208,18 @@ class StageSpec:
 
 
 @dataclass(frozen=True, kw_only=True)
+class SequenceStepSpec:
+    """One step of a task's ordered sequence: something that must have happened, after the steps before it."""
+
+    description: str
+    """Non-empty natural-language description of the step ("the apple has been lifted")."""
+    conditions: tuple[ConditionSpec, ...] = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
+    """At least one condition; the step is done once all hold (for ``hold_steps``) after the previous step was done."""
+    hold_steps: int = 0
+    """Number of consecutive steps the conditions must hold, >= 0."""
+
+
+@dataclass(frozen=True, kw_only=True)
 class SuccessSpec:
     """When the task counts as solved."""
 
@@ -216,6 +229,10 @@ class SuccessSpec:
     """At least one condition; all must hold."""
     hold_steps: int = 0
     """Number of consecutive steps the conditions must hold, >= 0."""
+    sequence: tuple[SequenceStepSpec, ...] | None = _bounded(MAX_STAGES, "sequence steps", "MAX_STAGES",
+                                                             default=None)
+    """Steps that must happen in this order before ``conditions`` count ("A, then B, then C": A and B here, C in
+    ``conditions``); a step, once done, stays done. None: no order, only ``conditions``."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -401,10 +418,22 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
     need(0 <= spec.success.hold_steps <= MAX_STEPS, "success.hold_steps", spec.success.hold_steps,
          f"must be >= 0 and <= {MAX_STEPS} (MAX_STEPS)")
     need(len(spec.success.conditions) >= 1, "success.conditions", [], "at least one condition is required")
-    for i, c in enumerate(spec.success.conditions):
-        p += condition_problems(c, f"success.conditions[{i}]", ref)
-        not_distractor(c.object, f"success.conditions[{i}].object")
-        not_distractor(c.target, f"success.conditions[{i}].target")
+    groups = [("success", spec.success.conditions)]
+    if spec.success.sequence is not None:
+        need(len(spec.success.sequence) >= 1, "success.sequence", [], "leave it out (no order) or give at least one "
+             "step")
+        for k, step in enumerate(spec.success.sequence):
+            at = f"success.sequence[{k}]"
+            need(bool(step.description.strip()), f"{at}.description", step.description, "must be a non-empty string")
+            need(0 <= step.hold_steps <= MAX_STEPS, f"{at}.hold_steps", step.hold_steps,
+                 f"must be >= 0 and <= {MAX_STEPS} (MAX_STEPS)")
+            need(len(step.conditions) >= 1, f"{at}.conditions", [], "at least one condition is required")
+            groups.append((at, step.conditions))
+    for at, conditions in groups:
+        for i, c in enumerate(conditions):
+            p += condition_problems(c, f"{at}.conditions[{i}]", ref)
+            not_distractor(c.object, f"{at}.conditions[{i}].object")
+            not_distractor(c.target, f"{at}.conditions[{i}].target")
     return p
 
 

@@ -8,12 +8,13 @@ observations, and ``fail`` vetoes success. So for every env and step::
     success = all conditions hold  and  not fail
     fail    = the reward module's fail
 
-The task's ``hold_steps`` (conditions held that many consecutive steps) is applied by the env, which owns the
-per-episode counters. Every consumer reads success through a :class:`Judge`: the env's ``evaluate`` (and so
-training, data collection, replay and evaluation), the stage executor when a stage policy runs, start-state
-collection, and the generator's critic (which reads the declared conditions for what the task asks of a scene).
+The task's ``sequence`` (steps that must happen in order first) and ``hold_steps`` (conditions held that many
+consecutive steps) are applied by :class:`SuccessTracker`, which the env owns and resets with each episode. Every
+consumer reads success through a :class:`Judge`: the env's ``evaluate`` (and so training, data collection, replay
+and evaluation), the stage executor when a stage policy runs, start-state collection, and the generator's critic
+(which reads the declared conditions for what the task asks of a scene).
 
-The condition types and their fields are listed in :data:`gendex_envs.spec.CONDITION_FIELDS`.
+The condition types and their fields are listed in :data:`gendex_envs.conditions.CONDITION_FIELDS`.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import torch
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import box_rest_point, xy_distance, z_twist
 from gendex_envs.reward_checks import check_evaluate
-from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, TaskSpec
+from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, SuccessSpec, TaskSpec
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.reward_module import RewardModule
@@ -226,3 +227,55 @@ class Judge:
         info["success"] = conditions_hold(env, self.conditions) & ~fail
         info["fail"] = fail
         return info
+
+
+class SuccessTracker:
+    """The task's success across the steps of an episode, per env: how far the ordered ``success.sequence`` has come
+    (a step, once done, stays done) and the streaks ``hold_steps`` count. The env owns one, resets it with each
+    episode and feeds it the judge's verdict on the final conditions; each control step is counted once, however
+    often ``evaluate`` is called within it.
+
+    A sequence step is done at the first control step at which its conditions have held for its ``hold_steps``
+    (at least that step) while it was the current one; the next step becomes current at the next control step, and
+    after the last one the task's ``conditions`` (with ``hold_steps`` and ``fail``) decide success."""
+
+    def __init__(self, success: SuccessSpec, num_envs: int, device: torch.device | str):
+        self.steps = success.sequence or ()
+        self.hold = success.hold_steps
+        with torch.device(device):
+            self.progress = torch.zeros(num_envs, dtype=torch.long)
+            """[N] sequence steps done."""
+            self.streak = torch.zeros(num_envs, dtype=torch.long)
+            """[N] consecutive control steps the current step's (or, after the sequence, the task's) conditions held."""
+            self.counted_at = torch.full((num_envs,), -1, dtype=torch.long)
+
+    def reset(self, env_idx: torch.Tensor) -> None:
+        self.progress[env_idx] = 0
+        self.streak[env_idx] = 0
+        self.counted_at[env_idx] = -1
+
+    def update(self, env: TaskEnv, holds: torch.Tensor, step: torch.Tensor) -> torch.Tensor:
+        """[N] bool success, given ``holds`` (the task's conditions hold now and no fail) at control step ``step``."""
+        if not self.steps and self.hold == 0:
+            return holds
+        fresh = self.counted_at != step
+        self.counted_at = torch.where(fresh, step, self.counted_at)
+        final = self.progress >= len(self.steps)  # the sequence was done before this call
+        if self.steps:
+            now = torch.zeros_like(holds)
+            need = torch.ones_like(self.progress)
+            for k, s in enumerate(self.steps):
+                at = self.progress == k
+                if bool(at.any()):
+                    now = torch.where(at, conditions_hold(env, s.conditions), now)
+                    need = torch.where(at, max(s.hold_steps, 1), need)
+            counting = fresh & ~final
+            self.streak = torch.where(counting, (self.streak + 1) * now, self.streak)
+            advance = counting & (self.streak >= need)
+            self.progress = self.progress + advance.long()
+            self.streak = torch.where(advance, 0, self.streak)
+        if self.hold == 0:
+            return final & holds
+        self.streak = torch.where(final & fresh, (self.streak + 1) * holds, self.streak)
+        return final & (self.streak >= self.hold)
+

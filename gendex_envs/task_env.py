@@ -62,7 +62,7 @@ from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.reward_view import reward_info
 from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
 from gendex_envs.start_states import StartStates
-from gendex_envs.success import Judge, conditions_hold
+from gendex_envs.success import Judge, SuccessTracker, conditions_hold
 from gendex_envs.task_version import TaskVersion
 
 log = logging.getLogger(__name__)
@@ -279,8 +279,7 @@ class TaskEnv(BaseEnv):
         with torch.device(self.device):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
             self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}
-            self._success_streak = torch.zeros(self.num_envs, dtype=torch.long)
-            self._streak_counted_at = torch.full((self.num_envs,), -1, dtype=torch.long)
+        self.success_tracker = SuccessTracker(self.task_spec.success, self.num_envs, self.device)
         self.goal_site = None
         if self.task_spec.goal is not None:
             gb = self.scene.create_actor_builder()
@@ -457,8 +456,7 @@ class TaskEnv(BaseEnv):
             for name, entity in self.objects.items():
                 self._obj_reset_pos[name][env_idx] = entity.pose.p[env_idx]
                 self._obj_reset_quat[name][env_idx] = entity.pose.q[env_idx]
-            self._success_streak[env_idx] = 0
-            self._streak_counted_at[env_idx] = -1
+            self.success_tracker.reset(env_idx)
 
     # ------------------------------------------------------------------ API for reward code
     def obj_pose(self, name: str) -> Pose:
@@ -581,15 +579,9 @@ class TaskEnv(BaseEnv):
     # ------------------------------------------------------------------ task hooks
     def evaluate(self) -> dict:
         info = self.judge.evaluate(self)
-        # a stage judged by the task's own conditions also holds them for the task's hold_steps
-        own = self.stage_spec is not None and self.stage_spec.success is not None
-        hold = 0 if own else self.task_spec.success.hold_steps
-        if hold > 0:  # count each control step once, however often evaluate() is called within it
-            fresh = self._streak_counted_at != self.elapsed_steps
-            self._success_streak = torch.where(fresh, (self._success_streak + 1) * info["success"],
-                                               self._success_streak)
-            self._streak_counted_at = self.elapsed_steps.clone()
-            info["success"] = self._success_streak >= hold
+        # a stage judged by the task's own conditions is judged as the task: after its sequence, for its hold_steps
+        if self.stage_spec is None or self.stage_spec.success is None:
+            info["success"] = self.success_tracker.update(self, info["success"], self.elapsed_steps)
         info["fail"] = info["fail"] & ~info["success"]
         return info
 

@@ -135,6 +135,40 @@ def test_success_must_hold_for_hold_steps(task_version):
         env.close()
 
 
+def test_a_sequence_step_must_come_first(task_version):
+    """success.sequence: with "the apple left of the bowl, then in it", the apple put straight into the bowl is no
+    success; set down left of the bowl (seen from the robot: +y) and then put in, it is."""
+    from gendex_envs.spec import parse_task_spec, spec_to_dict
+    from gendex_envs.task_env import TaskEnv
+
+    raw = spec_to_dict(task_version("PutAppleBowl", 0).spec)
+    raw["success"]["sequence"] = [{"description": "the apple lies left of the bowl", "hold_steps": 0, "conditions": [
+        {"type": "placed", "object": "apple", "relation": "left_of", "target": "bowl", "max_gap_m": 0.25}]}]
+    env = TaskEnv(task_spec=parse_task_spec(raw), render_backend="none")
+    try:
+        env.reset(seed=0)
+        apple, bowl = env.obj("apple"), env.obj("bowl")
+        hold = env.agent.controller.free_targets()
+
+        def put(dx: float, dy: float, dz: float) -> list[bool]:
+            p = bowl.pose.p.clone()
+            p[:, 0] += dx
+            p[:, 1] += dy
+            p[:, 2] += dz
+            apple.set_pose(type(apple.pose).create_from_pq(p, apple.pose.q))
+            return [bool(env.step(hold)[4]["success"][0]) for _ in range(3)]
+
+        assert put(0.0, 0.0, 0.01) == [False] * 3  # in the bowl, but not left of it first
+        assert env.success_tracker.progress.tolist() == [0]
+        assert put(0.0, 0.15, 0.005) == [False] * 3  # left of it: the step is done
+        assert env.success_tracker.progress.tolist() == [1]
+        assert put(0.0, 0.0, 0.01) == [True] * 3
+        env.reset(seed=0)
+        assert env.success_tracker.progress.tolist() == [0]
+    finally:
+        env.close()
+
+
 def test_a_bottle_lying_on_the_plate_is_on_it(make_env):
     """``near`` measures where an object lies, not its origin: a bottle laid on its side with its middle over the
     plate is on the plate, though its origin (the centre of its base) is half its length away."""
