@@ -25,6 +25,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 import yaml
 
+from gendex_envs.attributes import COLORS, ColorName
 from gendex_envs.conditions import (  # noqa: F401 - the spec's names for them
     CONDITION_DEFAULTS,
     CONDITION_FIELDS,
@@ -170,8 +171,15 @@ class ObjectSpec:
     """Pose noise applied at reset (layouts are drawn free of overlaps between objects)."""
     color_rgba: tuple[float, float, float, float] | None = None
     """Optional colour override, each channel in [0, 1]."""
+    color: ColorName | None = None
+    """Optional named colour (``gendex_envs.attributes.COLORS``) the object is painted in, instead of color_rgba."""
     distractor: bool = False
     """True for clutter the task is not about: no stage acts on it and no condition names it; solvers avoid it."""
+
+    @property
+    def rgba(self) -> tuple[float, float, float, float] | None:
+        """The colour the object is painted in (its named colour's or color_rgba), None: the asset's own."""
+        return COLORS[self.color] if self.color is not None else self.color_rgba
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -377,6 +385,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
         if o.color_rgba is not None:
             need(all(0 <= c <= 1 for c in o.color_rgba), f"{at}.color_rgba", list(o.color_rgba),
                  "each channel must be in [0, 1]")
+            need(o.color is None, f"{at}.color_rgba", list(o.color_rgba),
+                 f"give color ({o.color!r}) or color_rgba, not both")
 
     def ref(value: str | None, path: str, allow_goal: bool = False) -> None:
         if value is None or value in names or (allow_goal and value == GOAL_TARGET and spec.goal is not None):

@@ -266,7 +266,7 @@ class TaskEnv(BaseEnv):
         for obj in self.task_spec.objects:
             rec = self._records[obj.name]
             p, q = self._spec_pose(obj)
-            entity = rec.build(self.scene, obj.name, obj.scale, obj.color_rgba, obj.fixed,
+            entity = rec.build(self.scene, obj.name, obj.scale, obj.rgba, obj.fixed,
                                sapien.Pose(p=p.tolist(), q=q.tolist()))
             self.objects[obj.name] = entity
             if rec.articulated:

@@ -64,3 +64,28 @@ def test_cli_list_shows_tasks():
     assert result.exit_code == 0
     for env_id in REFERENCE_TASKS:
         assert env_id in result.output
+
+
+def test_named_colours_show_in_the_views(task_version):
+    """objects[i].color paints the object: the apple (red in the catalog) painted blue and the bowl (white) painted
+    green show as blue- and green-dominated pixels in every view."""
+    from gendex_envs.spec import parse_task_spec, spec_to_dict
+    from gendex_envs.task_env import TaskEnv
+
+    raw = spec_to_dict(task_version("PutAppleBowl", 0).spec)
+    paint = {"apple": ("blue", 2), "bowl": ("green", 1)}  # colour, the channel that must dominate
+    for obj in raw["objects"]:
+        obj["color"], obj["color_rgba"] = paint[obj["name"]][0], None
+    env = TaskEnv(task_spec=parse_task_spec(raw), obs_mode="rgb+segmentation", sensor_resolution=128)
+    try:
+        obs, _ = env.reset(seed=0)
+        for cam in VIEW_CAMERAS:
+            seg = obs["sensor_data"][cam]["segmentation"][0, ..., 0].cpu().numpy()
+            rgb = obs["sensor_data"][cam]["rgb"][0].cpu().numpy().astype(float)
+            for name, (colour, channel) in paint.items():
+                mask = np.isin(seg, list(_seg_ids(env.objects[name])))
+                assert mask.sum() > 20, f"{cam}: {name} covers {mask.sum()} px"
+                mean = rgb[mask].mean(axis=0)
+                assert mean.argmax() == channel, f"{cam}: {name} painted {colour} looks {mean.round()}"
+    finally:
+        env.close()
