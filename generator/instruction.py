@@ -10,6 +10,9 @@ phrase against the catalog — multi-word names (*tuna can*, *trash can*), plura
   *substitution*: the CLI prints it and the task's proposal record keeps it;
 - a verb GenDex has no skill for, or an object that cannot play the part the verb needs (*open the apple*), raises
   :class:`InstructionError` listing what is possible; ``gendex generate`` exits non-zero with that message.
+- a construct the author and solver do not build yet (a sequence, a direction, a place relative to something, an
+  amount, taking out: :data:`NOT_BUILT`) raises :class:`InstructionError` saying what was asked, so no task is built
+  without it.
 
 The skills are those of the solver (:data:`TASK_SKILLS`, the thirteen of ``docs/solving.md``); the same vocabulary
 goes into the language-model backend's proposal prompt (:func:`skill_vocabulary`).
@@ -108,6 +111,45 @@ _DETERMINERS = frozenset("a an the its my your our their his her some this these
 """Words that start a noun phrase: an unknown word names an object (the catalog lacks) only in such a phrase
 (*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
+NOT_BUILT: tuple[tuple[str, str, str], ...] = (
+    ("then", "steps in order", "sequences"), ("afterwards", "steps in order", "sequences"),
+    ("after that", "steps in order", "sequences"), ("before", "steps in order", "sequences"),
+    ("turn off", "a direction ('off')", "turning or switching off"),
+    ("switch off", "a direction ('off')", "turning or switching off"),
+    ("shut off", "a direction ('off')", "turning or switching off"),
+    ("turn it off", "a direction ('off')", "turning or switching off"),
+    ("switch it off", "a direction ('off')", "turning or switching off"),
+    ("turned off", "a direction ('off')", "turning or switching off"),
+    ("switched off", "a direction ('off')", "turning or switching off"),
+    ("half", "an amount ('half')", "half-open joints"), ("halfway", "an amount ('halfway')", "half-open joints"),
+    ("partly", "an amount ('partly')", "half-open joints"), ("degrees", "an angle", "turning to an angle"),
+    ("to the left", "a side ('to the left')", "places relative to objects or the table"),
+    ("to the right", "a side ('to the right')", "places relative to objects or the table"),
+    ("left of", "a side ('left of')", "places relative to objects or the table"),
+    ("right of", "a side ('right of')", "places relative to objects or the table"),
+    ("on the left", "a side ('on the left')", "places relative to objects or the table"),
+    ("on the right", "a side ('on the right')", "places relative to objects or the table"),
+    ("left side", "a side ('left side')", "places relative to objects or the table"),
+    ("right side", "a side ('right side')", "places relative to objects or the table"),
+    ("to its left", "a side ('to its left')", "places relative to objects or the table"),
+    ("to its right", "a side ('to its right')", "places relative to objects or the table"),
+    ("leftward", "a side ('leftward')", "places relative to objects or the table"),
+    ("rightward", "a side ('rightward')", "places relative to objects or the table"),
+    ("in front of", "a place ('in front of')", "places relative to objects"),
+    ("behind", "a place ('behind')", "places relative to objects"),
+    ("beside", "a place ('beside')", "places relative to objects"),
+    ("next to", "a place ('next to')", "places relative to objects"),
+    ("between", "a place ('between')", "places relative to objects"),
+    ("near", "a place ('near')", "places relative to objects"),
+    ("forward", "a direction ('forward')", "pushes in a direction"),
+    ("backward", "a direction ('backward')", "pushes in a direction"),
+    ("away from", "a direction ('away from')", "pushes in a direction"),
+)
+"""Phrases of constructs the task language has (``docs/task_spec.md``) but the author and solver do not build yet:
+(phrase, what the request asks for, the construct). A request with one is refused, never built without it; so is
+one ending in ``left``, ``right`` (*push the block left*) or ``off`` (*turn the tap off*), but not one where they name
+a model (*the left fridge*), are a verb (*the door that was left open*) or say where from (*lift it off the
+table*)."""
 _INTO = ("into", "in", "inside")
 _ONTO = ("onto", "on", "on top of", "upon")
 
@@ -319,6 +361,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
     words = _words(text)
+    _refuse_unbuilt(text, words)
     found = _skill(words)
     if found is None:
         raise InstructionError(f'"{text}" names no skill GenDex can perform. Possible requests:\n'
@@ -401,8 +444,38 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", ()))
         at.append(run[0][0])
     mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
+    _refuse_unbuilt(text, words, skill, [m for m in mentions if m.qualifier and m.how in ("id", "name", "synonym")
+                                         and not any(f"'{m.qualifier}' in" in n for n in notes)])
+    if skill in ("lift", "put_in", "place_on") and _find(words, "out of") >= 0:
+        raise InstructionError(
+            f'"{text}" asks to take an object out of another: taking out of a container is not built yet, and a '
+            f"task that only lifts it would not be what you asked. Possible requests:\n{skill_vocabulary()}")
     resolved = _assign(skill, roles, mentions, assets, text)
     return Reading(text, skill, tuple(resolved), tuple(notes))
+
+
+def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
+                    qualified: Sequence[Mention] = ()) -> None:
+    """:class:`InstructionError` when the request asks for a construct in :data:`NOT_BUILT` (a sequence, a
+    direction, an amount, a place relative to something): built without it, the task would not be what was asked.
+    Called before the verb is read (the phrases), and with the ``skill`` and the ``qualified`` mentions after (a
+    last word ``left``/``right``/``off``: a direction unless it names a model or the skill opens a lid)."""
+    if skill is None:
+        found = [(what, c) for p, what, c in NOT_BUILT if _find(words, p) >= 0]
+    else:
+        chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
+        last = words[-1]
+        found = []
+        if last in ("left", "right") and last not in chose:  # 'push the block left'
+            found.append((f"a direction ('{last}')", "pushes in a direction"))
+        if last == "off" and skill != "open":  # 'turn the tap off'
+            found.append(("a direction ('off')", "turning or switching off"))
+    if found:
+        what, construct = found[0]
+        raise InstructionError(
+            f'"{text}" asks for {what}: {construct} are in the task language (docs/task_spec.md) but the author '
+            f"and the solver do not build them yet, and a task without it would not be what you asked. Ask for one "
+            f"of these instead:\n{skill_vocabulary()}")
 
 
 QUALIFIER_WORDS = {"one": "1", "two": "2", "three": "3", "four": "4", "single": "1", "double": "2", "triple": "3",
