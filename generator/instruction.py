@@ -26,6 +26,7 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
+from gendex_envs.attributes import COLOR_WORDS
 from generator.errors import GeneratorError
 
 
@@ -141,6 +142,19 @@ NOT_BUILT: tuple[tuple[str, str, str], ...] = (
     ("next to", "a place ('next to')", "places relative to objects"),
     ("between", "a place ('between')", "places relative to objects"),
     ("near", "a place ('near')", "places relative to objects"),
+    ("corner", "a region of the table ('corner')", "places on the table"),
+    ("far side", "a region of the table ('far side')", "places on the table"),
+    ("near side", "a region of the table ('near side')", "places on the table"),
+    ("far end", "a region of the table ('far end')", "places on the table"),
+    ("far left", "a region of the table ('far left')", "places on the table"),
+    ("far right", "a region of the table ('far right')", "places on the table"),
+    ("near left", "a region of the table ('near left')", "places on the table"),
+    ("near right", "a region of the table ('near right')", "places on the table"),
+    ("middle of the table", "a region of the table ('middle of the table')", "places on the table"),
+    ("centre of the table", "a region of the table ('centre of the table')", "places on the table"),
+    ("center of the table", "a region of the table ('center of the table')", "places on the table"),
+    ("back of the table", "a region of the table ('back of the table')", "places on the table"),
+    ("front of the table", "a region of the table ('front of the table')", "places on the table"),
     ("forward", "a direction ('forward')", "pushes in a direction"),
     ("backward", "a direction ('backward')", "pushes in a direction"),
     ("away from", "a direction ('away from')", "pushes in a direction"),
@@ -462,6 +476,12 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
     last word ``left``/``right``/``off``: a direction unless it names a model or the skill opens a lid)."""
     if skill is None:
         found = [(what, c) for p, what, c in NOT_BUILT if _find(words, p) >= 0]
+        for i, w in enumerate(words):  # 'three blocks', 'all the fruit', 'both mugs'; not 'all the way'
+            rest = words[i + 1:i + 3]
+            nxt = rest[1] if rest[:1] == ["the"] and len(rest) > 1 else (rest[0] if rest else "")
+            plural = nxt.endswith("s") and not nxt.endswith("ss") and nxt != "drawers"
+            if w in GROUP_WORDS and nxt and nxt not in ("way", "time") and (plural or w in ("all", "both", "every")):
+                found.append((f"several objects ('{w} {nxt}')", "groups and towers of objects"))
     else:
         chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
         last = words[-1]
@@ -478,6 +498,9 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
             f"of these instead:\n{skill_vocabulary()}")
 
 
+GROUP_WORDS = frozenset("two three four five six several all both every".split())
+"""Words that ask for several objects at once when a plural follows (*three blocks*; not *three-drawer chest*)."""
+
 QUALIFIER_WORDS = {"one": "1", "two": "2", "three": "3", "four": "4", "single": "1", "double": "2", "triple": "3",
                    "big": "large", "huge": "large", "little": "small", "tiny": "small", "tallest": "tall"}
 """Qualifier words as catalog ids spell them (`drawer_chest_3`, `bowl_large`)."""
@@ -492,14 +515,19 @@ def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict
     category = _by_id(assets, m.asset)["category"]
     models = [a for a in assets if a["id"] == m.asset or ((m.how != "id" or m.asset == category)
                                                             and a["category"] == category)]
-    keys = {QUALIFIER_WORDS.get(w, w) for w in words}
+    colours = [w for w in words if w in COLOR_WORDS]
+    said = (f"'{' '.join(colours)}' in '{phrase}': colours are not built yet; the {category.replace('_', ' ')} "
+            "keeps the catalog's colour") if colours else ""
+    keys = {QUALIFIER_WORDS.get(w, w) for w in words if w not in COLOR_WORDS}
     chosen = [a for a in models if any(p.startswith(k) for k in keys for p in a["id"].split("_"))]
     if not chosen:
-        return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), (
-            f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
-            f"({', '.join(a['id'] for a in models)}); read as '{m.phrase}'")
+        if keys:
+            said = "; ".join(x for x in (said, (
+                f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
+                f"({', '.join(a['id'] for a in models)}); read as '{m.phrase}'")) if x)
+        return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), said
     ids = tuple(a["id"] for a in chosen)
-    return dataclasses.replace(m, phrase=phrase, asset=ids[0], options=ids, qualifier=qualifier), ""
+    return dataclasses.replace(m, phrase=phrase, asset=ids[0], options=ids, qualifier=qualifier), said
 
 
 def _one_per_object(mentions: list[Mention]) -> list[Mention]:

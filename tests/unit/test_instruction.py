@@ -151,7 +151,9 @@ def test_qualifiers_possessives_and_words_outside_noun_phrases(text, skill, asse
 def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused():
     r = read_instruction("put the red apple in the bowl", asset_dicts())
     assert [m.asset for m in r.objects] == ["apple", "bowl"]
-    assert any("'red'" in n and "matches none" in n for n in r.notes)
+    assert any("'red'" in n and "colours are not built yet" in n for n in r.notes)
+    r = read_instruction("put the shiny apple in the bowl", asset_dicts())
+    assert any("'shiny'" in n and "matches none" in n for n in r.notes)
     with pytest.raises(InstructionError, match="has no part in a 'close' task"):
         read_instruction("close the fridge and the cabinet", asset_dicts())
 
