@@ -393,11 +393,20 @@ def test_empty_and_missing_file(tmp_path: Path) -> None:
 
 
 def test_docs_example_is_valid(repo_root: Path) -> None:
+    """The full example under "## Example" parses; so does every smaller snippet's success section."""
     doc = (repo_root / "docs" / "task_spec.md").read_text()
-    block = re.search(r"```yaml\n(.*?)```", doc, re.S)
+    block = re.search(r"## Example\n.*?```yaml\n(.*?)```", doc, re.S)
     assert block is not None
-    spec = parse_task_spec(yaml.safe_load(block.group(1)), source="docs/task_spec.md")
+    full = yaml.safe_load(block.group(1))
+    spec = parse_task_spec(full, source="docs/task_spec.md")
     assert spec.name == "PutAppleBowl" and spec.goal is not None and len(spec.stages) == 4
+    snippets = [yaml.safe_load(b) for b in re.findall(r"```yaml\n(.*?)```", doc, re.S)]
+    for snippet in snippets:
+        if "success" in snippet and "name" not in snippet:  # a success section: in the example's place
+            objects = [{"name": n, "asset": "ycb_013_apple", "pos_m": [0.1, 0.0, 0.0]} for n in ("drawer",)]
+            parse_task_spec({**full, "objects": [*full["objects"], *objects], "success": snippet["success"]},
+                            source="docs/task_spec.md snippet")
+    assert len(snippets) >= 2
 
 
 # --------------------------------------------------------------------- skills and declared success
