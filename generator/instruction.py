@@ -187,6 +187,8 @@ class Mention:
     qualifier: str = ""
     """Words the person put next to a catalog name that are not catalog words themselves (``left fridge``,
     ``three drawer chest``): they choose among the name's models where they match a model's id."""
+    color: str | None = None
+    """The colour the person named it by (a key of :data:`gendex_envs.attributes.COLORS`): the task paints it so."""
 
     @property
     def substituted(self) -> bool:
@@ -215,7 +217,13 @@ class Reading:
         out = [f'"{self.instruction}" -> skill {self.skill!r}']
         for m in self.objects:
             verb = {"id": "is", "name": "is", "synonym": "means", "kind": "chose", "substitute": "SUBSTITUTED"}[m.how]
-            out.append(f"  {m.phrase!r} {verb} {m.asset}" + (f" ({m.detail})" if m.detail else ""))
+            what = m.asset
+            if m.how in ("id", "name", "synonym") and len(m.options) > 1:  # which one is the author's choice
+                what, detail = f"one of {', '.join(m.options)}", ""
+            else:
+                detail = m.detail
+            out.append(f"  {m.phrase!r} {verb} {what}" + (f", painted {m.color}" if m.color else "")
+                       + (f" ({detail})" if detail else ""))
         out += [f"  note: {n}" for n in self.notes]
         return out
 
@@ -465,6 +473,10 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
             f'"{text}" asks to take an object out of another: taking out of a container is not built yet, and a '
             f"task that only lifts it would not be what you asked. Possible requests:\n{skill_vocabulary()}")
     resolved = _assign(skill, roles, mentions, assets, text)
+    for m in resolved:
+        if m.color is not None and _by_id(assets, m.asset).get("joints"):
+            raise InstructionError(f"'{m.phrase}': painting an articulated object ({m.asset}) is not built yet; ask "
+                                   f"for it without a colour")
     return Reading(text, skill, tuple(resolved), tuple(notes))
 
 
@@ -515,9 +527,13 @@ def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict
     category = _by_id(assets, m.asset)["category"]
     models = [a for a in assets if a["id"] == m.asset or ((m.how != "id" or m.asset == category)
                                                             and a["category"] == category)]
-    colours = [w for w in words if w in COLOR_WORDS]
-    said = (f"'{' '.join(colours)}' in '{phrase}': colours are not built yet; the {category.replace('_', ' ')} "
-            "keeps the catalog's colour") if colours else ""
+    colours = sorted({COLOR_WORDS[w] for w in words if w in COLOR_WORDS})
+    if len(colours) > 1:
+        raise InstructionError(f"'{phrase}' names {len(colours)} colours ({', '.join(colours)}); an object is "
+                               "painted one colour")
+    said = ""
+    if colours:
+        m = dataclasses.replace(m, color=colours[0])
     keys = {QUALIFIER_WORDS.get(w, w) for w in words if w not in COLOR_WORDS}
     chosen = [a for a in models if any(p.startswith(k) for k in keys for p in a["id"].split("_"))]
     if not chosen:
@@ -538,6 +554,7 @@ def _one_per_object(mentions: list[Mention]) -> list[Mention]:
     out: list[Mention] = []
     for m in mentions:
         same = next((k for k, o in enumerate(out) if m.how in rank and o.how in rank and o.options and m.options
+                     and o.color == m.color  # the red block and the blue block are two blocks
                      and (set(o.options) <= set(m.options) or set(m.options) <= set(o.options))), None)
         if same is None:
             out.append(m)

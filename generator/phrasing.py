@@ -341,6 +341,26 @@ def command(part: Part, rng: np.random.Generator, surface: str) -> str:
     return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface)
 
 
+def qualifiers(a: dict, b: dict | None, colors: tuple[str | None, ...] = ()) -> dict[str, str]:
+    """Words that tell objects apart in a sentence: the colours the task paints them (``colors``: the main object's,
+    then the other's), then, for two of one category, their sizes from their ids (*the red medium block on the blue
+    large block*)."""
+    same = b is not None and a["category"] == b["category"]
+    out = {}
+    for key, x, color in (("main_qualifier", a, colors[0] if colors else None),
+                          ("other_qualifier", b, colors[1] if len(colors) > 1 else None)):
+        if x is not None:
+            words = [w for w in (color, x["id"].split("_")[-1] if same else None) if w]
+            if words:
+                out[key] = " ".join(words)
+    return out
+
+
+def painted(a: dict, colors: tuple[str | None, ...], k: int) -> tuple[str, ...]:
+    """The words of a task name for ``a`` painted ``colors[k]`` (if any): ``("red", "block_small")``."""
+    return (colors[k], a["id"]) if len(colors) > k and colors[k] else (a["id"],)
+
+
 def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | None = None,
            main_qualifier: str = "", other_qualifier: str = "", choose: Chooser | None = None) -> str:
     """An instruction for one :class:`Part` (see there and :func:`phrase_parts` for the arguments)."""
@@ -446,4 +466,4 @@ def split(instruction: str) -> tuple[str | None, str, str | None]:
 
 __all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS", "SITUATIONS_DIRECTED",
            "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for", "phrase",
-           "phrase_parts", "purposes", "situations", "split"]
+           "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]

@@ -21,6 +21,8 @@ class ProposedObject:
     name: str
     asset: str
     role: str
+    color: str | None = None
+    """The named colour the task paints it (``gendex_envs.attributes.COLORS``); None: the asset's own."""
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ import yaml
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
-from generator.phrasing import Part, phrase, phrase_parts
+from generator.phrasing import Part, painted, phrase, phrase_parts, qualifiers
 from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
@@ -158,14 +158,6 @@ def _part(a: dict) -> str:
 def _kind(skill: str, a: dict) -> str:
     """The task skill of ``skill`` (open, close, turn) on articulated ``a``: ``close_door``, ``open_lid``, ``turn``."""
     return "turn" if skill == "turn" else f"{skill}_{_part(a)}"
-
-
-def _qualifiers(a: dict, b: dict | None) -> dict[str, str]:
-    """Words that tell two objects of one category apart in a sentence (*the medium block on the large block*),
-    taken from their ids; none when the categories differ."""
-    if b is None or a["category"] != b["category"]:
-        return {}
-    return {"main_qualifier": a["id"].split("_")[-1], "other_qualifier": b["id"].split("_")[-1]}
 
 
 MOVABLE_REGION_M = ((-0.02, 0.18), (-0.26, 0.26))
@@ -335,7 +327,7 @@ class OfflineBackend:
         if {o["name"] for o in first["objects"]} & {o["name"] for o in rest["objects"]}:
             return None
         name = f"{first['name']}Then{rest['name']}"
-        parts = [Part(_kind(skill, art), art), Part(second, a, b, **_qualifiers(a, b))]
+        parts = [Part(_kind(skill, art), art), Part(second, a, b, **qualifiers(a, b))]
         text = rest["success_text"]
         return {
             "name": name, "description": phrase_parts(parts, self._words(name)),
@@ -344,11 +336,11 @@ class OfflineBackend:
             "success_text": f"{first['success_text'][:-1]}, and {text[:1].lower()}{text[1:]}",
         }
 
-    def _lift_task(self, a: dict) -> dict:
+    def _lift_task(self, a: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n = a["category"]
-        name = _camel("lift", a["id"])
+        name = _camel("lift", *filter(None, colors[:1]), a["id"])
         return {
-            "name": name, "description": phrase("lift", a, self._words(name)),
+            "name": name, "description": phrase("lift", a, self._words(name), **qualifiers(a, None, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [
                 _step("reach", n, "arm", f"Bring the open hand to the {_w(n)}."),
@@ -369,12 +361,13 @@ class OfflineBackend:
             _step("release", n, "hand", f"Open the hand to let go of the {_w(n)}."),
         ]
 
-    def _put_task(self, a: dict, b: dict) -> dict:
+    def _put_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n, t = a["category"], b["category"]
         t = t if t != n else t + "_2"
-        name = _camel("put", a["id"], "in", b["id"])
+        name = _camel("put", *painted(a, colors, 0), "in", *painted(b, colors, 1))
         return {
-            "name": name, "description": phrase("put_in", a, self._words(name), other=b, **_qualifiers(a, b)),
+            "name": name, "description": phrase("put_in", a, self._words(name), other=b,
+                                                **qualifiers(a, b, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "container"}],
             "steps": self._carry_steps(n, t, "above"),
@@ -383,11 +376,12 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} rests inside the {_w(t)}.",
         }
 
-    def _plate_task(self, a: dict, b: dict) -> dict:
+    def _plate_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n, t = a["category"], b["category"]
-        name = _camel("set", a["id"], "on", b["id"])
+        name = _camel("set", *painted(a, colors, 0), "on", *painted(b, colors, 1))
         return {
-            "name": name, "description": phrase("place_on", a, self._words(name), other=b, **_qualifiers(a, b)),
+            "name": name, "description": phrase("place_on", a, self._words(name), other=b,
+                                                **qualifiers(a, b, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "support"}],
             "steps": self._carry_steps(n, t, "over"),
@@ -413,12 +407,13 @@ class OfflineBackend:
             "success_text": f"The {part} is open to at least 80 % of its opening.",
         }
 
-    def _stack_task(self, a: dict, b: dict) -> dict:
+    def _stack_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n, t = a["id"], b["id"]
         h = float(b["size_m"][2])
-        name = _camel("stack", a["id"], "on", b["id"])
+        name = _camel("stack", *painted(a, colors, 0), "on", *painted(b, colors, 1))
         return {
-            "name": name, "description": phrase("stack", a, self._words(name), other=b, **_qualifiers(a, b)),
+            "name": name, "description": phrase("stack", a, self._words(name), other=b,
+                                                **qualifiers(a, b, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "support"}],
             "steps": [*self._carry_steps(n, t, "above")[:3],
@@ -433,7 +428,7 @@ class OfflineBackend:
         n = a["category"]
         name = _camel("push", a["id"], "to", "goal")
         return {
-            "name": name, "description": phrase("push", a, self._words(name), **_qualifiers(a, None)),
+            "name": name, "description": phrase("push", a, self._words(name), **qualifiers(a, None)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
             "steps": [_step("push", n, "arm", f"Push the {_w(n)} onto the goal mark.")],
             "success": {"type": "near", "object": n, "target": "goal", "max_dist_m": 0.04},
@@ -480,12 +475,12 @@ class OfflineBackend:
         mentions = reading["objects"]
         subs: dict[str, str] = {}
 
-        def pick(k: int, ok, what: str) -> dict:
-            """The k-th object of the reading, or the first of its options this grammar can use (a recorded
-            substitution when it is not the one read)."""
+        def pick(k: int, ok, what: str, smallest: bool = False) -> dict:
+            """The k-th object of the reading, or the first of its options this grammar can use (``smallest``: the
+            smallest of them; a recorded substitution when it is not the one read)."""
             m = mentions[k]
             options = [assets[i] for i in (m["options"] or [m["asset"]]) if i in assets]
-            usable = [a for a in options if ok(a)]
+            usable = sorted((a for a in options if ok(a)), key=_min_xy) if smallest else [a for a in options if ok(a)]
             if usable:
                 return usable[0]
             fallback = sorted((a for a in assets.values() if ok(a)), key=lambda a: a["id"])
@@ -498,18 +493,20 @@ class OfflineBackend:
                 f"'{m['phrase']}' ({m['asset']}) cannot be the {what} of a '{skill}' task this author writes; it "
                 f"writes them with: {', '.join(a['id'] for a in fallback)}")
 
+        colors = tuple(m.get("color") for m in mentions)
         if skill == "lift":
-            proposal = self._lift_task(pick(0, graspable, "object to lift"))
+            proposal = self._lift_task(pick(0, graspable, "object to lift"), colors)
         elif skill == "put_in":
             g = pick(0, graspable, "object to put in")
-            proposal = self._put_task(g, pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in"))
+            proposal = self._put_task(g, pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in"),
+                                      colors)
         elif skill == "place_on":
             proposal = self._plate_task(pick(0, graspable, "object to set down"),
-                                        pick(1, is_surface, "plate, tray or board"))
-        elif skill == "stack":
-            a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack")
+                                        pick(1, is_surface, "plate, tray or board"), colors)
+        elif skill == "stack":  # blocks named by colour alone: the smallest on top, the next size under it
+            a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack", smallest=True)
             proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a),
-                                                "larger block to stack on"))
+                                                "larger block to stack on", smallest=True), colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -565,6 +562,8 @@ class OfflineBackend:
             (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else movable
             x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
             entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
+            if o.get("color"):
+                entry["color"] = o["color"]
             layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
             if layout is not None:  # the measured layout of this skill on this object, jittered a little
                 targets = [st["target"] for st in proposal["steps"]]

@@ -11,6 +11,7 @@ import dataclasses
 import logging
 from typing import Any
 
+from gendex_envs.attributes import COLORS
 from gendex_envs.errors import suggest
 from gendex_envs.spec import (
     CONTROL_JOINT_MODES,
@@ -72,7 +73,9 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
         if (o["role"] == "articulated") != bool(assets[o["asset"]]["joints"]):
             kind = "is" if assets[o["asset"]]["joints"] else "is not"
             raise ProposalError(f"objects[{i}]: asset {o['asset']!r} {kind} articulated but has role {o['role']!r}")
-        objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"])))
+        if o.get("color") is not None and o["color"] not in COLORS:
+            raise ProposalError(f"objects[{i}]: color {o['color']!r} is not one of {list(COLORS)}")
+        objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"]), o.get("color")))
     if not 1 <= len(objects) <= MAX_OBJECTS:
         raise ProposalError(f"a task uses 1 to {MAX_OBJECTS} objects, the proposal has {len(objects)}")
     names = [o.name for o in objects]
@@ -126,7 +129,9 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
 
 def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
     """``proposal`` with the reading recorded and every substitution named: the reading's own (objects the catalog
-    lacks, kinds it chose from) and any object the backend used instead of the one the person named."""
+    lacks, kinds it chose from) and any object the backend used instead of the one the person named. Each object the
+    person named by colour gets that colour (the first proposed object of the mention's assets, in order), whatever
+    the backend wrote: the scene paints it so (:func:`generator.steps.scene.parse_scene`)."""
     subs = dict(reading.substitutions)
     used = [o.asset for o in proposal.objects]
     for m in reading.objects:
@@ -135,7 +140,15 @@ def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
             subs[m.phrase] = other[0] if other else "(left out)"
     for phrase, asset in proposal.substitutions.items():
         subs.setdefault(phrase, asset)
-    return dataclasses.replace(proposal, substitutions=subs, reading=reading.to_dict())
+    objects, taken = list(proposal.objects), set()
+    for m in reading.objects:  # the colours the person named: the reading is the authority, whatever the backend
+        k = next((k for k, o in enumerate(objects) if k not in taken and o.asset in (m.options or (m.asset,))), None)
+        if k is None:
+            continue  # left out: a substitution above
+        taken.add(k)
+        if m.color is not None:
+            objects[k] = dataclasses.replace(objects[k], color=m.color)
+    return dataclasses.replace(proposal, objects=tuple(objects), substitutions=subs, reading=reading.to_dict())
 
 
 def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (), instruction: str | None = None,

@@ -131,6 +131,11 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
     if spec.name != proposal.name:
         spec = dataclasses.replace(spec, name=proposal.name)
+    colors = {o.name: o.color for o in proposal.objects if o.color is not None}
+    if colors:  # the proposal's colours, whatever the scene answer painted
+        spec = dataclasses.replace(spec, objects=tuple(
+            dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
+            else o for o in spec.objects))
     return let_go(hold_lifted(spec))
 
 

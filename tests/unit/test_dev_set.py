@@ -38,8 +38,8 @@ def _misread(reading: Reading, steps: list[dict]) -> str | None:
         got = ASSETS[m.asset]
         if ("id" in want and got["id"] != want["id"]) or ("category" in want and got["category"] != want["category"]):
             return f"{want} read as {m.asset}"
-        if "color" in want and not any(f"'{want['color']}" in n for n in reading.notes):
-            return f"colour {want['color']!r} of {m.asset} neither read nor said"
+        if want.get("color") != m.color:
+            return f"colour {want.get('color')!r} of {m.asset} read as {m.color!r}"
     return None
 
 

@@ -151,7 +151,7 @@ def test_qualifiers_possessives_and_words_outside_noun_phrases(text, skill, asse
 def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused():
     r = read_instruction("put the red apple in the bowl", asset_dicts())
     assert [m.asset for m in r.objects] == ["apple", "bowl"]
-    assert any("'red'" in n and "colours are not built yet" in n for n in r.notes)
+    assert r.objects[0].color == "red" and not r.notes  # a colour is read, not a qualifier
     r = read_instruction("put the shiny apple in the bowl", asset_dicts())
     assert any("'shiny'" in n and "matches none" in n for n in r.notes)
     with pytest.raises(InstructionError, match="has no part in a 'close' task"):
@@ -188,3 +188,42 @@ def test_constructs_not_built_yet_are_refused_never_built_without_them(text, ask
 def test_the_same_words_elsewhere_are_not_refused(text, skill, assets):
     r = read(text)
     assert r.skill == skill and [m.asset for m in r.objects] == assets, r.lines()
+
+
+def test_colours_are_read_proposed_and_painted_in_the_scene():
+    """'the red block on the blue block': two blocks (not one named twice), the smaller on top, each painted as
+    named in the proposal, its name, its instruction and its scene, whatever the backend's scene wrote."""
+    from generator.steps.scene import write_scene
+
+    r = read("stack the red block on the blue block")
+    assert [(m.color, m.asset) for m in r.objects][0][0] == "red" and r.objects[1].color == "blue"
+    p, _ = propose(OfflineBackend(seed=0), instruction="stack the red block on the blue block")
+    assert [(o.asset, o.color) for o in p.objects] == [("block_small", "red"), ("block_medium", "blue")]
+    assert p.name == "StackRedBlockSmallOnBlueBlockMedium" and p.substitutions == {}
+    assert "red" in p.description.lower() and "blue" in p.description.lower(), p.description
+    spec, _ = write_scene(OfflineBackend(seed=0), p)
+    assert {o.name: o.color for o in spec.objects if not o.distractor} == {"block_small": "red",
+                                                                          "block_medium": "blue"}
+    p, _ = propose(OfflineBackend(seed=0), instruction="put the yellow apple in the white bowl")
+    assert [(o.asset, o.color) for o in p.objects] == [("apple", "yellow"), ("bowl", "white")]
+    with pytest.raises(InstructionError, match="painting an articulated object"):
+        read("open the red fridge")
+    with pytest.raises(InstructionError, match="names 2 colours"):
+        read("pick up the red blue block")
+
+
+def test_a_backend_that_drops_a_colour_is_overruled():
+    """The reading is the authority on colours: a backend whose proposal and scene leave the colour out still
+    gets the object painted."""
+    from generator.steps.scene import write_scene
+
+    class Colourless(OfflineBackend):
+        def complete(self, request):
+            r = super().complete(request)
+            return type(r)(text=r.text.replace('"color": "green"', '"color": null').replace("color: green", ""),
+                           backend=r.backend, model=r.model)
+
+    p, _ = propose(Colourless(seed=0), instruction="pick up the green block")
+    assert [o.color for o in p.objects] == ["green"]
+    spec, _ = write_scene(Colourless(seed=0), p)
+    assert [o.color for o in spec.objects if not o.distractor] == ["green"]
