@@ -264,11 +264,10 @@ class SuccessTracker:
         if self.steps:
             now = torch.zeros_like(holds)
             need = torch.ones_like(self.progress)
-            for k, s in enumerate(self.steps):
+            for k, s in enumerate(self.steps):  # every step for every env: no host sync on the GPU backend
                 at = self.progress == k
-                if bool(at.any()):
-                    now = torch.where(at, conditions_hold(env, s.conditions), now)
-                    need = torch.where(at, max(s.hold_steps, 1), need)
+                now = torch.where(at, conditions_hold(env, s.conditions), now)
+                need = torch.where(at, max(s.hold_steps, 1), need)
             counting = fresh & ~final
             self.streak = torch.where(counting, (self.streak + 1) * now, self.streak)
             advance = counting & (self.streak >= need)

@@ -519,9 +519,10 @@ QUALIFIER_WORDS = {"one": "1", "two": "2", "three": "3", "four": "4", "single": 
 
 
 def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict]) -> tuple[Mention, str]:
-    """``m`` with the qualifying ``words`` a person put next to it: the models of its name whose id has one of them
-    (``left`` -> ``refrigerator_left_hinge``; ``three`` -> ``drawer_chest_3``), or, when none has, the same models
-    and a note saying the words chose nothing."""
+    """``m`` with the qualifying ``words`` a person put next to it: a colour word is the colour the task paints it
+    (:data:`gendex_envs.attributes.COLOR_WORDS`); the others choose the models of its name whose id has one of them
+    (``left`` -> ``refrigerator_left_hinge``; ``three`` -> ``drawer_chest_3``), or, when none has, keep the same
+    models with a note saying the words chose nothing."""
     qualifier = " ".join(words)
     phrase = f"{qualifier} {m.phrase}" if before else f"{m.phrase} {qualifier}"
     category = _by_id(assets, m.asset)["category"]
@@ -531,19 +532,16 @@ def _qualified(m: Mention, words: list[str], before: bool, assets: Sequence[dict
     if len(colours) > 1:
         raise InstructionError(f"'{phrase}' names {len(colours)} colours ({', '.join(colours)}); an object is "
                                "painted one colour")
-    said = ""
     if colours:
         m = dataclasses.replace(m, color=colours[0])
     keys = {QUALIFIER_WORDS.get(w, w) for w in words if w not in COLOR_WORDS}
     chosen = [a for a in models if any(p.startswith(k) for k in keys for p in a["id"].split("_"))]
     if not chosen:
-        if keys:
-            said = "; ".join(x for x in (said, (
-                f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
-                f"({', '.join(a['id'] for a in models)}); read as '{m.phrase}'")) if x)
-        return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), said
+        note = (f"'{qualifier}' in '{phrase}' matches none of the catalog's {category.replace('_', ' ')} models "
+                f"({', '.join(a['id'] for a in models)}); read as '{m.phrase}'") if keys else ""
+        return dataclasses.replace(m, phrase=phrase, qualifier=qualifier), note
     ids = tuple(a["id"] for a in chosen)
-    return dataclasses.replace(m, phrase=phrase, asset=ids[0], options=ids, qualifier=qualifier), said
+    return dataclasses.replace(m, phrase=phrase, asset=ids[0], options=ids, qualifier=qualifier), ""
 
 
 def _one_per_object(mentions: list[Mention]) -> list[Mention]:
