@@ -8,6 +8,7 @@ replaying it reproduces the task files byte for byte.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import json
@@ -22,7 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gendex_envs.spec import dump_task_spec
-from gendex_envs.task_version import TaskLayout, TaskVersion, clean_drafts, new_draft, publish
+from gendex_envs.task_version import DRAFTS, TaskLayout, TaskVersion, clean_drafts, new_draft, publish
 from generator.backends.base import Backend
 from generator.backends.transcript import RecordingBackend
 from generator.catalog_view import asset_dicts
@@ -251,8 +252,23 @@ def generate(backend_factory: Callable[[], Backend], root: Path, *, n: int = 1, 
     picklable), with the same committed tasks as one process."""
     if instruction is not None and reading is None:
         reading = read_instruction(instruction, asset_dicts())
+    created = not root.exists()
     root.mkdir(parents=True, exist_ok=True)
     clean_drafts(root)
+    try:
+        return _generate(backend_factory, root, n=n, seed=seed, instruction=instruction, command=command,
+                         progress=progress, candidates=candidates, gate_attempts=gate_attempts, reading=reading,
+                         failed=failed, gate_workers=gate_workers, tasks_on=tasks_on)
+    finally:  # a refusal or a failed batch leaves no empty draft folder (nor an output folder it made)
+        for empty in (root / DRAFTS, *((root,) if created else ())):
+            with contextlib.suppress(OSError):  # rmdir: only when empty
+                empty.rmdir()
+
+
+def _generate(backend_factory: Callable[[], Backend], root: Path, *, n: int, seed: int, instruction: str | None,
+              command: str, progress: Callable[[TaskSummary], None] | None, candidates: int, gate_attempts: int,
+              reading: Reading | None, failed: list[str] | None, gate_workers: int,
+              tasks_on: FanOut | None) -> list[TaskSummary]:
     if tasks_on is not None and n > 1:
         return _generate_in_parallel(backend_factory, root, n=n, seed=seed, instruction=instruction,
                                      command=command, progress=progress, candidates=candidates,

@@ -122,6 +122,16 @@ def test_cli_refuses_an_impossible_request_non_zero_and_writes_nothing(tmp_path)
                                  "--out", str(out)])
     assert r.exit_code == 2 and "names no skill" in r.output and "push the block to the goal" in r.output
     assert not out.exists() or not any(out.iterdir())
+    # refused by the author after the reading (a dice is too small for its put-in template): nothing left behind
+    # either, not even an empty draft folder (an issue finding), and a folder it made is removed
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction",
+                                 "drop the green dice into the large bowl", "--out", str(out)])
+    assert r.exit_code == 2 and "cannot be the object to put in" in r.output, r.output
+    assert not out.exists()
+    out.mkdir()
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction",
+                                 "drop the green dice into the large bowl", "--out", str(out)])
+    assert r.exit_code == 2 and out.is_dir() and not any(out.iterdir())
 
 
 def test_reading_is_json_able():
