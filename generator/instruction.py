@@ -112,53 +112,24 @@ _DETERMINERS = frozenset("a an the its my your our their his her some this these
 """Words that start a noun phrase: an unknown word names an object (the catalog lacks) only in such a phrase
 (*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
-NOT_BUILT: tuple[tuple[str, str, str], ...] = (
-    ("then", "steps in order", "sequences"), ("afterwards", "steps in order", "sequences"),
-    ("after that", "steps in order", "sequences"), ("before", "steps in order", "sequences"),
-    ("turn off", "a direction ('off')", "turning or switching off"),
-    ("switch off", "a direction ('off')", "turning or switching off"),
-    ("shut off", "a direction ('off')", "turning or switching off"),
-    ("turn it off", "a direction ('off')", "turning or switching off"),
-    ("switch it off", "a direction ('off')", "turning or switching off"),
-    ("turned off", "a direction ('off')", "turning or switching off"),
-    ("switched off", "a direction ('off')", "turning or switching off"),
-    ("half", "an amount ('half')", "half-open joints"), ("halfway", "an amount ('halfway')", "half-open joints"),
-    ("partly", "an amount ('partly')", "half-open joints"), ("degrees", "an angle", "turning to an angle"),
-    ("to the left", "a side ('to the left')", "places relative to objects or the table"),
-    ("to the right", "a side ('to the right')", "places relative to objects or the table"),
-    ("left of", "a side ('left of')", "places relative to objects or the table"),
-    ("right of", "a side ('right of')", "places relative to objects or the table"),
-    ("on the left", "a side ('on the left')", "places relative to objects or the table"),
-    ("on the right", "a side ('on the right')", "places relative to objects or the table"),
-    ("left side", "a side ('left side')", "places relative to objects or the table"),
-    ("right side", "a side ('right side')", "places relative to objects or the table"),
-    ("to its left", "a side ('to its left')", "places relative to objects or the table"),
-    ("to its right", "a side ('to its right')", "places relative to objects or the table"),
-    ("leftward", "a side ('leftward')", "places relative to objects or the table"),
-    ("rightward", "a side ('rightward')", "places relative to objects or the table"),
-    ("in front of", "a place ('in front of')", "places relative to objects"),
-    ("behind", "a place ('behind')", "places relative to objects"),
-    ("beside", "a place ('beside')", "places relative to objects"),
-    ("next to", "a place ('next to')", "places relative to objects"),
-    ("between", "a place ('between')", "places relative to objects"),
-    ("near", "a place ('near')", "places relative to objects"),
-    ("corner", "a region of the table ('corner')", "places on the table"),
-    ("far side", "a region of the table ('far side')", "places on the table"),
-    ("near side", "a region of the table ('near side')", "places on the table"),
-    ("far end", "a region of the table ('far end')", "places on the table"),
-    ("far left", "a region of the table ('far left')", "places on the table"),
-    ("far right", "a region of the table ('far right')", "places on the table"),
-    ("near left", "a region of the table ('near left')", "places on the table"),
-    ("near right", "a region of the table ('near right')", "places on the table"),
-    ("middle of the table", "a region of the table ('middle of the table')", "places on the table"),
-    ("centre of the table", "a region of the table ('centre of the table')", "places on the table"),
-    ("center of the table", "a region of the table ('center of the table')", "places on the table"),
-    ("back of the table", "a region of the table ('back of the table')", "places on the table"),
-    ("front of the table", "a region of the table ('front of the table')", "places on the table"),
-    ("forward", "a direction ('forward')", "pushes in a direction"),
-    ("backward", "a direction ('backward')", "pushes in a direction"),
-    ("away from", "a direction ('away from')", "pushes in a direction"),
+_NOT_BUILT_GROUPS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
+    ("steps in order", "sequences", ("then", "afterwards", "after that", "before")),
+    ("a direction ('off')", "turning or switching off",
+     ("turn off", "switch off", "shut off", "turn it off", "switch it off", "turned off", "switched off")),
+    ("an amount ('{}')", "half-open joints", ("half", "halfway", "partly")),
+    ("an angle", "turning to an angle", ("degrees",)),
+    ("a side ('{}')", "places relative to objects or the table",
+     ("to the left", "to the right", "left of", "right of", "on the left", "on the right", "left side",
+      "right side", "to its left", "to its right", "leftward", "rightward")),
+    ("a place ('{}')", "places relative to objects", ("in front of", "behind", "beside", "next to", "between", "near")),
+    ("a region of the table ('{}')", "places on the table",
+     ("corner", "far side", "near side", "far end", "far left", "far right", "near left", "near right",
+      "middle of the table", "centre of the table", "center of the table", "back of the table", "front of the table")),
+    ("a direction ('{}')", "pushes in a direction", ("forward", "backward", "away from")),
 )
+NOT_BUILT: tuple[tuple[str, str, str], ...] = tuple((phrase, what.format(phrase), construct)
+                                                   for what, construct, phrases in _NOT_BUILT_GROUPS
+                                                   for phrase in phrases)
 """Phrases of constructs the task language has (``docs/task_spec.md``) but the author and solver do not build yet:
 (phrase, what the request asks for, the construct). A request with one is refused, never built without it; so is
 one ending in ``left``, ``right`` (*push the block left*) or ``off`` (*turn the tap off*), but not one where they name
@@ -468,10 +439,6 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
     _refuse_unbuilt(text, words, skill, [m for m in mentions if m.qualifier and m.how in ("id", "name", "synonym")
                                          and not any(f"'{m.qualifier}' in" in n for n in notes)])
-    if skill in ("lift", "put_in", "place_on") and _find(words, "out of") >= 0:
-        raise InstructionError(
-            f'"{text}" asks to take an object out of another: taking out of a container is not built yet, and a '
-            f"task that only lifts it would not be what you asked. Possible requests:\n{skill_vocabulary()}")
     resolved = _assign(skill, roles, mentions, assets, text)
     for m in resolved:
         if m.color is not None and _by_id(assets, m.asset).get("joints"):
@@ -502,12 +469,13 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
             found.append((f"a direction ('{last}')", "pushes in a direction"))
         if last == "off" and skill != "open":  # 'turn the tap off'
             found.append(("a direction ('off')", "turning or switching off"))
+        if skill in ("lift", "put_in", "place_on") and _find(words, "out of") >= 0:  # not 'sticking out of'
+            found.append(("an object taken out of another ('out of')", "taking out of a container"))
     if found:
         what, construct = found[0]
         raise InstructionError(
-            f'"{text}" asks for {what}: {construct} are in the task language (docs/task_spec.md) but the author '
-            f"and the solver do not build them yet, and a task without it would not be what you asked. Ask for one "
-            f"of these instead:\n{skill_vocabulary()}")
+            f'"{text}" asks for {what}: the author and the solver do not build {construct} yet, and a task '
+            f"without it would not be what you asked. Ask for one of these instead:\n{skill_vocabulary()}")
 
 
 GROUP_WORDS = frozenset("two three four five six several all both every".split())
