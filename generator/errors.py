@@ -10,6 +10,11 @@ class GeneratorError(GenDexError):
     """Base class of every error the generator raises on purpose."""
 
 
+class InstructionError(GeneratorError, ValueError):
+    """A request GenDex cannot turn into a task: a verb outside its skills, or an object that cannot play the part
+    the verb needs. The message lists what is possible."""
+
+
 class PromptError(GeneratorError, KeyError):
     """A prompt template is missing, or was rendered with a missing or unexpected variable."""
 

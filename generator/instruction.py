@@ -27,12 +27,16 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from gendex_envs.attributes import COLOR_WORDS
-from generator.errors import GeneratorError
-
-
-class InstructionError(GeneratorError, ValueError):
-    """A request GenDex cannot turn into a task: a verb outside its skills, or an object that cannot play the part
-    the verb needs. The message lists what is possible."""
+from generator.constructs import (
+    DETERMINERS,
+    GROUP_WORDS,
+    NOT_BUILT,
+    amount_words,
+    find,
+    is_off,
+    read_amount,
+)
+from generator.errors import InstructionError
 
 
 @dataclass(frozen=True)
@@ -64,8 +68,8 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
               "open the top drawer"),
     TaskSkill("close", ("close", "shut", "push shut", "push closed"),
               "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
-    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing"), "a faucet or valve lever",
-              "turn on the faucet"),
+    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing", "turn off", "switch off", "switch"),
+              "a faucet or valve lever, on or off", "turn on the faucet"),
     TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
 )}
@@ -108,33 +112,9 @@ _FILLER = frozenset("into inside onto top hand goal mark table shut closed open 
                     "there here target spot marked place position edge middle centre center surface counter worktop "
                     "tabletop air way width tower floor".split())
 """Words after the verb that name no object (places on the table among them)."""
-_DETERMINERS = frozenset("a an the its my your our their his her some this these those".split())
-"""Words that start a noun phrase: an unknown word names an object (the catalog lacks) only in such a phrase
-(*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
-_NOT_BUILT_GROUPS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
-    ("steps in order", "sequences", ("then", "afterwards", "after that", "before")),
-    ("a direction ('off')", "turning or switching off",
-     ("turn off", "switch off", "shut off", "turn it off", "switch it off", "turned off", "switched off")),
-    ("an amount ('{}')", "half-open joints", ("half", "halfway", "partly")),
-    ("an angle", "turning to an angle", ("degrees",)),
-    ("a side ('{}')", "places relative to objects or the table",
-     ("to the left", "to the right", "left of", "right of", "on the left", "on the right", "left side",
-      "right side", "to its left", "to its right", "leftward", "rightward")),
-    ("a place ('{}')", "places relative to objects", ("in front of", "behind", "beside", "next to", "between", "near")),
-    ("a region of the table ('{}')", "places on the table",
-     ("corner", "far side", "near side", "far end", "far left", "far right", "near left", "near right",
-      "middle of the table", "centre of the table", "center of the table", "back of the table", "front of the table")),
-    ("a direction ('{}')", "pushes in a direction", ("forward", "backward", "away from")),
-)
-NOT_BUILT: tuple[tuple[str, str, str], ...] = tuple((phrase, what.format(phrase), construct)
-                                                   for what, construct, phrases in _NOT_BUILT_GROUPS
-                                                   for phrase in phrases)
-"""Phrases of constructs the task language has (``docs/task_spec.md``) but the author and solver do not build yet:
-(phrase, what the request asks for, the construct). A request with one is refused, never built without it; so is
-one ending in ``left``, ``right`` (*push the block left*) or ``off`` (*turn the tap off*), but not one where they name
-a model (*the left fridge*), are a verb (*the door that was left open*) or say where from (*lift it off the
-table*)."""
+
+
 _INTO = ("into", "in", "inside")
 _ONTO = ("onto", "on", "on top of", "upon")
 
@@ -177,6 +157,12 @@ class Reading:
     """In the order of their roles (the thing acted on first, then the container, surface or base)."""
     notes: tuple[str, ...] = field(default=())
     """Parts of the request that shape nothing (``the top drawer``: the drawer the solver opens is the first)."""
+    direction: str | None = None
+    """For a turn: ``"on"`` (towards the open end, the default) or ``"off"`` (*turn the tap off*, *close the
+    valve*: back to the shut end)."""
+    amount: str | None = None
+    """How far an open or a turn goes when the request says: ``"half"`` (*open the drawer halfway*) or ``"<n>
+    degrees"`` (*turn the valve 45 degrees*, from the shut end); None: all the way."""
 
     @property
     def substitutions(self) -> dict[str, str]:
@@ -185,7 +171,8 @@ class Reading:
 
     def lines(self) -> list[str]:
         """Human-readable account of the reading (what the CLI prints)."""
-        out = [f'"{self.instruction}" -> skill {self.skill!r}']
+        out = [f'"{self.instruction}" -> skill {self.skill!r}' + (f", {self.direction}" if self.direction else "")
+               + (f", {self.amount}" if self.amount else "")]
         for m in self.objects:
             verb = {"id": "is", "name": "is", "synonym": "means", "kind": "chose", "substitute": "SUBSTITUTED"}[m.how]
             what = m.asset
@@ -259,15 +246,6 @@ def _words(text: str) -> list[str]:
     return [w for w in (re.sub(r"'s?$", "", w) for w in words) if w]
 
 
-def _find(words: Sequence[str], phrase: str, start: int = 0) -> int:
-    """Index of ``phrase`` (words) in ``words`` at or after ``start``, else -1."""
-    p = phrase.split()
-    for i in range(start, len(words) - len(p) + 1):
-        if list(words[i:i + len(p)]) == p:
-            return i
-    return -1
-
-
 def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
     """Phrase -> (how, assets it names): ids and categories with their words spaced, plurals, synonyms."""
     assets = sorted(assets, key=lambda a: (a["id"] != a["category"], a["id"]))
@@ -299,17 +277,21 @@ def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
 
 
 def _spans(words: list[str], names: dict[str, tuple[str, list[dict]]]) -> list[tuple[int, int, str]]:
-    """Non-overlapping (start, end, phrase) of catalog phrases in ``words``, longest first."""
+    """Non-overlapping (start, end, phrase) of catalog phrases in ``words``, longest first, then the earliest
+    (*ball valve lever*: the synonym *ball valve* and its part, not *ball* and the id *valve lever*)."""
+    hits = []
+    for phrase in names:
+        n = len(phrase.split())
+        i = find(words, phrase)
+        while i >= 0:
+            hits.append((-n, i, phrase))
+            i = find(words, phrase, i + 1)
     taken = [False] * len(words)
     found = []
-    for phrase in sorted(names, key=lambda p: -len(p.split())):
-        n = len(phrase.split())
-        i = _find(words, phrase)
-        while i >= 0:
-            if not any(taken[i:i + n]):
-                found.append((i, i + n, phrase))
-                taken[i:i + n] = [True] * n
-            i = _find(words, phrase, i + 1)
+    for neg, i, phrase in sorted(hits):
+        if not any(taken[i:i - neg]):
+            found.append((i, i - neg, phrase))
+            taken[i:i - neg] = [True] * -neg
     return sorted(found)
 
 
@@ -318,7 +300,7 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
     hits = []
     for s in TASK_SKILLS.values():
         for v in s.verbs:
-            i = _find(words, v)
+            i = find(words, v)
             if i >= 0:
                 hits.append((i, -len(v.split()), s.name, i + len(v.split())))
     if not hits:
@@ -339,8 +321,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
         if into:
             return "put_in", end
         return ("place_on" if "place_on" in names else "put_in"), end
-    if names[0] in ("lift", "push", "turn") and " open " in rest:  # lift the lid open, swing the door open
-        return "open", end
+    if names[0] in ("lift", "push", "turn") and (" open " in rest or " lid off " in rest):
+        return "open", end  # lift the lid open, swing the door open, take the lid off
     if "turn" in names and "reorient" in names:
         return "turn", end
     return names[0], end
@@ -360,7 +342,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         raise InstructionError(f'"{text}" names no skill GenDex can perform. Possible requests:\n'
                                + skill_vocabulary())
     skill, verb_end = found
-    in_hand = _find(words, "in the hand") >= 0 or _find(words, "in hand") >= 0 or _find(words, "in its hand") >= 0
+    in_hand = find(words, "in the hand") >= 0 or find(words, "in hand") >= 0 or find(words, "in its hand") >= 0
     names = _names(assets)
     spans = _spans(words, names)
     notes: list[str] = []
@@ -380,14 +362,16 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
                          "moves; which one is not chosen by its place")
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
         at.append(i)
-    # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
+    # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb; not the words of an amount
+    in_amount = amount_words(words)
     unknown = []
     for k, w in enumerate(words):
-        if used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or (len(w) < 3 and not w.isdigit()):
+        if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in in_amount
+                or (len(w) < 3 and not w.isdigit())):
             continue
         if w in _VERB_WORDS or w in _FILLER:
             continue
-        in_phrase = k > 0 and (words[k - 1] in _DETERMINERS or (unknown and unknown[-1][0] == k - 1)
+        in_phrase = k > 0 and (words[k - 1] in DETERMINERS or (unknown and unknown[-1][0] == k - 1)
                                or used[k - 1] or (k + 1 < len(words) and used[k + 1]))
         if not in_phrase:  # not in a noun phrase: 'keep hold of it', 'without lifting it'
             continue
@@ -437,6 +421,17 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", ()))
         at.append(run[0][0])
     mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
+    direction = None
+    amount, loose = read_amount(words)
+    if loose:
+        notes.append(loose)
+    off = is_off(words)
+    if skill == "close" and mentions and mentions[0].asset and ROLE_TESTS["turnable"](
+            _by_id(assets, mentions[0].asset)) and not ROLE_TESTS["openable"](_by_id(assets, mentions[0].asset)):
+        skill, roles, direction = "turn", SKILL_ROLES["turn"], "off"  # 'close the valve', 'shut the tap'
+        notes.append(f"closing the {mentions[0].phrase} is turning it off")
+    elif skill == "turn":
+        direction = "off" if off else "on"
     _refuse_unbuilt(text, words, skill, [m for m in mentions if m.qualifier and m.how in ("id", "name", "synonym")
                                          and not any(f"'{m.qualifier}' in" in n for n in notes)])
     resolved = _assign(skill, roles, mentions, assets, text)
@@ -444,7 +439,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         if m.color is not None and _by_id(assets, m.asset).get("joints"):
             raise InstructionError(f"'{m.phrase}': painting an articulated object ({m.asset}) is not built yet; ask "
                                    f"for it without a colour")
-    return Reading(text, skill, tuple(resolved), tuple(notes))
+    return Reading(text, skill, tuple(resolved), tuple(notes), direction, amount)
 
 
 def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
@@ -454,12 +449,13 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
     Called before the verb is read (the phrases), and with the ``skill`` and the ``qualified`` mentions after (a
     last word ``left``/``right``/``off``: a direction unless it names a model or the skill opens a lid)."""
     if skill is None:
-        found = [(what, c) for p, what, c in NOT_BUILT if _find(words, p) >= 0]
+        found = [(what, c) for p, what, c in NOT_BUILT if find(words, p) >= 0]
         for i, w in enumerate(words):  # 'three blocks', 'all the fruit', 'both mugs'; not 'all the way'
             rest = words[i + 1:i + 3]
             nxt = rest[1] if rest[:1] == ["the"] and len(rest) > 1 else (rest[0] if rest else "")
             plural = nxt.endswith("s") and not nxt.endswith("ss") and nxt != "drawers"
-            if w in GROUP_WORDS and nxt and nxt not in ("way", "time") and (plural or w in ("all", "both", "every")):
+            if w in GROUP_WORDS and nxt and nxt not in ("way", "time", "degrees") and (
+                    plural or w in ("all", "both", "every")):
                 found.append((f"several objects ('{w} {nxt}')", "groups and towers of objects"))
     else:
         chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
@@ -467,9 +463,13 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
         found = []
         if last in ("left", "right") and last not in chose:  # 'push the block left'
             found.append((f"a direction ('{last}')", "pushes in a direction"))
-        if last == "off" and skill != "open":  # 'turn the tap off'
-            found.append(("a direction ('off')", "turning or switching off"))
-        if skill in ("lift", "put_in", "place_on") and _find(words, "out of") >= 0:  # not 'sticking out of'
+        amount = read_amount(words)[0]
+        if amount is not None and (skill not in ("open", "turn") or (skill == "turn" and is_off(words))):
+            found.append((f"an amount ('{amount}')", f"part-way moves with the '{skill}' skill"))
+        if skill not in ("open", "turn") and is_off(words):
+            found.append(("a direction ('off')", f"turning off with the '{skill}' skill"))  # 'switch off the oven'
+
+        if skill in ("lift", "put_in", "place_on") and find(words, "out of") >= 0:  # not 'sticking out of'
             found.append(("an object taken out of another ('out of')", "taking out of a container"))
     if found:
         what, construct = found[0]
@@ -477,9 +477,6 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
             f'"{text}" asks for {what}: the author and the solver do not build {construct} yet, and a task '
             f"without it would not be what you asked. Ask for one of these instead:\n{skill_vocabulary()}")
 
-
-GROUP_WORDS = frozenset("two three four five six several all both every".split())
-"""Words that ask for several objects at once when a plural follows (*three blocks*; not *three-drawer chest*)."""
 
 QUALIFIER_WORDS = {"one": "1", "two": "2", "three": "3", "four": "4", "single": "1", "double": "2", "triple": "3",
                    "big": "large", "huge": "large", "little": "small", "tiny": "small", "tallest": "tall"}

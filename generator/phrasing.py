@@ -149,9 +149,29 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "swing the {d}'s lever round to turn it on",
         "turn the {d} on by pushing its handle all the way to one side",
     ),
+    "open_door_part": (
+        "open the {d}'s door {a} and hold it there",
+        "pull the {d} door open {a}, no further",
+        "swing the door of the {d} open {a} and keep it there",
+    ),
+    "open_drawer_part": (
+        "pull the {d}'s drawer out {a}",
+        "open the drawer of the {d} {a} and leave it there",
+        "slide the {d}'s drawer open {a}, no further",
+    ),
+    "turn_part": (
+        "turn the {d}'s lever {a} and stop there",
+        "swing the {d}'s lever round {a}, no further",
+        "turn the {d} {a} and hold it there",
+    ),
+    "turn_off": (
+        "turn the {d} off by pushing its lever back",
+        "swing the {d}'s lever back to turn it off",
+        "shut the {d} off by pushing its handle back to the middle",
+    ),
 }
 """Command templates per task skill: ``{o}`` the object acted on, ``{d}`` the destination or articulated object,
-``{s}`` a word for the table."""
+``{s}`` a word for the table, ``{a}`` how far a part-way open or turn goes (*halfway*, *45 degrees*)."""
 
 SITUATIONS: dict[str, tuple[str, ...]] = {
     "fruit": ("Breakfast is being laid out for a family of four", "The grocery bag was tipped out onto the {s}",
@@ -329,6 +349,8 @@ class Part:
     other: dict | None = None
     main_qualifier: str = ""
     other_qualifier: str = ""
+    amount: str = ""
+    """How far a part-way open or turn goes, in words (*halfway*, *45 degrees*)."""
 
 
 def command(part: Part, rng: np.random.Generator, surface: str) -> str:
@@ -338,7 +360,7 @@ def command(part: Part, rng: np.random.Generator, surface: str) -> str:
     articulated = bool(part.main.get("joints"))
     o = _pick(rng, names_for(part.main, part.main_qualifier or MODEL_WORDS.get(part.main["id"], "")))
     d = _pick(rng, names_for(part.other, part.other_qualifier)) if part.other is not None else o
-    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface)
+    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface, a=part.amount)
 
 
 def qualifiers(a: dict, b: dict | None, colors: tuple[str | None, ...] = ()) -> dict[str, str]:
@@ -362,16 +384,17 @@ def painted(a: dict, colors: tuple[str | None, ...], k: int) -> tuple[str, ...]:
 
 
 def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | None = None,
-           main_qualifier: str = "", other_qualifier: str = "", choose: Chooser | None = None) -> str:
+           main_qualifier: str = "", other_qualifier: str = "", amount: str = "",
+           choose: Chooser | None = None) -> str:
     """An instruction for one :class:`Part` (see there and :func:`phrase_parts` for the arguments)."""
-    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier)], rng, choose=choose)
+    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier, amount)], rng, choose=choose)
 
 
 def direction(skill: str) -> str | None:
     """``"open"`` for a skill that opens or turns something on, ``"close"`` for one that closes, else None."""
-    if skill.startswith("open_") or skill == "turn":
+    if skill.startswith("open_") or skill in ("turn", "turn_part"):
         return "open"
-    if skill.startswith("close_"):
+    if skill.startswith("close_") or skill == "turn_off":
         return "close"
     return None
 

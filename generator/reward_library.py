@@ -98,8 +98,10 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     if kind in ("open", "close", "turn"):
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
-        progress = ('(1.0 - info["open_fraction"]) / (1.0 - OPEN_FRACTION)' if kind == "close"
+        progress = ('(1.0 - info["open_fraction"]) / (1.0 - OPEN_FRACTION)' if kind == "close" or cond.get("negate")
                     else 'info["open_fraction"] / OPEN_FRACTION')
+        if cond["type"] == "joint_at":
+            frac, progress = float(cond["fraction"]), _progress(cond)
         src += f'''REWARD_MAX = 4.0
 OPEN_FRACTION = {frac}
 
@@ -211,7 +213,11 @@ def _get_obs_extra(env, info):
 
 
 def _progress(cond: dict) -> str:
-    """A joint condition's progress in [0, 1] as code: a shut joint from open (0) to shut past the fraction (1)."""
+    """A joint condition's progress in [0, 1] as code: a shut joint from open (0) to shut past the fraction (1); a
+    joint set part way (``joint_at``) from the far end of its range (0) to the fraction (1)."""
+    if cond["type"] == "joint_at":
+        frac = float(cond["fraction"])
+        return f'1.0 - (info["open_fraction"] - {frac!r}).abs() / {max(frac, 1.0 - frac)!r}'
     frac = float(cond.get("min_fraction") or 0.8)
     return (f'(1.0 - info["open_fraction"]) / {1.0 - frac!r}' if cond.get("negate")
             else f'info["open_fraction"] / {frac!r}')
@@ -227,7 +233,7 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
     the articulated part's condition first, then the rigid part's)."""
     conds = _parts(spec)
     if len(conds) > 1:
-        joint = next(c for c in conds if c["type"] == "joint_open")
+        joint = next(c for c in conds if c["type"] in ("joint_open", "joint_at"))
         rest = next(c for c in conds if c is not joint)
         rigid = _rigid(spec, roles)
         fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
@@ -239,11 +245,12 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     src = _header(f"{spec['name']}: {spec['instruction']}")
     obj = cond["object"]
-    if cond["type"] == "joint_open":
-        # a shut joint (negated condition) progresses from open (0) to shut past the fraction (1)
+    if cond["type"] in ("joint_open", "joint_at"):
+        # a shut joint (negated condition) progresses from open (0) to shut past the fraction (1); a joint set part
+        # way, from the far end to its fraction
         frac = float(cond.get("min_fraction") or 0.8)
         progress = (f'(1.0 - info["open_fraction"]) / {1.0 - frac!r}' if cond.get("negate")
-                    else 'info["open_fraction"]')
+                    else _progress(cond) if cond["type"] == "joint_at" else 'info["open_fraction"]')
         src += f'''REWARD_MAX = 4.0
 
 

@@ -3,9 +3,10 @@
 A stage's success is data in the spec (``stages[k].success``, :mod:`gendex_envs.success`). The templates below
 follow the reference tasks: a grasp holds the target with the thumb against two fingers (a hook on a handle: three
 fingers, no thumb), a lift holds it at the task's lift height, a release leaves the task's success met with the hand
-let go, an open, close or turn moves the joint past the task's fraction, a push meets the task's condition on the pushed
-object. Skills without a template (reach, carry, place, reorient) declare nothing, so the stage succeeds with the
-task.
+let go, an open, close or turn moves the joint past the task's fraction (a turn back below it when the task's
+condition is the joint shut: turning off; to the task's ``joint_at`` fraction when it has one), a push meets the
+task's condition on the pushed object. Skills without a template (reach, carry, place, reorient) declare nothing, so
+the stage succeeds with the task.
 """
 
 from __future__ import annotations
@@ -30,6 +31,11 @@ def _task_value(task_conditions: list[dict], kind: str, obj: str, key: str, defa
     return default
 
 
+def _shuts(task_conditions: list[dict], obj: str) -> bool:
+    """Whether the task's joint condition on ``obj`` is the joint shut (a turn off)."""
+    return any(c.get("type") == "joint_open" and c.get("object") == obj and c.get("negate") for c in task_conditions)
+
+
 def stage_goal(skill: str, target: str | None, task_conditions: list[dict], articulated: bool) -> list[dict] | None:
     """The standard ``success`` of a stage (a list of condition mappings), or None when the skill has none."""
     if target is None:
@@ -45,9 +51,13 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         mine = [c for c in task_conditions if c.get("object") == target] or task_conditions
         return [*(dict(c) for c in mine), {"type": "grasped", "object": target, "negate": True}]
     if skill in ("open", "close", "turn"):
+        at = [dict(c) for c in task_conditions if c.get("type") == "joint_at" and c.get("object") == target]
+        if at:  # set part way (open halfway, turn to an angle): the stage ends where the task does
+            return at
         frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
         cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
-        return [cond | {"negate": True}] if skill == "close" else [cond]
+        return [cond | {"negate": True}] if skill == "close" or (skill == "turn" and _shuts(task_conditions, target)) \
+            else [cond]
     if skill == "place":  # the task's conditions with this target: the held object set on it
         return [dict(c) for c in task_conditions if c.get("target") == target] or None
     if skill == "push":  # the task's own condition on the pushed object (near the goal mark)

@@ -71,7 +71,7 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
         return "push" if target_is_goal else "place_on"
     if kind == "over":
         return "stack" if target_category == "block" else "place_on"
-    if kind == "joint_open" and part is not None:
+    if kind in ("joint_open", "joint_at") and part is not None:
         return "turn" if part == "lever" else f"{'close' if negate else 'open'}_{part}"
     if kind == "rotated":
         return "reorient"

@@ -72,6 +72,8 @@ CLOSE_FRACTION = 0.4
 """A close aims at this part of the largest open fraction the task allows."""
 OVERSHOOT = 0.05
 """The closed loop commands at most this far (rad or m) past its goal."""
+JOINT_AT_REACHED = 0.03
+"""A move to a ``joint_at`` fraction is done this close to it (a fraction of the joint's range)."""
 ARC_CHECK_RAD = 0.05
 """Door-angle spacing of the reachability check along the arc."""
 INFLATES_M = (0.01, 0.0)
@@ -235,8 +237,19 @@ def hook_grasps(joint: JointFrame, handle: np.ndarray) -> list[HookGrasp]:
     return out
 
 
+def joint_target(env: TaskEnv, name: str) -> float | None:
+    """The fraction a ``joint_at`` success condition puts ``name``'s joint at (*open the drawer halfway*), else
+    None."""
+    return next((c.fraction for c in env.task_spec.success.conditions
+                 if c.type == "joint_at" and c.object == name and not c.negate and c.fraction is not None), None)
+
+
 def opening_goal(env: TaskEnv, name: str) -> float:
-    """Joint position the pull aims for: the success condition's open fraction plus :data:`GOAL_MARGIN`."""
+    """Joint position the pull aims for: the success condition's open fraction plus :data:`GOAL_MARGIN`, or the
+    ``joint_at`` condition's fraction itself."""
+    target = joint_target(env, name)
+    if target is not None:
+        return _clip_joint(env, name, target)
     fractions = [c.min_fraction for c in env.task_spec.success.conditions
                  if c.type == "joint_open" and c.object == name and c.min_fraction is not None and not c.negate]
     frac = max(fractions) if fractions else 1.0
@@ -245,7 +258,10 @@ def opening_goal(env: TaskEnv, name: str) -> float:
 
 def closing_goal(env: TaskEnv, name: str, part: float = CLOSE_FRACTION) -> float:
     """Joint position a close aims for: ``part`` of the open fraction a negated ``joint_open`` condition still
-    allows (short of the closed end, where the hand would hit the body)."""
+    allows (short of the closed end, where the hand would hit the body), or a ``joint_at`` condition's fraction."""
+    target = joint_target(env, name)
+    if target is not None:
+        return _clip_joint(env, name, target)
     fractions = [c.min_fraction for c in env.task_spec.success.conditions
                  if c.type == "joint_open" and c.object == name and c.min_fraction is not None and c.negate]
     frac = min(fractions) if fractions else 0.1
@@ -516,10 +532,15 @@ class HandlePrimitives:
         rate, default_lead, stall = ((c.rate_m, c.lead_m, c.stall_m) if joint.prismatic else
                                      (c.rate_rad, c.lead_rad, c.stall_rad))
         lead = default_lead if lead is None else lead
+        # a joint_at goal is where the part must stay: the command stops there and the loop ends once the joint is
+        # within JOINT_AT_REACHED of it (the hand, still on the part, keeps it there)
+        exact = joint_target(u, name) is not None
+        beyond = 0.0 if exact else OVERSHOOT
+        near = JOINT_AT_REACHED * abs(u.open_qpos(name) - u.closed_qpos(name)) if exact else 0.0
         for _ in range(c.max_steps):
             joint = read_joint(u, name)
             history.append(joint.q)
-            if sign * (joint.q - goal) >= 0:
+            if sign * (joint.q - goal) >= -near:
                 log.info("joint of %r at %.3f (goal %.3f)", name, joint.q, goal)
                 return
             if len(history) > c.stall_steps and sign * (history[-1] - history[-1 - c.stall_steps]) < stall:
@@ -527,7 +548,7 @@ class HandlePrimitives:
                                      cause="slipped")
             target = ex.target()
             # the command advances at most ``rate`` a step and runs at most ``lead`` ahead of the measured position
-            q_next = sign * min(sign * q_cmd + rate, sign * joint.q + lead, sign * goal + OVERSHOOT)
+            q_next = sign * min(sign * q_cmd + rate, sign * joint.q + lead, sign * goal + beyond)
             q = ex.ik.solve(self.grasp.palm_at(joint, q_next), target, restarts=0)
             if q is None:
                 raise ExecutionError(f"no IK for the palm on {name!r}'s path at {q_next:.3f}", cause="no_ik")
@@ -544,4 +565,5 @@ class HandlePrimitives:
 
 
 __all__ = ["HOOK_CLOSED", "HOOK_OPEN", "SOLVED_CATEGORIES", "HandleConfig", "HandlePrimitives", "HookGrasp",
-           "JointFrame", "LinkGrip", "closing_goal", "handle_local", "hook_grasps", "opening_goal", "read_joint"]
+           "JointFrame", "LinkGrip", "closing_goal", "handle_local", "hook_grasps", "joint_target", "opening_goal",
+           "read_joint"]

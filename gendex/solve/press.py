@@ -166,11 +166,13 @@ def press_direction(joint: JointFrame, point_local: np.ndarray) -> np.ndarray:
     return t / n
 
 
-def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, sign: float) -> list[PressPose]:
+def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, sign: float,
+                shelf_first: bool = False) -> list[PressPose]:
     """Press poses of the moving link (its convex ``shape`` in the link frame) that push the point ``point_local``
     (moved by each of :data:`SHIFTS_M`) towards opening (``sign`` +1) or closing (-1), in order of preference: palm
-    presses before fingertip presses; then by contact point; fingers as :data:`FINGER_ANGLES_DEG` orders them; the
-    palm following as :data:`FOLLOWS` does."""
+    presses before fingertip presses before shelf lifts (``shelf_first``: shelf lifts before fingertip presses);
+    then by contact point; fingers as :data:`FINGER_ANGLES_DEG` orders them; the palm following as :data:`FOLLOWS`
+    does."""
     rot_t = joint.link[:3, :3].T
     axis = rot_t @ joint.axis
     posed = shape.posed(np.eye(4))
@@ -218,7 +220,11 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
                         out.append(PressPose(off, back.copy(), site=site, fingers=words, back=how, shift_m=shift,
                                              follow=follow, q_ref=joint.q, contact=contact.copy()))
     if not joint.prismatic:
-        out += shelf_poses(joint, contacts)
+        shelves = shelf_poses(joint, contacts)
+        if shelf_first:
+            palm = [p for p in out if p.site == "palm"]
+            return palm + shelves + [p for p in out if p.site != "palm"]
+        out += shelves
     return out
 
 
@@ -378,7 +384,10 @@ class PressPrimitives(HandlePrimitives):
         fixed = self._fixed_shapes(name)
         moving = self._shape(name).posed(joint.link)
         around = self._part_boxes(name)
-        for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign):
+        # a lever turned back to off: the fingertips slid off it short of shut (stalled at 0.15-0.17 rad in 8 of 8
+        # dev seeds of a faucet and a valve), the bent fingers' shelf carried it home (13 of 13)
+        back = sign < 0 and any(s.skill == "turn" and s.target == name for s in u.task_spec.stages)
+        for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign, shelf_first=back):
             touch = pose.palm_at(joint, joint.q)
             if pose.site not in covers:
                 covers[pose.site] = self.hand_cover(pose.hand)

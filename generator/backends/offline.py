@@ -39,6 +39,8 @@ import numpy as np
 import yaml
 
 from generator.backends.base import ModelRequest, ModelResponse
+from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
+from generator.constructs import amount_text, amount_word, joint_fraction
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
 from generator.phrasing import Part, painted, phrase, phrase_parts, qualifiers
@@ -47,69 +49,6 @@ from generator.reword import ProposalWording
 MODEL_ID = "gendex-offline-1"
 
 _OPENABLE_LINKS = ("door", "lid", "drawer")
-ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
-    ("close", "cabinet_left_hinge"): {"pos_m": (0.62, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                      "measured": "CloseCabinet 50/50"},
-    ("close", "microwave_compact"): {"pos_m": (0.58, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                     "measured": "CloseMicrowave 50/50"},
-    ("close", "drawer_chest_1"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
-                                  "measured": "CloseDrawer 50/50"},
-    ("close", "trash_can_small"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
-                                   "measured": "CloseTrashCan 49/50"},
-    ("open", "trash_can_small"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                  "measured": "OpenTrashCan 50/50"},
-    ("open", "box_with_lid_large"): {"pos_m": (0.5, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                     "measured": "OpenBoxLid 50/50", "fixed": False, "composed_pos_m": (0.515, 0.0),
-                                     "composed": False},
-    ("turn", "faucet_lever_swivel"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                      "measured": "TurnFaucet 50/50"},
-    # the layout of a sibling model, measured by the solvability gate of a guided generation (seeds 911-9113)
-    ("close", "cabinet_right_hinge"): {"pos_m": (0.62, -0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                       "measured": "gate 10/10 (guided generation)"},
-    ("close", "microwave_standard"): {"pos_m": (0.6, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                      "measured": "gate 10/10 (guided generation)"},
-    ("close", "drawer_chest_2"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
-                                  "measured": "gate 9/10 (guided generation)"},
-    ("close", "drawer_chest_3"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
-                                  "measured": "gate 10/10 (guided generation)"},
-    ("open", "trash_can_tall"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                 "measured": "gate 10/10 (guided generation)", "composed_pos_m": (0.47, 0.0)},
-    ("close", "trash_can_tall"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
-                                  "measured": "gate 10/10 (guided generation)"},
-    ("close", "box_with_lid_large"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
-                                      "measured": "gate 10/10 (guided generation)"},
-    ("close", "box_with_lid_small"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
-                                      "measured": "gate 10/10 (guided generation)"},
-    # a laptop lid started below ~1.45 rad falls shut by itself (CloseLaptop*-v0, won by holding still)
-    ("close", "laptop_13in"): {"pos_m": (0.45, 0.0), "yaw_deg": 0.0, "start": 1.5, "grasp": False,
-                               "measured": "gate 10/10 (CloseLaptop13in-v1)"},
-    ("close", "laptop_15in"): {"pos_m": (0.45, 0.0), "yaw_deg": 0.0, "start": 1.5, "grasp": False,
-                               "measured": "gate 10/10 (CloseLaptop15in-v1)"},
-    ("turn", "valve_lever"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                              "measured": None},
-    ("turn", "valve_lever_short"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                    "measured": None},
-    ("close", "refrigerator_left_hinge"): {"pos_m": (0.65, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                           "measured": "gate 10/10 (guided generation)"},
-}
-"""Articulated objects the offline author closes, opens by pressing (lids) or turns, with a layout the skill was
-measured in: the reference task's (``benchmarks/collect.py``, 50 unseen seeds), or a sibling model's layout that the
-solvability gate passed on this model (``measured`` says which; ``None`` would be a candidate the gate has yet to
-judge). The pose is jittered by at most :data:`LAYOUT_JITTER_M`, and randomized ±5 cm / ±15° at reset.
-``composed_pos_m``: where a lid goes when later steps act on something else, so it must stay open: the press then
-follows the lid past its balance point, which the hand reaches with the large box further out and the tall bin
-nearer in (dev seeds with the lid falling shut behind the hand: box at x < 0.50 and bin at x > 0.53). The box goes
-no further than the physical critic's reach check allows with the jitter and the reset's randomization (it moved a
-box laid at 0.56 back to 0.49). Dev seeds, composed tasks of batches 41953, 66431 and 73019: bin at 0.47 8/8; box
-at 0.56 8/8, at 0.525 8/10, at 0.515 6/10 (the box still fails where a reset puts it nearer than 0.50).
-``composed: False``: the autonomous grammar composes no task from this one (the large box's lid, at 6/10, was the
-only proposal the gate dropped from the unused-seed batches 73019 and 85213); a guided request may still ask for it.
-Opening a door or drawer by its handle works across :data:`ARTICULATED_REGION_M` for every solved category and
-needs no entry. Tried and left out: opening the small lidded box by its lid (no arm pose reaches its tab: ``no_ik``
-9/9), turning a stove knob (no primitive twists a knob: ``unsupported``) and lifting the lift-lever faucet's lever
-(the pressing hand slips off it: 0/3 at four gates). A request for a variant not listed gets a listed variant of the
-same object as a recorded substitution."""
-LAYOUT_JITTER_M = 0.02
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
 STACK_PAIRS: dict[tuple[str, str], str | None] = {
@@ -156,8 +95,9 @@ def _part(a: dict) -> str:
 
 
 def _kind(skill: str, a: dict) -> str:
-    """The task skill of ``skill`` (open, close, turn) on articulated ``a``: ``close_door``, ``open_lid``, ``turn``."""
-    return "turn" if skill == "turn" else f"{skill}_{_part(a)}"
+    """The task skill of ``skill`` (open, close, turn, turn_off) on articulated ``a``: ``close_door``, ``open_lid``,
+    ``turn``, ``turn_off``."""
+    return skill if skill in ("turn", "turn_off") else f"{skill}_{_part(a)}"
 
 
 MOVABLE_REGION_M = ((-0.02, 0.18), (-0.26, 0.26))
@@ -218,6 +158,19 @@ def fits_in(g: dict, c: dict) -> bool:
     from gendex.solve.grasp import hand_fit_scale
 
     return max(g["size_m"][:2]) * hand_fit_scale(g["size_m"][:2]) < 0.7 * _min_xy(c)
+
+
+def _acts(proposal: dict) -> dict[str, str]:
+    """What the proposal does to each articulated object, as a key of :data:`ARTICULATED_LAYOUTS`: its step's skill
+    (open, close, turn), ``turn_off`` for a turn whose success condition is the joint shut."""
+    shut = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ()))
+            if c["type"] == "joint_open" and c.get("negate")}
+    return {s["target"]: "turn_off" if s["skill"] == "turn" and s["target"] in shut else s["skill"]
+            for s in proposal["steps"] if s["skill"] in ("open", "close", "turn")}
+
+
+def _joint_at(n: str, fraction: float) -> dict:
+    return {"type": "joint_at", "object": n, "fraction": fraction, "max_error": 0.1}
 
 
 def _movable_region(proposal: dict, assets: dict[str, dict], acts: dict[str, str]) -> tuple:
@@ -306,7 +259,7 @@ class OfflineBackend:
         # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
-                  if i in by_id and not lay["grasp"] and lay["measured"] and skill != "turn"
+                  if i in by_id and not lay["grasp"] and lay["measured"] and skill not in ("turn", "turn_off")
                   and lay.get("composed", True)]
         seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in g for b in c if fits_in(a, b)]
                    + [("place_on", a, b) for a in g for b in p])
@@ -390,21 +343,32 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} lies on the {_w(t)}.",
         }
 
-    def _open_task(self, a: dict) -> dict:
+    def _open_task(self, a: dict, fraction: float | None = None) -> dict:
+        """Open ``a``'s door or drawer by its handle: at least 80 % of the way, or to ``fraction`` of it (held
+        there)."""
         n = a["category"]
         part = _part(a)
-        name = _camel("open", a["id"])
+        if fraction is None:
+            name = _camel("open", a["id"])
+            description = phrase(f"open_{part}", a, self._words(name))
+            success = {"type": "joint_open", "object": n, "target": None, "min_height_m": None, "min_fraction": 0.8,
+                       "max_dist_m": None}
+            text = f"The {part} is open to at least 80 % of its opening."
+        else:
+            name = _camel("open", a["id"], amount_word(fraction, a))
+            description = phrase(f"open_{part}_part", a, self._words(name), amount=amount_text(fraction, a))
+            success = _joint_at(n, fraction)
+            text = f"The {part} stays open {amount_text(fraction, a)} (within 10 % of its opening)."
         return {
-            "name": name, "description": phrase(f"open_{part}", a, self._words(name)),
+            "name": name, "description": description,
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": [
                 _step("reach", n, "arm", f"Bring the open hand to the {part} handle."),
                 _step("grasp", n, "hand", "Hook the fingers around the handle."),
-                _step("open", n, "both", f"Pull the {part} open along its path."),
+                _step("open", n, "both", f"Pull the {part} open along its path" +
+                      ("." if fraction is None else f", {amount_text(fraction, a)}, and hold it there.")),
             ],
-            "success": {"type": "joint_open", "object": n, "target": None, "min_height_m": None, "min_fraction": 0.8,
-                        "max_dist_m": None},
-            "success_text": f"The {part} is open to at least 80 % of its opening.",
+            "success": success, "success_text": text,
         }
 
     def _stack_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
@@ -435,8 +399,11 @@ class OfflineBackend:
             "success_text": f"The {_w(n)}'s centre is within 4 cm of the goal mark.",
         }
 
-    def _articulated_task(self, skill: str, a: dict) -> dict:
-        """Close a door or drawer, open or close a lid, turn a lever: one of :data:`ARTICULATED_LAYOUTS`."""
+    def _articulated_task(self, skill: str, a: dict, fraction: float | None = None) -> dict:
+        """Close a door or drawer, open or close a lid, turn a lever on or off: one of :data:`ARTICULATED_LAYOUTS`;
+        a turn to ``fraction`` of the lever's range (held there) when one is given."""
+        if fraction is not None:
+            return self._turn_to(a, fraction)
         layout = ARTICULATED_LAYOUTS[skill, a["id"]]
         n = a["category"]
         part = _part(a)
@@ -451,15 +418,32 @@ class OfflineBackend:
             steps.append(_step("turn", n, "both", f"Push the {part} round until it is fully turned."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.8}
             text = f"The {part} is turned to at least 80 % of its range."
+        elif skill == "turn_off":  # a turn whose success is the joint shut: the stage pushes the lever back
+            steps.append(_step("turn", n, "both", f"Push the {part} back until the {_w(n)} is off."))
+            success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
+            text = f"The {part} is back to less than 10 % of its range: the {_w(n)} is off."
         else:
             steps.append(_step("open", n, "both", f"Lift the {part} along its arc until it is open."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.5}
             text = f"The {part} is open to at least half of its opening."
-        name = _camel(skill, a["id"])
+        name = _camel("turn", a["id"], "off") if skill == "turn_off" else _camel(skill, a["id"])
         return {
             "name": name, "description": phrase(_kind(skill, a), a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": steps, "success": success, "success_text": text,
+        }
+
+    def _turn_to(self, a: dict, fraction: float) -> dict:
+        """Turn ``a``'s lever from off to ``fraction`` of its range (the turn layout) and hold it there."""
+        n, part = a["category"], _part(a)
+        name = _camel("turn", a["id"], amount_word(fraction, a))
+        return {
+            "name": name, "description": phrase("turn_part", a, self._words(name), amount=amount_text(fraction, a)),
+            "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
+            "steps": [_step("reach", n, "arm", f"Bring the open hand to the {_w(n)}'s {part}."),
+                      _step("turn", n, "both", f"Push the {part} round {amount_text(fraction, a)} and stop there.")],
+            "success": _joint_at(n, fraction),
+            "success_text": f"The {part} stays turned {amount_text(fraction, a)} (within 10 % of its range).",
         }
 
     def _propose_guided(self, request: ModelRequest, ctx: dict) -> str:
@@ -494,6 +478,7 @@ class OfflineBackend:
                 f"writes them with: {', '.join(a['id'] for a in fallback)}")
 
         colors = tuple(m.get("color") for m in mentions)
+        amount = reading.get("amount")
         if skill == "lift":
             proposal = self._lift_task(pick(0, graspable, "object to lift"), colors)
         elif skill == "put_in":
@@ -512,9 +497,19 @@ class OfflineBackend:
                                             "block to push"))
         elif skill == "open" and mentions and any(
                 (i in assets and openable(assets[i])) for i in (mentions[0]["options"] or [mentions[0]["asset"]])):
-            proposal = self._open_task(pick(0, openable, "door or drawer to open"))
+            a = pick(0, openable, "door or drawer to open")
+            if amount is not None and _part(a) not in ("door", "drawer"):
+                raise InstructionError(f"the offline author opens only doors and drawers part way (a lid let go part "
+                                       f"way falls); '{mentions[0]['phrase']}' ({a['id']}) opens by its {_part(a)}")
+            proposal = self._open_task(a, None if amount is None else joint_fraction(amount, a))
         elif skill in ("open", "close", "turn"):
-            proposal = self._articulated_task(skill, self._measured_variant(skill, mentions[0], assets, subs))
+            act = "turn_off" if skill == "turn" and reading.get("direction") == "off" else skill
+            if amount is not None and act != "turn":
+                raise InstructionError(f"the offline author opens only doors and drawers part way (by their handle: "
+                                       f"a lid let go part way falls); it cannot {act} "
+                                       f"'{mentions[0]['phrase']}' {amount}")
+            a = self._measured_variant(act, mentions[0], assets, subs)
+            proposal = self._articulated_task(act, a, None if amount is None else joint_fraction(amount, a))
         else:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
@@ -552,7 +547,7 @@ class OfflineBackend:
         assets = {a["id"]: a for a in ctx["assets"]}
         rng = self._rng(request, ctx.get("index", 0), ctx["candidate_index"], ctx.get("attempt", 0))
         objects = []
-        acts = {s["target"]: s["skill"] for s in proposal["steps"] if s["skill"] in ("open", "close", "turn")}
+        acts = _acts(proposal)
         goal = None
         movable = _movable_region(proposal, assets, acts)
         for o in proposal["objects"]:

@@ -63,7 +63,9 @@ How each check is measured (the thresholds are the module constants below):
 ``joint_state`` (static)
     An articulated object whose initial joint state contradicts the first stage that targets it with skill
     ``open`` or ``close``: "open" while the joint starts at least JOINT_OPEN_FRACTION open, "close" while it starts
-    less than that open. With no such stage, a ``joint_open`` success condition on the object means "open". The
+    less than that open. With no such stage, a ``joint_open`` success condition on the object means "open" (every
+    one negated: "close", a turn off). A joint a ``joint_at`` condition sets part way must not start within its
+    ``max_error`` of the fraction (fix: the end of its range further from it). The
     fraction is (q - closed) / (open - closed) of the joint the conditions name, else the asset's main joint.
     Fix: ``joint_fix`` = {object, joint, value} setting the joint to its closed (resp. open) value; the directive
     grammar has no joint edit.
@@ -82,10 +84,10 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
-from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec, parse_task_spec, spec_to_dict
+from gendex_envs.conditions import CONDITION_DEFAULTS
+from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec
 from generator.critic.directives import Directive
 from generator.critic.layout import Room, choose_move, front_zone
-from generator.errors import DirectiveError
 
 log = logging.getLogger(__name__)
 
@@ -553,8 +555,10 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violati
                 intent, source = JOINT_SKILLS[s.skill], f"stage {s.name!r} (skill {s.skill!r})"
                 break
         conds = [c for c in spec.success.conditions if c.object == name and c.type == "joint_open"]
-        if intent is None and conds:
-            intent, source = "open", "the joint_open success condition"
+        if intent is None and conds:  # a turn (or no stage): the success condition says which way
+            shut = all(c.negate for c in conds)
+            intent = "close" if shut else "open"
+            source = f"the {'negated ' if shut else ''}joint_open success condition"
         joint_name = next((c.joint for c in conds if c.joint), None)
         try:
             joint = rec.joint(joint_name) if joint_name else rec.joints[0]
@@ -564,6 +568,17 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violati
         span = joint.open_qpos - joint.closed_qpos
         frac = (q - joint.closed_qpos) / span if span else 0.0
         meas[name] = {"joint": joint.name, "qpos": rounded(q), "open_fraction": rounded(frac), "intent": intent}
+        at = next((c for c in spec.success.conditions if c.object == name and c.type == "joint_at" and not c.negate),
+                  None)
+        if at is not None:  # set part way: it must not start there; the fix starts it at the end further away
+            err = at.max_error if at.max_error is not None else CONDITION_DEFAULTS["max_error"]
+            if abs(frac - at.fraction) <= err:
+                far = joint.closed_qpos if at.fraction >= 0.5 else joint.open_qpos
+                violations.append(Violation(
+                    "joint_state", name, f"{name!r} starts {frac:.0%} open ({joint.name} = {q:g}), already within "
+                    f"{err:.0%} of the {at.fraction:.0%} the joint_at success condition asks for", measured=frac,
+                    limit=at.fraction, joint_fix={"object": name, "joint": joint.name, "value": far}))
+            continue
         if intent == "open" and frac >= JOINT_OPEN_FRACTION:
             violations.append(Violation(
                 "joint_state", name, f"{name!r} starts {frac:.0%} open ({joint.name} = {q:g}) but {source} "
@@ -618,31 +633,6 @@ def check_raw_scales(raw: Mapping) -> list[Violation]:
         out.append(Violation("scale", name, f"{name!r} has scale {s:g}, outside the allowed range {lo}-{hi}",
                              measured=float(s), limit=lo if s < lo else hi, fix=fix))
     return out
-
-
-def apply_joint_fix(spec: TaskSpec, fixes: Mapping | Iterable[Mapping]) -> TaskSpec:
-    """A new TaskSpec with each ``{"object", "joint", "value"}`` written into that object's ``joint_state``.
-
-    DirectiveError for an unknown object or joint, or a value outside the joint's limits.
-    """
-    fixes = [fixes] if isinstance(fixes, Mapping) else list(fixes)
-    raw = spec_to_dict(spec)
-    by_name = {o["name"]: o for o in raw["objects"]}
-    for fx in fixes:
-        name, joint, value = fx.get("object"), fx.get("joint"), fx.get("value")
-        if name not in by_name:
-            raise DirectiveError(f"joint fix {dict(fx)} names object {name!r}, which is not in the scene; "
-                                 f"objects: {', '.join(by_name)}")
-        rec = get_asset(by_name[name]["asset"])
-        joints = [j.name for j in rec.joints]
-        if joint not in joints:
-            raise DirectiveError(f"joint fix {dict(fx)}: {name!r} (asset {rec.id!r}) has no joint {joint!r}; "
-                                 f"joints: {', '.join(joints) or 'none'}")
-        jlo, jhi = rec.joint(joint).limits
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not jlo <= value <= jhi:
-            raise DirectiveError(f"joint fix {dict(fx)}: value {value!r} is outside {joint}'s limits [{jlo}, {jhi}]")
-        by_name[name]["joint_state"] = {**by_name[name]["joint_state"], joint: float(value)}
-    return parse_task_spec(raw, source=f"<{spec.name} after {len(fixes)} joint fixes>")
 
 
 def ordered(violations: list[Violation]) -> list[Violation]:

@@ -37,8 +37,9 @@ MAX_STEPS = 8
 MAX_PARTS = 2
 """Success conditions of a proposal: one, or one per part of a composed task (``success`` and ``also``)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
-                "min_dz_m", "max_dz_m")
-"""Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut)."""
+                "min_dz_m", "max_dz_m", "fraction", "max_error")
+"""Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut; ``fraction``
+and ``max_error`` with ``joint_at``: the joint set part way)."""
 
 
 def skill_list() -> str:
@@ -122,8 +123,12 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
     if succ["type"] in ("inside", "near", "over") and succ.get("target") not in targets:
         raise ProposalError(f"{where}.target {succ.get('target')!r} must name a proposed object for a "
                             f"{succ['type']!r} condition; allowed: {targets}")
-    if succ["type"] == "joint_open" and not assets[objects[names.index(succ["object"])].asset]["joints"]:
-        raise ProposalError(f"{where}: joint_open needs an articulated object, {succ['object']!r} is rigid")
+    if succ["type"] in ("joint_open", "joint_at") and not assets[objects[names.index(succ["object"])].asset]["joints"]:
+        raise ProposalError(f"{where}: {succ['type']} needs an articulated object, {succ['object']!r} is rigid")
+    if succ["type"] == "joint_at" and not (isinstance(succ.get("fraction"), (int, float))
+                                           and 0.0 <= succ["fraction"] <= 1.0):
+        raise ProposalError(f"{where}: joint_at needs a fraction in [0, 1] of the way from closed to open, got "
+                            f"{succ.get('fraction')!r}")
     return {k: v for k, v in succ.items() if k in SUCCESS_KEYS}
 
 

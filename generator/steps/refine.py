@@ -43,7 +43,7 @@ def _vision_directives(backend: Backend, spec: TaskSpec, findings: str,
 def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpec, list[str], list[str]]:
     """Apply the measured fixes, then the critic's directives, one at a time; returns (spec, applied, rejected)."""
     from generator.critic.directives import apply_directives
-    from generator.critic.physical import apply_joint_fix
+    from generator.critic.joints import apply_joint_fix
 
     applied: list[str] = []
     rejected: list[str] = []

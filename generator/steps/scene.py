@@ -112,6 +112,16 @@ def let_go(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=success)
 
 
+def hold_joint_at(spec: TaskSpec) -> TaskSpec:
+    """Give a success with a ``joint_at`` condition (a joint set part way) :data:`SETTLED_STEPS` to hold: a door
+    swung through the band, or a lever pushed past it, is not where it was asked to be."""
+    if not any(c.type == "joint_at" and not c.negate for c in spec.success.conditions) \
+            or spec.success.hold_steps >= SETTLED_STEPS:
+        return spec
+    log.info("success of %s: the joint must stay at its fraction %d steps", spec.name, SETTLED_STEPS)
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, hold_steps=SETTLED_STEPS))
+
+
 def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     """Parse a scene answer into a TaskSpec using exactly the proposal's objects; :class:`SceneError` otherwise."""
     raw = parse_yaml_block(text, "scene file", SceneError)
@@ -136,7 +146,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return let_go(hold_lifted(spec))
+    return hold_joint_at(let_go(hold_lifted(spec)))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

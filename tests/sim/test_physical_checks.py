@@ -10,7 +10,8 @@ import pytest
 from gendex_envs.registry import REFERENCE_TASKS
 from gendex_envs.spec import TaskSpec, parse_task_spec, spec_to_dict
 from generator.critic.directives import apply_directives
-from generator.critic.physical import FALL_TOL_M, PENETRATION_TOL_M, apply_joint_fix
+from generator.critic.joints import apply_joint_fix
+from generator.critic.physical import FALL_TOL_M, PENETRATION_TOL_M
 from generator.critic.physical_sim import check_scene
 
 REFERENCE: dict[str, TaskSpec] = {}

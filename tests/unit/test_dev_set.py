@@ -26,11 +26,15 @@ def _misread(reading: Reading, steps: list[dict]) -> str | None:
     step = steps[0]
     if step["skill"] != reading.skill:
         return f"read as {reading.skill!r}, asked {step['skill']!r}"
-    for key in ("amount", "relation", "region"):
+    want_amount = step.get("amount")
+    want_amount = f"{want_amount:g} degrees" if isinstance(want_amount, (int, float)) else want_amount
+    if want_amount != reading.amount:
+        return f"amount {step.get('amount')!r} read as {reading.amount!r}"
+    for key in ("relation", "region"):
         if key in step:
             return f"its {key} ({step[key]}) is not in the reading"
-    if step.get("direction") not in (None, "on"):  # turn tasks turn on
-        return f"direction {step['direction']!r} is not in the reading"
+    if (step.get("direction") or ("on" if step["skill"] == "turn" else None)) != reading.direction:
+        return f"direction {step.get('direction')!r} read as {reading.direction!r}"
     if len(step["objects"]) != len(reading.objects):
         return f"objects {step['objects']} read as {[m.asset for m in reading.objects]}"
     for want, m in zip(step["objects"], reading.objects, strict=True):

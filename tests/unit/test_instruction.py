@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 from gendex.cli import app
 from generator.backends.offline import OfflineBackend
 from generator.catalog_view import asset_dicts
-from generator.instruction import TASK_SKILLS, InstructionError, read_instruction
+from generator.instruction import ROLE_TESTS, TASK_SKILLS, InstructionError, read_instruction
 from generator.steps.propose import propose
 
 A = asset_dicts()
@@ -169,15 +169,14 @@ def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused
 
 
 @pytest.mark.parametrize("text, asks", [
-    ("turn the faucet off", "a direction ('off')"),
-    ("switch off the tap", "a direction ('off')"),
+    ("close the drawer off", "a direction ('off')"),
     ("push the block left", "a direction ('left')"),
     ("slide the mug to the left", "a side ('to the left')"),
     ("put the apple to the right of the bowl", "a side ('to the right')"),
     ("set the lemon next to the plate", "a place ('next to')"),
     ("put the pear between the bowl and the plate", "a place ('between')"),
     ("place the apple in front of the bowl", "a place ('in front of')"),
-    ("open the drawer halfway", "an amount ('halfway')"),
+    ("lift the apple halfway", "an amount ('half')"),
     ("open the fridge, then put the apple in the bowl", "steps in order"),
     ("put the apple in the bowl before closing the microwave", "steps in order"),
     ("take the apple out of the bowl", "out of another"),
@@ -188,6 +187,26 @@ def test_constructs_not_built_yet_are_refused_never_built_without_them(text, ask
     'left' as an object)."""
     with pytest.raises(InstructionError, match=re.escape(asks)):
         read(text)
+
+
+@pytest.mark.parametrize("text, direction", [
+    ("turn the faucet off", "off"), ("switch off the tap", "off"), ("turn the valve off please", "off"),
+    ("shut off the faucet", "off"), ("close the valve", "off"), ("switch the tap off", "off"),
+    ("turn on the faucet", "on"), ("turn the valve", "on"), ("swing the faucet lever to turn it on", "on"),
+])
+def test_a_turn_reads_its_direction(text, direction):
+    """'off' after a verb or pronoun, or not followed by what something comes off, turns the lever back to shut; so
+    does closing a faucet or valve (it has no door or lid). The issue's misread: 'off' built a turn-on task."""
+    r = read(text)
+    assert (r.skill, r.direction) == ("turn", direction), r.lines()
+    assert ROLE_TESTS["turnable"](next(a for a in asset_dicts() if a["id"] == r.objects[0].asset))
+
+
+def test_off_is_no_direction_where_it_says_where_from():
+    r = read("lift the apple off the table")
+    assert (r.skill, r.direction) == ("lift", None)
+    r = read("take the lid off the box")  # taking a lid off opens it (before: a lift of a cracker box)
+    assert r.skill == "open" and r.objects[0].asset.startswith("box_with_lid")
 
 
 @pytest.mark.parametrize("text, skill, assets", [

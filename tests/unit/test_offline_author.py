@@ -12,6 +12,7 @@ from gendex_envs.spec import parse_task_spec, spec_to_dict
 from generator.backends.base import ModelRequest
 from generator.backends.offline import OfflineBackend
 from generator.catalog_view import asset_dicts
+from generator.instruction import InstructionError, read_instruction
 from generator.reward_library import compose_stage_module, compose_task_module, roles_of
 from generator.steps.propose import propose
 from generator.steps.scene import adjust_sizes, parse_scene
@@ -147,7 +148,7 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
     the scene parses with the task schema, starts the joint where the reference task measured it, and the composed
     reward modules pass the static validator (a shut joint rewards closing, a push rewards the object's way to the
     goal mark)."""
-    from generator.backends.offline import ARTICULATED_LAYOUTS
+    from generator.backends.offline import ARTICULATED_LAYOUTS, _acts
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=3)
@@ -172,10 +173,9 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
             assert "(1.0 - info[\"open_fraction\"])" in src
         if cond.get("target") == "goal":
             assert "goal" in spec and "env.goal_pos" in src
+        acts = _acts(raw)  # a turn whose success is the joint shut is laid out as turn_off (lever starts open)
         for obj in spec["objects"]:
-            skill = next((s.skill for s in p.steps if s.target == obj["name"]
-                          and s.skill in ("open", "close", "turn")), None)
-            layout = ARTICULATED_LAYOUTS.get((skill, obj["asset"]))
+            layout = ARTICULATED_LAYOUTS.get((acts.get(obj["name"], ""), obj["asset"]))
             if layout:
                 assert list(obj["joint_state"].values()) == [layout["start"]]
                 assert abs(obj["pos_m"][0] - layout["pos_m"][0]) <= 0.02 + 1e-9
@@ -368,3 +368,88 @@ def test_a_set_down_success_is_written_with_a_release_held_while_it_settles():
     raw["goal"] = {"pos_m": [0.1, 0.0, 0.0]}
     pushed = parse_task_spec(raw)
     assert let_go(pushed) == pushed
+
+
+@pytest.mark.parametrize("text, asset", [("turn the faucet off", "faucet_lever_swivel"),
+                                         ("close the valve", "valve_lever")])
+def test_turning_off_starts_the_lever_open_and_succeeds_with_it_shut(text, asset):
+    """'Off' is a turn back to the shut end: the lever starts at its open angle (the turn_off layout), the task's
+    and the stage's conditions are the joint shut, the stage reward rises as it shuts, and the critic asks for
+    nothing (the joint starts open, as a close wants it). Before, 'off' built the turn-on task."""
+    from generator.backends.offline import ARTICULATED_LAYOUTS
+    from generator.critic.physical import static_findings
+    from generator.stage_goals import stage_goal
+    from generator.steps.propose import parse_proposal
+
+    reading = read_instruction(text, asset_dicts())
+    assert reading.direction == "off"
+    b = OfflineBackend(seed=4)
+    raw = json.loads(b.complete(ModelRequest(step="propose_guided", prompt="", context={
+        "reading": reading.to_dict(), "assets": asset_dicts()})).text.split("```json\n")[1].split("```")[0])
+    assert raw["objects"][0]["asset"] == asset and raw["name"].endswith("Off")
+    assert raw["success"] == {"type": "joint_open", "object": raw["objects"][0]["name"], "min_fraction": 0.1,
+                              "negate": True}
+    assert " off" in raw["description"]
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] == asset],
+               "candidate_index": 0, "index": 0, "attempt": 0}
+    spec = adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
+    (joint, start), = spec.objects[0].joint_state.items()
+    assert start == ARTICULATED_LAYOUTS["turn_off", asset]["start"] == 1.2  # the lever's open angle
+    violations, meas, _, _ = static_findings(spec, overlap=True)
+    assert meas["joint_state"][spec.objects[0].name]["intent"] == "close"
+    assert not [v for v in violations if v.check == "joint_state"]
+    d = spec_to_dict(spec)
+    turn = next(s for s in d["stages"] if s["skill"] == "turn")
+    goal = stage_goal("turn", turn["target"], d["success"]["conditions"], articulated=True)
+    assert goal == [{"type": "joint_open", "object": turn["target"], "min_fraction": 0.1, "negate": True}]
+    src = compose_stage_module(d, turn["name"], roles_of(dataclasses.asdict(p)))
+    assert '(1.0 - info["open_fraction"])' in src
+    check_reward_source(src)
+
+
+@pytest.mark.parametrize("text, asset, fraction", [
+    ("open the drawer halfway", "drawer_chest_1", 0.5),
+    ("open the cabinet door half way", "cabinet_left_hinge", 0.5),
+    ("turn the valve 45 degrees", "valve_lever", round(np.radians(45) / 1.2, 3)),  # the lever's range is 1.2 rad
+])
+def test_a_part_way_request_sets_the_joint_there_and_holds_it(text, asset, fraction):
+    """'Halfway' and '<n> degrees' become a joint_at condition at that fraction of the range (degrees from the shut
+    end), the stage that moves the joint ends there too, and the success must hold 10 steps (a door swung through
+    the band is not half open). Before, 'halfway' was refused."""
+    from generator.phrasing import split
+    from generator.stage_goals import stage_goal
+    from generator.steps.propose import parse_proposal
+    from generator.steps.scene import SETTLED_STEPS
+
+    reading = read_instruction(text, asset_dicts())
+    b = OfflineBackend(seed=5)
+    raw = json.loads(b.complete(ModelRequest(step="propose_guided", prompt="", context={
+        "reading": reading.to_dict(), "assets": asset_dicts()})).text.split("```json\n")[1].split("```")[0])
+    n = raw["objects"][0]["name"]
+    assert raw["objects"][0]["asset"] == asset
+    assert raw["success"] == {"type": "joint_at", "object": n, "fraction": fraction, "max_error": 0.1}
+    command = split(raw["description"])[1]  # without the situation and purpose framing it
+    assert read_instruction(command, asset_dicts()).amount == reading.amount  # its wording reads back
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] == asset],
+               "candidate_index": 0, "index": 0, "attempt": 0}
+    spec = adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
+    assert spec.success.hold_steps == SETTLED_STEPS
+    d = spec_to_dict(spec)
+    moving = next(s for s in d["stages"] if s["skill"] in ("open", "turn"))
+    goal, = stage_goal(moving["skill"], n, d["success"]["conditions"], articulated=True)
+    assert {k: v for k, v in goal.items() if v is not None and v is not False} == raw["success"]
+    check_reward_source(compose_task_module(d, roles_of(dataclasses.asdict(p))))
+
+
+@pytest.mark.parametrize("text, why", [
+    ("turn the valve 80 degrees", "turns 69 degrees"),  # past the lever's range
+    ("open the drawer 30 degrees", "slides"),
+    ("open the trash can lid halfway", "part way"),  # a lid let go part way falls
+])
+def test_a_part_way_request_the_author_cannot_build_is_refused_saying_why(text, why):
+    reading = read_instruction(text, asset_dicts())
+    with pytest.raises(InstructionError, match=why):
+        OfflineBackend(seed=5).complete(ModelRequest(step="propose_guided", prompt="", context={
+            "reading": reading.to_dict(), "assets": asset_dicts()}))

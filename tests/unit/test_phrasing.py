@@ -12,15 +12,21 @@ from generator.phrasing import COMMANDS, NAMES, PURPOSES, SITUATIONS, domain, na
 
 ASSETS = {a["id"]: a for a in asset_dicts()}
 READ_AS = {"open_door": "open", "open_drawer": "open", "open_lid": "open", "close_door": "close",
-           "close_drawer": "close", "close_lid": "close"}
+           "close_drawer": "close", "close_lid": "close", "turn_off": "turn", "open_door_part": "open",
+           "open_drawer_part": "open", "turn_part": "turn"}
 CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks of that skill
     "lift": ("apple", None), "put_in": ("lemon", "pot"), "place_on": ("pear", "plate"),
     "stack": ("block_medium", "block_large"), "push": ("block_large", None),
     "open_door": ("cabinet_left_hinge", None), "open_drawer": ("drawer_chest_1", None),
     "close_door": ("microwave_compact", None), "close_drawer": ("drawer_chest_1", None),
     "open_lid": ("trash_can_small", None), "close_lid": ("box_with_lid_large", None),
-    "turn": ("faucet_lever_swivel", None),
+    "turn": ("faucet_lever_swivel", None), "turn_off": ("valve_lever", None),
+    "open_door_part": ("cabinet_left_hinge", None), "open_drawer_part": ("drawer_chest_2", None),
+    "turn_part": ("valve_lever_short", None),
 }
+AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
+           "turn_part": ("45 degrees", "45 degrees")}
+"""How far a part-way command says (as the author words it) and what the reader must read."""
 
 
 @pytest.mark.parametrize("skill", sorted(COMMANDS))
@@ -33,9 +39,12 @@ def test_every_command_reads_back_as_its_task(skill):
     for template in COMMANDS[skill]:
         for o in names_for(ASSETS[main], q_main):
             for d in (names_for(ASSETS[other], q_other) if other else (o,)):
-                text = template.format(o=o, d=d, s="table")
+                text = template.format(o=o, d=d, s="table", a=AMOUNTS.get(skill, ("",))[0])
                 r = read_instruction(text, list(ASSETS.values()))
+                assert r.amount == AMOUNTS.get(skill, ("", None))[1], text
                 assert r.skill == READ_AS.get(skill, skill), text
+                if r.skill == "turn":  # the direction the command says, read back
+                    assert r.direction == ("off" if skill == "turn_off" else "on"), text
                 got = [ASSETS[m.asset]["category"] for m in r.objects]
                 want = [ASSETS[main]["category"]] + ([ASSETS[other]["category"]] if other else [])
                 assert got == want, (text, got)

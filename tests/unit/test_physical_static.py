@@ -15,11 +15,11 @@ from gendex_envs.spec import (
     spec_to_dict,
 )
 from generator.critic.directives import Directive, apply_directives
+from generator.critic.joints import apply_joint_fix
 from generator.critic.physical import (
     GRASP_MAX_WIDTH_M,
     REACH_MAX_M,
     REACH_MIN_M,
-    apply_joint_fix,
     check_raw_scales,
     check_scene_static,
 )
