@@ -48,7 +48,10 @@ x = 0.1 with the base at x = -0.8, the middle of where the library's objects sta
 REGION_MARGIN_M = 0.1
 """An object is in a side region (left, right, near, far) from this far off that point towards it; in the centre
 within this of it both ways."""
-_REGION_PARTS = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}
+REGION_DEPTH_M = REGION_MARGIN_M + 0.08
+"""Where a solver or a reward aims an object for a side region: this far out from the table's middle point, 8 cm
+inside the region (it starts ``REGION_MARGIN_M`` out), so a place a few centimetres off still counts."""
+REGION_PARTS = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}
 """Region word -> (axis: 0 forward, 1 left; sign)."""
 
 
@@ -99,7 +102,7 @@ def _placed(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
             return (along[0].abs() <= REGION_MARGIN_M) & (along[1].abs() <= REGION_MARGIN_M)
         ok = torch.ones(p.shape[0], dtype=torch.bool, device=p.device)
         for part in c.region.split("_"):
-            axis, sign = _REGION_PARTS[part]
+            axis, sign = REGION_PARTS[part]
             ok = ok & (sign * along[axis] >= REGION_MARGIN_M)
         return ok
     lo, offset = _param(c, "min_gap_m"), _param(c, "max_offset_m")

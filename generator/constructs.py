@@ -27,13 +27,7 @@ DETERMINERS = frozenset("a an the its my your our their his her some this these 
 (*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _NOT_BUILT_GROUPS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ("steps in order", "sequences", ("then", "afterwards", "after that", "before")),
-    ("a side ('{}')", "places relative to objects or the table",
-     ("to the left", "to the right", "left of", "right of", "on the left", "on the right", "left side",
-      "right side", "to its left", "to its right", "leftward", "rightward")),
-    ("a place ('{}')", "places relative to objects", ("in front of", "behind", "beside", "next to", "between", "near")),
-    ("a region of the table ('{}')", "places on the table",
-     ("corner", "far side", "near side", "far end", "far left", "far right", "near left", "near right",
-      "middle of the table", "centre of the table", "center of the table", "back of the table", "front of the table")),
+    ("a side of something held ('{}')", "places relative to the hand", ("to its left", "to its right")),
     ("a direction ('{}')", "pushes in a direction", ("forward", "backward", "away from")),
 )
 NOT_BUILT: tuple[tuple[str, str, str], ...] = tuple((phrase, what.format(phrase), construct)
@@ -149,3 +143,42 @@ def amount_text(fraction: float, a: dict | None = None) -> str:
         span = abs(a["joints"][0]["open_qpos"] - a["joints"][0]["closed_qpos"])
         return f"{np.degrees(fraction * span):.0f} degrees"
     return f"{100 * fraction:.0f} % of the way"
+
+
+REGION_PHRASES: tuple[tuple[str, str], ...] = (
+    ("far left corner", "far_left"), ("far right corner", "far_right"), ("near left corner", "near_left"),
+    ("near right corner", "near_right"), ("back left corner", "far_left"), ("back right corner", "far_right"),
+    ("front left corner", "near_left"), ("front right corner", "near_right"), ("far left", "far_left"),
+    ("far right", "far_right"), ("near left", "near_left"), ("near right", "near_right"), ("far side", "far"),
+    ("far end", "far"), ("back of the table", "far"), ("near side", "near"), ("front of the table", "near"),
+    ("left side", "left"), ("right side", "right"), ("middle of the table", "centre"),
+    ("centre of the table", "centre"), ("center of the table", "centre"), ("left of the table", "left"),
+    ("right of the table", "right"), ("to the left", "left"), ("to the right", "right"), ("on the left", "left"),
+    ("on the right", "right"), ("leftward", "left"), ("rightward", "right"))
+"""Phrases naming a region of the table (``placed`` with ``in_region``), longest first."""
+RELATION_PHRASES: tuple[tuple[str, str], ...] = (
+    ("to the left of", "left_of"), ("to the right of", "right_of"), ("left of", "left_of"),
+    ("right of", "right_of"), ("in front of", "in_front_of"), ("behind", "behind"), ("next to", "next_to"),
+    ("beside", "next_to"), ("alongside", "next_to"), ("between", "between"))
+"""Phrases naming a place relative to other objects (``placed``)."""
+
+
+def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
+    """``(relation, region, where its words are)``: where the request sets something down, seen from the robot
+    (*to the left of the bowl*: ``left_of``; *on the far right corner of the table*: ``in_region``, ``far_right``;
+    *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``."""
+    for phrase, region in REGION_PHRASES:
+        k = find(words, phrase)
+        if k >= 0 and not (phrase.startswith("to the") and words[k + 3:k + 4] == ["of"]):
+            n = len(phrase.split())
+            after = words[k + n:k + n + 3]
+            extra = 3 if after == ["of", "the", "table"] else 0
+            return "in_region", region, set(range(k, k + n + extra))
+    for phrase, relation in RELATION_PHRASES:
+        k = find(words, phrase)
+        if k >= 0:
+            return relation, None, set(range(k, k + len(phrase.split())))
+    if words and words[-1] in ("left", "right"):  # 'push the block left' (a model's qualifier is checked later)
+        return "in_region", words[-1], {len(words) - 1}
+    return None, None, set()
+

@@ -35,6 +35,7 @@ from generator.constructs import (
     find,
     is_off,
     read_amount,
+    read_place,
 )
 from generator.errors import InstructionError
 
@@ -72,6 +73,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
               "a faucet or valve lever, on or off", "turn on the faucet"),
     TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
+    TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
+              "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",
+              "put the apple to the left of the bowl"),
 )}
 """The task skills a request may ask for, in the order verbs are tried (earlier skills win ties)."""
 
@@ -160,6 +164,11 @@ class Reading:
     direction: str | None = None
     """For a turn: ``"on"`` (towards the open end, the default) or ``"off"`` (*turn the tap off*, *close the
     valve*: back to the shut end)."""
+    relation: str | None = None
+    """For ``place_at``: where the object goes relative to the others (a relation of the ``placed`` condition:
+    ``left_of``, ``between``, ..., or ``in_region``)."""
+    region: str | None = None
+    """For ``place_at`` with ``in_region``: the region of the table (``far_left``, ``near``, ``centre``, ...)."""
     amount: str | None = None
     """How far an open or a turn goes when the request says: ``"half"`` (*open the drawer halfway*) or ``"<n>
     degrees"`` (*turn the valve 45 degrees*, from the shut end); None: all the way."""
@@ -171,8 +180,9 @@ class Reading:
 
     def lines(self) -> list[str]:
         """Human-readable account of the reading (what the CLI prints)."""
-        out = [f'"{self.instruction}" -> skill {self.skill!r}' + (f", {self.direction}" if self.direction else "")
-               + (f", {self.amount}" if self.amount else "")]
+        where = (self.region if self.relation == "in_region" else self.relation or "").replace("_", " ")
+        out = [f'"{self.instruction}" -> skill {self.skill!r}'
+               + "".join(f", {x}" for x in (self.direction, where, self.amount) if x)]
         for m in self.objects:
             verb = {"id": "is", "name": "is", "synonym": "means", "kind": "chose", "substitute": "SUBSTITUTED"}[m.how]
             what = m.asset
@@ -228,13 +238,14 @@ ROLE_TESTS = {
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
     "ball": lambda a: "ball" in a["tags"] and not a.get("joints"),
+    "landmark": lambda a: not a.get("joints"),
 }
 """What an object must be to play each role."""
 
 SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
-    "turn": ("turnable",), "reorient": ("ball",),
+    "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -363,7 +374,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
         at.append(i)
     # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb; not the words of an amount
-    in_amount = amount_words(words)
+    relation, region, at_place = read_place(words)
+    in_amount = amount_words(words) | at_place
     unknown = []
     for k, w in enumerate(words):
         if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in in_amount
@@ -386,6 +398,15 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         else:  # an unknown word, or a kind word after one ('dragon fruit': a fruit the catalog lacks)
             unknown.append((k, w))
     roles = SKILL_ROLES[skill]
+    if relation is not None and skill in ("put_in", "place_on", "push", "lift", "stack"):
+        # 'put the apple to the left of the bowl', 'push the block left': set down there, seen from the robot
+        skill = "place_at"
+        roles = {"in_region": ("graspable",), "between": ("graspable", "landmark", "landmark")}.get(
+            relation, SKILL_ROLES["place_at"])
+    elif relation is not None and not (relation == "in_region" and at_place == {len(words) - 1}):
+        raise InstructionError(f'"{text}" asks for a place ({relation.replace("_", " ")}'
+                               + (f", {region}" if region else "") + f") with the '{skill}' skill: places are for "
+                               "setting an object down (put, set, place, move, push)")
     if skill == "reorient" and not in_hand and not any(ROLE_TESTS["ball"](_by_id(assets, m.asset))
                                                        for m in mentions if m.asset):
         # 'rotate the faucet' is a turn; 'rotate the ball' (or anything 'in the hand') is a reorientation
@@ -439,7 +460,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         if m.color is not None and _by_id(assets, m.asset).get("joints"):
             raise InstructionError(f"'{m.phrase}': painting an articulated object ({m.asset}) is not built yet; ask "
                                    f"for it without a colour")
-    return Reading(text, skill, tuple(resolved), tuple(notes), direction, amount)
+    return Reading(text, skill, tuple(resolved), tuple(notes), direction=direction, relation=relation,
+                   region=region, amount=amount)
 
 
 def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
@@ -461,8 +483,8 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
         chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
         last = words[-1]
         found = []
-        if last in ("left", "right") and last not in chose:  # 'push the block left'
-            found.append((f"a direction ('{last}')", "pushes in a direction"))
+        if last in ("left", "right") and last not in chose and skill != "place_at":  # 'close the door left'
+            found.append((f"a direction ('{last}')", f"a direction with the '{skill}' skill"))
         amount = read_amount(words)[0]
         if amount is not None and (skill not in ("open", "turn") or (skill == "turn" and is_off(words))):
             found.append((f"an amount ('{amount}')", f"part-way moves with the '{skill}' skill"))

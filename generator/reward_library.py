@@ -9,8 +9,11 @@ schema.
 
 from __future__ import annotations
 
+import math
 import textwrap
 from typing import Any
+
+from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
 
 _HEADER_TEMPLATE = '''"""{title}
 
@@ -167,6 +170,7 @@ def _get_obs_extra(env, info):
         return src
     # carry / place / release: bring the held object to the success condition's target, then let go
     target = cond.get("target") or obj
+    goal = placed_goal(cond, spec) or f"env.obj_pose({target!r}).p"
     release = kind == "release"
     src += f'''REWARD_MAX = 3.0
 
@@ -177,13 +181,13 @@ def evaluate(env):
 
 
 def compute_dense_reward(env, obs, action, info):
-    place = rt.place(env.obj_pose({obj!r}).p, env.obj_pose({target!r}).p)
+    place = rt.place(env.obj_pose({obj!r}).p, {goal})
     reward = 2.0 * place {"+ (1.0 - info['contact']) * (place > 0.8)" if release else "+ info['contact']"}
     return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
 
 
 def _get_obs_extra(env, info):
-    return {{"obj_to_target": env.obj_pose({target!r}).p - env.obj_pose({obj!r}).p}}
+    return {{"obj_to_target": {goal} - env.obj_pose({obj!r}).p}}
 '''
     return src
 
@@ -223,9 +227,37 @@ def _progress(cond: dict) -> str:
             else f'info["open_fraction"] / {frac!r}')
 
 
-def _carry_term(target: str | None) -> str:
+def _carry_term(target: str | None, goal: str | None = None) -> str:
+    """The carry term's code: the object over ``target``, or at the point code ``goal`` computes."""
+    if goal is not None:
+        return f'    carry = rt.place(p, {goal}) * (lifted > 0.5)\n'
     return (f'    carry = rt.place(p, env.obj_pose({target!r}).p) * (lifted > 0.5)\n'
             if target else "    carry = torch.zeros_like(reach)\n")
+
+
+def placed_goal(cond: dict, spec: dict) -> str | None:
+    """Code for the [N, 3] point a ``placed`` condition sets its object down at (the solver's
+    :func:`gendex.solve.set_down.set_down_point`, in the robot's frame from the spec's base yaw), else None."""
+    if cond.get("type") != "placed":
+        return None
+    yaw = math.radians(float(spec.get("robot", {}).get("base_yaw_deg", 0.0)))
+    fwd, left = (math.cos(yaw), math.sin(yaw)), (-math.sin(yaw), math.cos(yaw))
+    rel = cond["relation"]
+    if rel == "in_region":
+        base = spec.get("robot", {}).get("base_pos_m", [-0.8, 0.0, 0.0])
+        x, y = base[0] + REGION_AHEAD_M * fwd[0], base[1] + REGION_AHEAD_M * fwd[1]
+        for part in () if cond["region"] == "centre" else cond["region"].split("_"):
+            axis, sign = REGION_PARTS[part]
+            u = (fwd, left)[axis]
+            x, y = x + sign * REGION_DEPTH_M * u[0], y + sign * REGION_DEPTH_M * u[1]
+        return f"torch.tensor([[{x:.4f}, {y:.4f}, 0.0]], device=env.device)"
+    t = f"env.obj_pose({cond['target']!r}).p"
+    if rel == "between":
+        return f"({t} + env.obj_pose({cond['other']!r}).p) / 2"
+    gap = (float(cond.get("min_gap_m") or 0.05) + float(cond.get("max_gap_m") or 0.3)) / 2
+    d = {"left_of": left, "right_of": (-left[0], -left[1]), "behind": fwd, "in_front_of": (-fwd[0], -fwd[1]),
+         "next_to": (-fwd[0], -fwd[1])}[rel]
+    return f"{t} + torch.tensor([[{gap * d[0]:.4f}, {gap * d[1]:.4f}, 0.0]], device=env.device)"
 
 
 def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
@@ -271,7 +303,7 @@ def _get_obs_extra(env, info):
     target = cond.get("target")
     if target == "goal":  # a push: the object towards the goal mark, never lifted
         return src + _PUSH.format(fail=fail, obj=obj)
-    carry = _carry_term(target)
+    carry = _carry_term(target, placed_goal(cond, spec))
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1
 

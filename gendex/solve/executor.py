@@ -52,6 +52,7 @@ from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.press import PressPrimitives
 from gendex.solve.rigid import CARRY_M_PER_STEP, RigidConfig, RigidPrimitives
+from gendex.solve.set_down import POINT, placed_condition, set_down_point
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.success import SET_DOWN_CONDITIONS
@@ -123,6 +124,8 @@ class StageExecutor:
         # the episode's own randomness (env.np_random follows the reset seed): the same seed plans the same paths
         self.motion.planner.reseed(int(u.np_random.integers(2**31)))
         self.carried = False
+        self._points: dict[str, np.ndarray] = {}
+        """Set-down points of ``placed`` conditions, by held object (:meth:`_point`)."""
         self.logs: list[StageLog] = []
         self._handles = HandlePrimitives(self.motion, hand_cover=self._hand_cover)
         self._presses = PressPrimitives(self.motion, self._hand_cover)
@@ -308,7 +311,8 @@ class StageExecutor:
         stages = self._env.task_spec.stages
         after = stages[self.stage_index + 1] if self.stage_index + 1 < len(stages) else None
         lift_to = None
-        if after is not None and after.skill == "carry" and after.target in self._env.objects:
+        if after is not None and after.skill == "carry" and after.target in self._env.objects \
+                and after.target != stage.target:
             lift_to = self.rigid.carry_bottom(after.target)
         yield from self.rigid.grasp(stage.target, lift_to)
 
@@ -317,12 +321,22 @@ class StageExecutor:
                    if cond.type == "lifted" and cond.object == stage.target]
         yield from self.rigid.lift(stage.target, max(heights) if heights else self.config.rigid.motion.lift_m)
 
+    def _point(self, stage, held: str | None) -> np.ndarray | None:
+        """The table point a ``placed`` condition on ``held`` wants it set down at (:mod:`gendex.solve.set_down`),
+        fixed when first asked for in an episode (the target does not move under the carry), else None."""
+        c = None if held is None else placed_condition(self._env, held, stage)
+        if c is None:
+            return None
+        if self._points.get(held) is None:
+            self._points[held] = set_down_point(self._env, c)
+        return self._points[held]
+
     def _carry(self, stage) -> Iterator[np.ndarray]:
-        yield from self.rigid.carry(stage.target)
+        yield from self.rigid.carry(stage.target, self._point(stage, self.rigid.held))
         self.carried = True
 
     def _place(self, stage) -> Iterator[np.ndarray]:
-        yield from self.rigid.place(stage.target)
+        yield from self.rigid.place(stage.target, self._point(stage, self.rigid.held))
 
     def _push(self, stage) -> Iterator[np.ndarray]:
         """Push the target to where a ``near`` condition on it (the stage's, else the task's) wants it."""
@@ -348,7 +362,10 @@ class StageExecutor:
         object topples out of a bowl; a dropped ball bounces off a flat board)."""
         held = self.rigid.held
         onto = self._set_down_on(stage, held)
-        if held is not None and onto is not None and self.rigid.placed_on != onto:
+        point = self._point(stage, held)
+        if point is not None and self.rigid.placed_on != POINT:
+            yield from self.rigid.place(held, point)
+        elif held is not None and onto is not None and self.rigid.placed_on != onto:
             yield from self.rigid.place(onto)
         yield from self.rigid.release()
 

@@ -59,6 +59,7 @@ from gendex.solve.grasp_trial import (
     rose_with_hand,
 )
 from gendex.solve.hand import TIP_ALONG_M, HandModel
+from gendex.solve.set_down import POINT, POINT_CARRY_M
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
 from gendex_envs.errors import ExecutionError
@@ -405,12 +406,12 @@ class RigidPrimitives:
             yield from self.m.cartesian(np.array([0.0, 0.0, need_m + 0.03 - risen]),
                                         self.config.motion.lift_m_per_step, guard=True, paced=True)
 
-    def carry(self, target: str) -> Iterator[np.ndarray]:
-        c, m = self.config, self.m
-        held = self.held
+    def carry(self, target: str, point: np.ndarray | None = None) -> Iterator[np.ndarray]:
+        """Carry the held object over ``target`` (its top + ``carry_clearance_m``), or over table ``point`` (xy) at
+        that height (:data:`~gendex.solve.set_down.POINT_CARRY_M` over the table when ``target`` is the held one)."""
+        c, m, held = self.config, self.m, self.held
         if held is None:
-            raise ExecutionError(f"carrying to {target!r} needs an object in the hand; it holds nothing",
-                                 cause="slipped")
+            raise ExecutionError(f"carrying to {target!r} needs an object in the hand; it holds nothing", "slipped")
         held_lo, held_hi = m.world_aabb(held)
         if held_lo[2] < self.env.table_height + 0.5 * c.motion.lift_m:
             # still at the table (a trained grasp policy closes the hand but does not lift, unlike the scripted
@@ -424,10 +425,10 @@ class RigidPrimitives:
                 raise ExecutionError(f"{held!r} slipped when lifted for the carry (rose {risen:.3f} m of "
                                      f"{done * c.motion.lift_m:.3f} m)", cause="slipped")
             held_lo, held_hi = m.world_aabb(held)
-        t_center = m.object_geometry(target)[0]
-        t_hi = m.world_aabb(target)[1]
+        t_center = m.object_geometry(target)[0] if point is None else point
+        top = float(m.world_aabb(target)[1][2]) if target != held else self.env.table_height + POINT_CARRY_M
         obj_p = (held_lo + held_hi) / 2
-        goal_center = np.array([t_center[0], t_center[1], t_hi[2] + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
+        goal_center = np.array([t_center[0], t_center[1], top + c.carry_clearance_m + (obj_p[2] - held_lo[2])])
         q_now = m.target()
         palm = m.ik.fk(q_now)
         in_hand = m.ik.fk(m.qpos()).inv() * sapien.Pose(self._pose_now(held)[:3])
@@ -476,18 +477,16 @@ class RigidPrimitives:
             raise ExecutionError(f"{held!r} slipped in the hand while carried to {target!r} (drifted {drift:.3f} m)",
                                  cause="slipped")
 
-    def place(self, target: str) -> Iterator[np.ndarray]:
-        """Lower the held object onto ``target`` (a surface, another object, a container's floor) until it rests
-        there: the palm descends (grip guarded) to where the object's bottom meets the target's top under it; the
-        descent goes a little below the surface and stops once the object stops following the palm (it is supported,
-        and pressed flat)."""
-        c, m = self.config, self.m
-        held = self.held
+    def place(self, target: str, point: np.ndarray | None = None) -> Iterator[np.ndarray]:
+        """Lower the held object onto ``target`` (a surface, another object, a container's floor), or onto the
+        table at ``point`` (xy), until it rests there: the palm descends (grip guarded) to where the object's bottom
+        meets the top under it; the descent goes a little below the surface and stops once the object stops
+        following the palm (it is supported, and pressed flat)."""
+        c, m, held = self.config, self.m, self.held
         if held is None:
-            raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing",
-                                 cause="slipped")
+            raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing", "slipped")
         yield from self._stand_as_before(held)
-        goal_xy = self.shape(target).footprint().center
+        goal_xy = self.shape(target).footprint().center if point is None else np.asarray(point, dtype=np.float64)
         for _ in range(PLACE_CORRECTIONS):  # the carry ends within a few cm: centre the object over the target
             lo, hi = m.world_aabb(held)
             error = goal_xy - (lo[:2] + hi[:2]) / 2
@@ -498,7 +497,7 @@ class RigidPrimitives:
             yield from m.hold(c.motion.settle_steps)
         lo, hi = m.world_aabb(held)
         xy = (lo[:2] + hi[:2]) / 2
-        surface = self.shape(target).top_at(xy)
+        surface = self.shape(target).top_at(xy) if point is None else self.env.table_height
         if surface is None:
             raise ExecutionError(f"the held {held!r} is not over {target!r} (nothing of it under {xy.round(3)})",
                                  cause="target_not_reached")
@@ -515,7 +514,7 @@ class RigidPrimitives:
             if k < n - 1 and lag > PLACE_RESTING_M:
                 break  # the object stopped while the palm went on: it rests on something
         yield from m.hold(self.config.motion.settle_steps)
-        self.placed_on = target
+        self.placed_on = target if point is None else POINT
         lag = (palm0 - m.ik.fk(m.qpos()).p[2]) - (z0 - float(self.env.obj(held).pose.p[0, 2]))
         if lag > 0.002:  # take the press off: the object rests on its support under its own weight
             yield from m.cartesian(np.array([0.0, 0.0, min(lag, PLACE_PRESS_M)]), c.motion.lift_m_per_step,

@@ -31,15 +31,19 @@ from __future__ import annotations
 
 import functools
 import json
-import re
 import zlib
 from typing import Any
 
 import numpy as np
 import yaml
 
+from generator.backends import placed as placed_tasks
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
+from generator.backends.wording import camel as _camel
+from generator.backends.wording import fence as _fence
+from generator.backends.wording import step as _step
+from generator.backends.wording import word as _w
 from generator.constructs import amount_text, amount_word, joint_fraction
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
@@ -70,23 +74,6 @@ DISTRACTOR_P = 0.4
 """Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
-
-
-def _w(name: str) -> str:
-    """An object name as a word in a sentence (``tuna_can`` -> ``tuna can``)."""
-    return name.replace("_", " ")
-
-
-def _step(skill: str, target: str, control_joint: str, instruction: str) -> dict:
-    return {"skill": skill, "target": target, "control_joint": control_joint, "instruction": instruction}
-
-
-def _fence(lang: str, body: str) -> str:
-    return f"```{lang}\n{body.rstrip()}\n```\n"
-
-
-def _camel(*words: str) -> str:
-    return "".join(w[:1].upper() + w[1:] for part in words for w in re.split(r"[_\s]+", part) if w)
 
 
 def _part(a: dict) -> str:
@@ -492,6 +479,11 @@ class OfflineBackend:
             a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack", smallest=True)
             proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a),
                                                 "larger block to stack on", smallest=True), colors)
+        elif skill == "place_at":
+            rel = reading.get("relation") or "in_region"
+            refs = [pick(k, lambda x: not x.get("joints"), "object to set it by") for k in range(1, len(mentions))]
+            a = pick(0, graspable, "object to set down")
+            proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -550,12 +542,14 @@ class OfflineBackend:
         acts = _acts(proposal)
         goal = None
         movable = _movable_region(proposal, assets, acts)
+        spots = (placed_tasks.placed_layout(proposal["success"], proposal["objects"][0]["name"], rng)
+                 if proposal["success"]["type"] == "placed" else {})
         for o in proposal["objects"]:
             a = assets[o["asset"]]
             # articulated objects anywhere at the back, movable ones where the solver measurably works (module
             # constant); overlaps and support are the critic's job
             (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else movable
-            x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
+            x, y = spots.get(o["name"]) or (rng.uniform(x0, x1), rng.uniform(y0, y1))
             entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
             if o.get("color"):
                 entry["color"] = o["color"]
@@ -584,7 +578,7 @@ class OfflineBackend:
                     gy = y - np.sign(y or 1.0) * PUSH_M
                     goal = {"pos_m": [round(x, 3), round(float(gy), 3), 0.0], "radius_m": 0.03}
             objects.append(entry)
-        if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P:
+        if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P and not spots:
             objects.append(self._distractor(proposal, assets, rng, movable))
         stages = []
         for i, s in enumerate(proposal["steps"]):

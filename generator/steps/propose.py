@@ -37,9 +37,11 @@ MAX_STEPS = 8
 MAX_PARTS = 2
 """Success conditions of a proposal: one, or one per part of a composed task (``success`` and ``also``)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
-                "min_dz_m", "max_dz_m", "fraction", "max_error")
+                "min_dz_m", "max_dz_m", "fraction", "max_error", "relation", "other", "region", "min_gap_m",
+                "max_gap_m", "max_offset_m")
 """Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut; ``fraction``
-and ``max_error`` with ``joint_at``: the joint set part way)."""
+and ``max_error`` with ``joint_at``: the joint set part way; ``relation``, ``other``, ``region`` and the gaps with
+``placed``: where the object is set down, seen from the robot)."""
 
 
 def skill_list() -> str:
@@ -123,6 +125,16 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
     if succ["type"] in ("inside", "near", "over") and succ.get("target") not in targets:
         raise ProposalError(f"{where}.target {succ.get('target')!r} must name a proposed object for a "
                             f"{succ['type']!r} condition; allowed: {targets}")
+    if succ["type"] == "placed":
+        from gendex_envs.conditions import RELATIONS
+
+        rel = succ.get("relation")
+        if rel not in RELATIONS:
+            raise ProposalError(f"{where}: placed needs a relation, one of {list(RELATIONS)}; got {rel!r}")
+        for key in (() if rel == "in_region" else ("target",)) + (("other",) if rel == "between" else ()):
+            if succ.get(key) not in names or succ.get(key) == succ["object"]:
+                raise ProposalError(f"{where}.{key} {succ.get(key)!r} must name another proposed object for "
+                                    f"relation {rel!r}; objects: {names}")
     if succ["type"] in ("joint_open", "joint_at") and not assets[objects[names.index(succ["object"])].asset]["joints"]:
         raise ProposalError(f"{where}: {succ['type']} needs an articulated object, {succ['object']!r} is rigid")
     if succ["type"] == "joint_at" and not (isinstance(succ.get("fraction"), (int, float))

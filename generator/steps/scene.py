@@ -101,8 +101,8 @@ def let_go(spec: TaskSpec) -> TaskSpec:
     dev seeds). A ``near`` on the ``goal`` point (a push) is left alone, as is an object the success itself holds."""
     conds = spec.success.conditions
     kept = {c.object for c in conds if c.type in ("released", "grasped") and not c.negate}
-    add = [c.object for c in conds if c.type in SET_DOWN_CONDITIONS and not c.negate and c.target != GOAL_TARGET
-           and c.object not in kept]
+    add = [c.object for c in conds if c.type in (*SET_DOWN_CONDITIONS, "placed") and not c.negate
+           and c.target != GOAL_TARGET and c.object not in kept]
     if not add:
         return spec
     log.info("success of %s: %s must also be let go and stay %d steps", spec.name, ", ".join(add), SETTLED_STEPS)

@@ -30,9 +30,9 @@ def _misread(reading: Reading, steps: list[dict]) -> str | None:
     want_amount = f"{want_amount:g} degrees" if isinstance(want_amount, (int, float)) else want_amount
     if want_amount != reading.amount:
         return f"amount {step.get('amount')!r} read as {reading.amount!r}"
-    for key in ("relation", "region"):
-        if key in step:
-            return f"its {key} ({step[key]}) is not in the reading"
+    want_relation = step.get("relation") or ("in_region" if "region" in step else None)
+    if (want_relation, step.get("region")) != (reading.relation, reading.region):
+        return f"place {want_relation} {step.get('region')} read as {reading.relation} {reading.region}"
     if (step.get("direction") or ("on" if step["skill"] == "turn" else None)) != reading.direction:
         return f"direction {step.get('direction')!r} read as {reading.direction!r}"
     if len(step["objects"]) != len(reading.objects):

@@ -170,12 +170,8 @@ def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused
 
 @pytest.mark.parametrize("text, asks", [
     ("close the drawer off", "a direction ('off')"),
-    ("push the block left", "a direction ('left')"),
-    ("slide the mug to the left", "a side ('to the left')"),
-    ("put the apple to the right of the bowl", "a side ('to the right')"),
-    ("set the lemon next to the plate", "a place ('next to')"),
-    ("put the pear between the bowl and the plate", "a place ('between')"),
-    ("place the apple in front of the bowl", "a place ('in front of')"),
+    ("close the cabinet door left", "a direction ('left')"),
+    ("open the fridge on the left", "a place (in region, left)"),
     ("lift the apple halfway", "an amount ('half')"),
     ("open the fridge, then put the apple in the bowl", "steps in order"),
     ("put the apple in the bowl before closing the microwave", "steps in order"),
@@ -187,6 +183,24 @@ def test_constructs_not_built_yet_are_refused_never_built_without_them(text, ask
     'left' as an object)."""
     with pytest.raises(InstructionError, match=re.escape(asks)):
         read(text)
+
+
+@pytest.mark.parametrize("text, relation, region, objects", [
+    ("push the block left", "in_region", "left", ["block"]),
+    ("slide the mug to the left", "in_region", "left", ["mug"]),
+    ("put the orange on the far right corner of the table", "in_region", "far_right", ["orange"]),
+    ("put the apple to the right of the bowl", "right_of", None, ["apple", "bowl"]),
+    ("set the lemon next to the plate", "next_to", None, ["lemon", "plate"]),
+    ("put the pear between the bowl and the plate", "between", None, ["pear", "bowl", "plate"]),
+    ("place the apple in front of the bowl", "in_front_of", None, ["apple", "bowl"]),
+])
+def test_a_place_is_read_as_where_the_object_is_set_down(text, relation, region, objects):
+    """Places relative to objects and regions of the table, seen from the robot: the skill is place_at and the
+    place words name no object (before: refused; 'to the left' once read 'left' as an object)."""
+    r = read(text)
+    assert (r.skill, r.relation, r.region) == ("place_at", relation, region), r.lines()
+    cats = {a["id"]: a["category"] for a in asset_dicts()}
+    assert [cats[m.asset] for m in r.objects] == objects, r.lines()
 
 
 @pytest.mark.parametrize("text, direction", [

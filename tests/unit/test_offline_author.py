@@ -453,3 +453,60 @@ def test_a_part_way_request_the_author_cannot_build_is_refused_saying_why(text, 
     with pytest.raises(InstructionError, match=why):
         OfflineBackend(seed=5).complete(ModelRequest(step="propose_guided", prompt="", context={
             "reading": reading.to_dict(), "assets": asset_dicts()}))
+
+
+@pytest.mark.parametrize("text", [
+    "put the apple to the left of the bowl", "set the lemon to the right of the plate",
+    "move the banana in front of the bowl", "put the can behind the pot", "place the pear next to the cup",
+    "put the peach between the bowl and the mug", "put the orange on the far right corner of the table",
+    "move the block to the near side of the table", "put the tennis ball in the middle of the table",
+])
+def test_a_place_request_becomes_a_placed_task_that_does_not_start_solved(text):
+    """Each relation and region: the proposal's success is the reading's ``placed`` condition (gaps from the
+    objects' sizes), its command reads back as the same place, the scene starts the object where the condition does
+    not hold (also at the corners of the reset's randomization), nothing else stands at the set-down point, and the
+    reward module aims the carry at that point."""
+    import itertools
+
+    import torch
+
+    from gendex_envs.task_env import TaskEnv
+    from generator.phrasing import split
+    from generator.steps.propose import parse_proposal
+
+    reading = read_instruction(text, asset_dicts())
+    b = OfflineBackend(seed=6)
+    raw = json.loads(b.complete(ModelRequest(step="propose_guided", prompt="", context={
+        "reading": reading.to_dict(), "assets": asset_dicts()})).text.split("```json\n")[1].split("```")[0])
+    cond = raw["success"]
+    assert (cond["type"], cond["relation"], cond.get("region")) == ("placed", reading.relation, reading.region)
+    back = read_instruction(split(raw["description"])[1], asset_dicts())
+    assert (back.skill, back.relation, back.region) == ("place_at", reading.relation, reading.region)
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+    ids = {o.asset for o in p.objects}
+    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+               "candidate_index": 0, "index": 0, "attempt": 0}
+    spec = adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
+    assert not [o for o in spec.objects if o.distractor]
+    src = compose_task_module(spec_to_dict(spec), roles_of(dataclasses.asdict(p)))
+    check_reward_source(src)
+    if cond["relation"] != "in_region":
+        assert "torch.tensor" in src or "/ 2" in src  # a point beside or between, not the target itself
+    # the condition is false at reset, at the nominal layout and with every object moved to a corner of its
+    # randomization box
+    from gendex_envs.success import _holds
+
+    placed = next(c for c in spec.success.conditions if c.type == "placed")
+    env = TaskEnv(task_spec=spec, obs_mode="none", render_backend="none")
+    try:
+        env.reset(seed=0)
+        movable = [o for o in spec.objects if not o.fixed]
+        for shifts in itertools.product((-0.08, 0.0, 0.08), repeat=2 * len(movable)):
+            for k, o in enumerate(movable):
+                pose = env.obj(o.name).pose
+                p_new = torch.tensor([[o.pos_m[0] + shifts[2 * k], o.pos_m[1] + shifts[2 * k + 1],
+                                       float(pose.p[0, 2])]])
+                env.obj(o.name).set_pose(type(pose).create_from_pq(p_new, pose.q))
+            assert not bool(_holds(env, placed)[0]), (text, shifts)
+    finally:
+        env.close()

@@ -1,0 +1,57 @@
+"""Where the solver sets a held object down for a ``placed`` condition (*put the apple to the left of the bowl*, *move
+the block to the far left of the table*): a point on the table top, from the condition and where things are now.
+
+The point is in the middle of what the condition accepts (:func:`gendex_envs.success._placed` measures it): for a
+side relation, the middle of the ``min_gap_m``..``max_gap_m`` band straight out from the target on that side, as the
+robot sees it; ``between``, the midpoint of the two objects; ``next_to``, the middle of the band on the side the
+object comes from; a region, :data:`REGION_DEPTH_M` into it from the middle of the table's working area.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gendex_envs.conditions import CONDITION_DEFAULTS, ConditionSpec
+from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS, rest_point, robot_axes
+
+POINT_CARRY_M = 0.05
+"""A carry to a table point with no object to clear (a region of the table) brings the held object's bottom this far
+(+ the carry clearance) over the table top."""
+POINT = "<point>"
+"""What :attr:`gendex.solve.rigid.RigidPrimitives.placed_on` says after a place at a table point."""
+
+
+def placed_condition(env, held: str, stage=None) -> ConditionSpec | None:
+    """The ``placed`` condition on ``held`` (the stage's first, then the task's), if any."""
+    conds = (*((stage.success or ()) if stage is not None else ()), *env.task_spec.success.conditions)
+    return next((c for c in conds if c.type == "placed" and c.object == held and not c.negate), None)
+
+
+def set_down_point(env, c: ConditionSpec) -> np.ndarray:
+    """[2] the table point (world xy) to set ``c.object`` down at so that ``c`` holds, from the first env's state."""
+    def xy(name: str) -> np.ndarray:
+        return rest_point(env, name)[0, :2].double().cpu().numpy()
+
+    p = xy(c.object)
+    base, fwd, left = (t.double().cpu().numpy() for t in robot_axes(env, rest_point(env, c.object)))
+    if c.relation == "in_region":
+        point = base + REGION_AHEAD_M * fwd
+        for part in ("centre",) if c.region == "centre" else c.region.split("_"):
+            if part != "centre":
+                axis, sign = REGION_PARTS[part]
+                point = point + sign * REGION_DEPTH_M * (fwd, left)[axis]
+        return point
+    a = xy(c.target)
+    if c.relation == "between":
+        return (a + xy(c.other)) / 2
+    lo, hi = (CONDITION_DEFAULTS[k] if getattr(c, k) is None else getattr(c, k) for k in ("min_gap_m", "max_gap_m"))
+    gap = (lo + hi) / 2
+    if c.relation == "next_to":
+        d = p - a
+        n = float(np.linalg.norm(d))
+        return a + gap * (d / n if n > 1e-6 else -fwd)
+    axis = {"left_of": left, "right_of": -left, "behind": fwd, "in_front_of": -fwd}[c.relation]
+    return a + gap * axis
+
+
+__all__ = ["POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "placed_condition", "set_down_point"]

@@ -1,0 +1,129 @@
+"""The offline author's ``placed`` tasks: set a graspable object down beside, in front of, behind or between other
+objects, or in a region of the table, as the robot sees it (*put the apple to the left of the bowl*).
+
+:func:`placed_task` writes the proposal (the gaps of the condition from the objects' sizes); :func:`placed_layout`
+lays the scene out so the object starts where the condition does not hold, on the far side of where it goes, and the
+set-down point is clear of the other objects and inside the region where the solver measurably grasps and places.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from generator.backends.wording import camel, step, word
+from generator.phrasing import names_for, painted
+
+HAND_ROOM_M = 0.06
+"""Centre distance beyond touching that a side relation's band starts at: room for the fingers round the held object
+(at 2 cm the hand setting a lemon down in front of a cutting board pushed the board out of the band, dev seeds)."""
+BAND_M = 0.15
+"""Width of a side or ``next_to`` relation's band of centre distances."""
+REGION_WORDS = {"left": "left side", "right": "right side", "near": "near side", "far": "far side",
+                "centre": "middle", "near_left": "near left corner", "near_right": "near right corner",
+                "far_left": "far left corner", "far_right": "far right corner"}
+"""How a region of the table is said (the reader reads these back)."""
+SIDE_WORDS = {"left_of": "to the left of", "right_of": "to the right of", "in_front_of": "in front of",
+              "behind": "behind", "next_to": "next to"}
+TABLE_CENTRE = np.array([0.1, 0.0])
+"""The middle of the table's working area in world xy (``REGION_AHEAD_M`` ahead of the base at x = -0.8)."""
+REGION_POINT_M = 0.18
+"""How far from :data:`TABLE_CENTRE` the solver sets an object down in a side region (``REGION_DEPTH_M``)."""
+
+
+def _radius(a: dict) -> float:
+    return 0.5 * float(max(a["size_m"][:2]))
+
+
+def placed_condition(n: str, a: dict, relation: str, b: dict | None = None, names: tuple[str, ...] = (),
+                     region: str | None = None, c: dict | None = None) -> dict:
+    """The ``placed`` success condition for object ``n`` (asset ``a``); ``names``: the reference objects' names."""
+    cond: dict = {"type": "placed", "object": n, "relation": relation}
+    if relation == "in_region":
+        return cond | {"region": region}
+    cond["target"] = names[0]
+    if relation == "between":
+        return cond | {"other": names[1], "min_gap_m": round(max(_radius(b), _radius(c)) + _radius(a) + 0.02, 3)}
+    lo = _radius(b) + _radius(a) + HAND_ROOM_M
+    return cond | {"min_gap_m": round(lo, 3), "max_gap_m": round(lo + BAND_M, 3)}
+
+
+def command(rng: np.random.Generator, a: dict, relation: str, b: dict | None, c: dict | None,
+            region: str | None, colors: tuple[str | None, ...] = ()) -> tuple[str, str]:
+    """The bare command (the reader reads it back as ``place_at`` with this relation or region) and its words for
+    where the object goes."""
+    def name(x: dict, k: int) -> str:
+        word = str(rng.choice(names_for(x, "")))
+        return f"{colors[k]} {word}" if len(colors) > k and colors[k] else word
+
+    verb = str(rng.choice(("put", "set", "place", "move")))
+    o = name(a, 0)
+    if relation == "in_region":
+        where = f"on the {REGION_WORDS[region]} of the table"
+    elif relation == "between":
+        where = f"between the {name(b, 1)} and the {name(c, 2)}"
+    else:
+        where = f"{SIDE_WORDS[relation]} the {name(b, 1)}"
+    return f"{verb} the {o} {where}", where
+
+
+def placed_task(a: dict, relation: str, refs: list[dict], region: str | None, colors: tuple[str | None, ...],
+            words: Callable[[str], np.random.Generator]) -> dict:
+    """The proposal: set ``a`` down ``relation`` to the reference objects ``refs`` (none for a region of the
+    table); ``words(name)`` seeds the wording of task ``name``."""
+    n = a["category"]
+    names = [r["category"] if r["category"] != n else r["id"] for r in refs]
+    cond = placed_condition(n, a, relation, *(refs[:1] or [None]), names=tuple(names), region=region,
+                            c=refs[1] if len(refs) > 1 else None)
+    parts = [relation if relation != "in_region" else region, *(r["id"] for r in refs)]
+    name = camel("set", *painted(a, colors, 0), *parts)
+    text, where = command(words(name), a, relation, *(refs + [None, None])[:2], region, colors)
+    return {
+        "name": name, "description": text[:1].upper() + text[1:] + ".",
+        "objects": [{"name": m, "asset": x["id"], "role": "graspable" if k == 0 else "support"}
+                    | ({"color": colors[k]} if len(colors) > k and colors[k] else {})
+                    for k, (m, x) in enumerate(zip([n, *names], [a, *refs], strict=True))],
+        "steps": [step("reach", n, "arm", f"Bring the open hand to the {word(n)}."),
+                  step("grasp", n, "hand", f"Close the fingers around the {word(n)}."),
+                  step("carry", names[0] if names else n, "arm", f"Carry the {word(n)} {where}."),
+                  step("release", n, "hand", f"Set the {word(n)} down and let go of it.")],
+        "success": cond, "success_text": f"The {word(n)} lies {where}.",
+    }
+
+
+def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, list[float]]:
+    """Nominal (x, y) of the held object and its references: the set-down point inside the grasp region, the
+    object starting on the far side of it (the condition false at reset, whatever the ±8 cm randomization)."""
+    rel = cond["relation"]
+    if rel == "in_region":
+        point = TABLE_CENTRE.copy()
+        if cond["region"] != "centre":
+            for part in cond["region"].split("_"):
+                axis, sign = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}[part]
+                point[axis] += sign * REGION_POINT_M
+        start = 2 * TABLE_CENTRE - point if cond["region"] != "centre" else TABLE_CENTRE + np.array([0.0, 0.22])
+        return {held: [float(v) for v in start]}
+    if rel == "between":
+        gap = cond["min_gap_m"] * 2 + 0.16  # the two references this far apart, the object starting in front
+        y0 = float(rng.uniform(-0.04, 0.04))
+        return {cond["target"]: [0.2, y0 + gap / 2], cond["other"]: [0.2, y0 - gap / 2], held: [-0.1, y0]}
+    mid = (cond["min_gap_m"] + cond["max_gap_m"]) / 2
+    if rel in ("left_of", "right_of"):
+        s = 1.0 if rel == "left_of" else -1.0
+        y_ref = float(rng.uniform(-0.05, 0.0)) * s
+        x = float(rng.uniform(0.0, 0.15))
+        return {cond["target"]: [x, y_ref], held: [x, y_ref - s * mid]}
+    if rel in ("in_front_of", "behind"):
+        x_ref = 0.25 if rel == "in_front_of" else -0.05
+        y = float(rng.uniform(-0.1, 0.1))
+        side = float(np.sign(rng.uniform(-1, 1)) or 1.0)
+        return {cond["target"]: [x_ref, y], held: [x_ref, y + side * (mid + 0.1)]}
+    # next_to: the object starts beyond the band even where the reset moves both 8 cm towards each other; it is
+    # set down on the side it comes from
+    y_ref = float(rng.uniform(-0.24, -0.22))
+    return {cond["target"]: [0.1, y_ref], held: [0.1, y_ref + cond["max_gap_m"] + 0.18]}
+
+
+__all__ = ["BAND_M", "HAND_ROOM_M", "REGION_WORDS", "SIDE_WORDS", "command", "placed_condition", "placed_layout",
+           "placed_task"]
