@@ -26,7 +26,8 @@ DETERMINERS = frozenset("a an the its my your our their his her some this these 
 """Words that start a noun phrase: an unknown word names an object (the catalog lacks) only in such a phrase
 (*grab the mango*), never elsewhere in the sentence (*keep hold of it*, *without lifting it*)."""
 _NOT_BUILT_GROUPS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
-    ("steps in order", "sequences", ("then", "afterwards", "after that", "before")),
+    ("steps out of order ('{}')", "steps said after the step they come before",
+     ("afterwards", "after that", "before", "after you")),
     ("a side of something held ('{}')", "places relative to the hand", ("to its left", "to its right")),
     ("a direction ('{}')", "pushes in a direction", ("forward", "backward", "away from")),
 )
@@ -181,4 +182,12 @@ def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
     if words and words[-1] in ("left", "right"):  # 'push the block left' (a model's qualifier is checked later)
         return "in_region", words[-1], {len(words) - 1}
     return None, None, set()
+
+
+def split_steps(text: str) -> list[str]:
+    """The steps of a request said in order (*A, then B, then C*; *first A and then B*), each without its joiner;
+    one step for a request without ``then``."""
+    parts = re.split(r"\s*,?\s*(?:\band\s+)?\bthen\b[\s,]*", text, flags=re.IGNORECASE)
+    parts = [re.sub(r"^(first|firstly)\s+", "", p.strip(" ,.;"), flags=re.IGNORECASE) for p in parts]
+    return [p for p in parts if p]
 

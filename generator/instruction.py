@@ -36,6 +36,7 @@ from generator.constructs import (
     is_off,
     read_amount,
     read_place,
+    split_steps,
 )
 from generator.errors import InstructionError
 
@@ -169,14 +170,22 @@ class Reading:
     ``left_of``, ``between``, ..., or ``in_region``)."""
     region: str | None = None
     """For ``place_at`` with ``in_region``: the region of the table (``far_left``, ``near``, ``centre``, ...)."""
+    then: tuple[Reading, ...] = ()
+    """The steps the request asks for after this one, in order (*close the microwave, then set the bottle on the
+    plate*); each its own reading."""
     amount: str | None = None
     """How far an open or a turn goes when the request says: ``"half"`` (*open the drawer halfway*) or ``"<n>
     degrees"`` (*turn the valve 45 degrees*, from the shut end); None: all the way."""
 
     @property
+    def all_objects(self) -> tuple[Mention, ...]:
+        """The objects of this step and of every later one."""
+        return self.objects + tuple(m for r in self.then for m in r.all_objects)
+
+    @property
     def substitutions(self) -> dict[str, str]:
-        """Phrase -> asset for every object the catalog lacked (or a kind that was chosen from)."""
-        return {m.phrase: m.asset for m in self.objects if m.substituted}
+        """Phrase -> asset for every object the catalog lacked (or a kind that was chosen from), in every step."""
+        return {m.phrase: m.asset for m in self.all_objects if m.substituted}
 
     def lines(self) -> list[str]:
         """Human-readable account of the reading (what the CLI prints)."""
@@ -193,6 +202,8 @@ class Reading:
             out.append(f"  {m.phrase!r} {verb} {what}" + (f", painted {m.color}" if m.color else "")
                        + (f" ({detail})" if detail else ""))
         out += [f"  note: {n}" for n in self.notes]
+        for r in self.then:
+            out += ["  then " + r.lines()[0], *r.lines()[1:]]
         return out
 
     def to_dict(self) -> dict:
@@ -346,6 +357,15 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if not text:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
+    steps = split_steps(text)
+    if len(steps) > 1:  # each step read on its own; 'it' is the previous step's first object
+        readings: list[Reading] = []
+        for step in steps:
+            if readings and readings[-1].objects:
+                m = readings[-1].objects[0]
+                step = re.sub(r"\b(it|them)\b", f"the {m.color + ' ' if m.color else ''}{m.phrase}", step)
+            readings.append(read_instruction(step, assets))
+        return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
     words = _words(text)
     _refuse_unbuilt(text, words)
     found = _skill(words)

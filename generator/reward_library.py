@@ -271,7 +271,7 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
         fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
         return _header(f"{spec['name']}: {spec['instruction']}") + _COMPOSED.format(
             fail=fail, art=joint["object"], obj=rest["object"], progress=_progress(joint),
-            carry=_carry_term(rest.get("target")))
+            carry=_carry_term(rest.get("target"), placed_goal(rest, spec)))
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE

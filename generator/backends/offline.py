@@ -38,6 +38,7 @@ import numpy as np
 import yaml
 
 from generator.backends import placed as placed_tasks
+from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
 from generator.backends.wording import camel as _camel
@@ -64,6 +65,8 @@ base's centre): written only when asked for."""
 PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a generated push 10/10",
                                  "rubiks_cube": None, "foam_brick": None, "tuna_can": None, "sponge": None}
 """Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
+PART_TURN = 0.65
+"""How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 COMPOSE_STRIDE = 12
 """Each articulated first part is composed with every COMPOSE_STRIDE-th rigid task (a different slice for each)."""
 COMPOSED_SIDE_M = 0.1
@@ -243,6 +246,11 @@ class OfflineBackend:
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
+        # part way: a door or drawer held half open by its handle; a lever turned to PART_TURN of its range
+        out += [("open_part", self._open_task(a, 0.5)) for a in o if _part(a) in ("door", "drawer")]
+        out += [("turn_part", self._articulated_task("turn", by_id[i], PART_TURN)) for (s, i), lay
+                in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]]
+        out += [("place_at", t) for t in placed_tasks.placed_options(g, c + p, self._words)]
         # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
@@ -442,6 +450,9 @@ class OfflineBackend:
                                "(generator.instruction.read_instruction) in the request context")
         assets = {a["id"]: a for a in ctx["assets"]}
         existing = set(ctx.get("existing_tasks", []))
+        if reading.get("then"):  # steps in order: each its own task, joined where the solver does them in turn
+            step = lambda r: sequence.parse_step(self._propose_guided(request, ctx | {"reading": r}))  # noqa: E731
+            return _fence("json", json.dumps(sequence.sequence_task(step, reading, _acts, existing), indent=2))
         skill = reading["skill"]
         mentions = reading["objects"]
         subs: dict[str, str] = {}
@@ -542,8 +553,8 @@ class OfflineBackend:
         acts = _acts(proposal)
         goal = None
         movable = _movable_region(proposal, assets, acts)
-        spots = (placed_tasks.placed_layout(proposal["success"], proposal["objects"][0]["name"], rng)
-                 if proposal["success"]["type"] == "placed" else {})
+        place = next((c for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "placed"), None)
+        spots = {} if place is None else placed_tasks.placed_layout(place, place["object"], rng)
         for o in proposal["objects"]:
             a = assets[o["asset"]]
             # articulated objects anywhere at the back, movable ones where the solver measurably works (module

@@ -26,6 +26,10 @@ REGION_WORDS = {"left": "left side", "right": "right side", "near": "near side",
 """How a region of the table is said (the reader reads these back)."""
 SIDE_WORDS = {"left_of": "to the left of", "right_of": "to the right of", "in_front_of": "in front of",
               "behind": "behind", "next_to": "next to"}
+RELATIONS_IN_TURN = ("left_of", "right_of", "in_front_of", "behind", "next_to", "between")
+"""Relations the autonomous grammar gives its graspable objects in turn (one each)."""
+REGIONS_IN_TURN = ("far_left", "near_right", "left", "far", "right", "near_left", "centre", "far_right", "near")
+"""Regions of the table the autonomous grammar sends its graspable objects to in turn."""
 TABLE_CENTRE = np.array([0.1, 0.0])
 """The middle of the table's working area in world xy (``REGION_AHEAD_M`` ahead of the base at x = -0.8)."""
 REGION_POINT_M = 0.18
@@ -92,6 +96,19 @@ def placed_task(a: dict, relation: str, refs: list[dict], region: str | None, co
     }
 
 
+def placed_options(graspable: list[dict], marks: list[dict],
+                   words: Callable[[str], np.random.Generator]) -> list[dict]:
+    """The autonomous grammar's places: each graspable object by one landmark (two for ``between``) and in one
+    region of the table, relations, landmarks and regions taken in turn."""
+    out = []
+    for k, a in enumerate(graspable):
+        rel = RELATIONS_IN_TURN[k % len(RELATIONS_IN_TURN)]
+        refs = [b for b in marks[k % len(marks):] + marks if b["category"] != a["category"]]
+        out.append(placed_task(a, rel, refs[:2 if rel == "between" else 1], None, (), words))
+        out.append(placed_task(a, "in_region", [], REGIONS_IN_TURN[k % len(REGIONS_IN_TURN)], (), words))
+    return out
+
+
 def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, list[float]]:
     """Nominal (x, y) of the held object and its references: the set-down point inside the grasp region, the
     object starting on the far side of it (the condition false at reset, whatever the ±8 cm randomization)."""
@@ -125,5 +142,5 @@ def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, 
     return {cond["target"]: [0.1, y_ref], held: [0.1, y_ref + cond["max_gap_m"] + 0.18]}
 
 
-__all__ = ["BAND_M", "HAND_ROOM_M", "REGION_WORDS", "SIDE_WORDS", "command", "placed_condition", "placed_layout",
-           "placed_task"]
+__all__ = ["BAND_M", "HAND_ROOM_M", "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS", "command",
+           "placed_condition", "placed_layout", "placed_options", "placed_task"]

@@ -151,14 +151,15 @@ def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
     the backend wrote: the scene paints it so (:func:`generator.steps.scene.parse_scene`)."""
     subs = dict(reading.substitutions)
     used = [o.asset for o in proposal.objects]
-    for m in reading.objects:
+    named = reading.all_objects  # every step's
+    for m in named:
         if not m.substituted and m.asset and not set(m.options or (m.asset,)) & set(used):
-            other = [a for a in used if a not in {x.asset for x in reading.objects}]
+            other = [a for a in used if a not in {x.asset for x in named}]
             subs[m.phrase] = other[0] if other else "(left out)"
     for phrase, asset in proposal.substitutions.items():
         subs.setdefault(phrase, asset)
     objects, taken = list(proposal.objects), set()
-    for m in reading.objects:  # the colours the person named: the reading is the authority, whatever the backend
+    for m in named:  # the colours the person named: the reading is the authority, whatever the backend
         k = next((k for k, o in enumerate(objects) if k not in taken and o.asset in (m.options or (m.asset,))), None)
         if k is None:
             continue  # left out: a substitution above

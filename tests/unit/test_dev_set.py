@@ -20,10 +20,18 @@ OBJECT_KEYS = {"id", "category", "color", "kind", "count"}
 
 
 def _misread(reading: Reading, steps: list[dict]) -> str | None:
-    """Why ``reading`` is not the expected one-step reading and does not say so (None: it is, or it says so)."""
-    if len(steps) != 1:
-        return f"{len(steps)} steps read as one ({reading.skill})"
-    step = steps[0]
+    """Why ``reading`` is not the expected reading, step by step, and does not say so (None: it is, or it says so)."""
+    readings = [reading, *reading.then]
+    if len(steps) != len(readings):
+        return f"{len(steps)} steps read as {len(readings)} ({[r.skill for r in readings]})"
+    for step, r in zip(steps, readings, strict=True):
+        why = _misread_step(r, step)
+        if why is not None:
+            return why
+    return None
+
+
+def _misread_step(reading: Reading, step: dict) -> str | None:
     if step["skill"] != reading.skill:
         return f"read as {reading.skill!r}, asked {step['skill']!r}"
     want_amount = step.get("amount")

@@ -173,8 +173,7 @@ def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused
     ("close the cabinet door left", "a direction ('left')"),
     ("open the fridge on the left", "a place (in region, left)"),
     ("lift the apple halfway", "an amount ('half')"),
-    ("open the fridge, then put the apple in the bowl", "steps in order"),
-    ("put the apple in the bowl before closing the microwave", "steps in order"),
+    ("put the apple in the bowl before closing the microwave", "steps out of order ('before')"),
     ("take the apple out of the bowl", "out of another"),
 ])
 def test_constructs_not_built_yet_are_refused_never_built_without_them(text, asks):
@@ -183,6 +182,17 @@ def test_constructs_not_built_yet_are_refused_never_built_without_them(text, ask
     'left' as an object)."""
     with pytest.raises(InstructionError, match=re.escape(asks)):
         read(text)
+
+
+def test_steps_in_order_are_read_one_by_one_and_it_is_the_object_before():
+    r = read("close the microwave, then set the bottle on the plate")
+    assert [(x.skill, [m.asset for m in x.objects]) for x in (r, *r.then)] == [
+        ("close", ["microwave_compact"]), ("place_on", ["bottle", "plate"])]
+    assert r.instruction == "close the microwave, then set the bottle on the plate"
+    r = read("first pick up the apple and then put it in the bowl, then push the block to the goal")
+    assert [x.skill for x in (r, *r.then)] == ["lift", "put_in", "push"]
+    assert [m.asset for m in r.then[0].objects] == ["apple", "bowl"]  # 'it': the apple
+    assert [m.asset for m in r.all_objects] == ["apple", "apple", "bowl", "block_large"]
 
 
 @pytest.mark.parametrize("text, relation, region, objects", [
