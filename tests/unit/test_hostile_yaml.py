@@ -2,7 +2,9 @@
 
 Each file of ``tests/data/hostile_yaml`` (and the big ones generated here into tmp_path) must raise TaskSpecError
 whose message holds the named reason; an alias bomb is refused in under a second and 200 MB; a property-based fuzz of
-the loader finds nothing but typed errors.
+the loader finds nothing but typed errors. Time bounds on work done in this process are on its CPU time
+(``time.process_time``): a parser stuck on a bomb spends CPU; other work on a loaded machine does not count (a wall-
+clock bound of 1 s failed at 1.08 s beside two task generations).
 """
 
 from __future__ import annotations
@@ -100,9 +102,9 @@ def test_the_alias_bomb_is_small():
 def test_alias_bomb_is_refused_fast_and_small_in_process():
     tracemalloc.start()
     try:
-        start = time.perf_counter()
+        start = time.process_time()
         _refused(DATA / "alias_bomb.yaml", "more than 20000 nodes")
-        elapsed = time.perf_counter() - start
+        elapsed = time.process_time() - start
         _, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
@@ -155,27 +157,27 @@ def test_object_flood_of_full_objects_is_refused_before_parsing(tmp_path):
     path = tmp_path / "flood.yaml"
     objects = "".join(f"  - {{name: o{i}, asset: apple, pos_m: [0.0, 0.0, 0.0]}}\n" for i in range(150_000))
     path.write_text("name: Flood\ninstruction: x\nobjects:\n" + objects + _reference_tail())
-    start = time.perf_counter()
+    start = time.process_time()
     _refused(path, f"at most {MAX_INPUT_BYTES} bytes are allowed")
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
 
 
 def test_object_flood_under_the_size_bound_is_refused_by_the_node_ceiling(tmp_path):
     path = tmp_path / "flood.yaml"
     path.write_text("name: Flood\ninstruction: x\nobjects: [" + "{}, " * 150_000 + "]\n")
     assert path.stat().st_size < MAX_INPUT_BYTES
-    start = time.perf_counter()
+    start = time.process_time()
     _refused(path, f"more than {MAX_NODES} nodes")
-    assert time.perf_counter() - start < 5.0
+    assert time.process_time() - start < 5.0
 
 
 def test_object_flood_in_a_mapping_is_refused_before_any_object_is_built():
     raw = yaml.safe_load(REFERENCE.read_text())
     raw["objects"] = [dict(raw["objects"][0], name=f"o{i}") for i in range(150_000)]
-    start = time.perf_counter()
+    start = time.process_time()
     with pytest.raises(TaskSpecError, match=r"objects: 150000 objects; at most 64 are allowed"):
         parse_task_spec(raw, "flood")
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
 
 
 @pytest.mark.parametrize("key,items,limit", [("stages", "stages", 32), ("conditions", "conditions", 32)])
@@ -207,9 +209,9 @@ def test_file_over_one_megabyte_is_refused_before_parsing(tmp_path):
 def test_ten_thousand_deep_nesting_is_refused(tmp_path, open_, close):
     path = tmp_path / "deep.yaml"
     path.write_text("name: " + open_ * 10_000 + "1" + close * 10_000 + "\n")
-    start = time.perf_counter()
+    start = time.process_time()
     _refused(path, f"nesting deeper than {MAX_DEPTH} levels")
-    assert time.perf_counter() - start < 2.0
+    assert time.process_time() - start < 2.0
 
 
 def test_deep_block_nesting_is_refused(tmp_path):
@@ -261,11 +263,11 @@ BOMB = (DATA / "alias_bomb.yaml").read_text()
     ("```yaml\n" + "# pad\n" * 200_000 + "a: 1\n```", "at most 1000000 bytes are allowed"),
 ])
 def test_model_yaml_reply_bounds(reply, reason):
-    start = time.perf_counter()
+    start = time.process_time()
     with pytest.raises(SceneError) as info:
         parse_yaml_block(reply, "scene file", SceneError)
     assert reason in str(info.value) and len(str(info.value)) <= MAX_MESSAGE
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
 
 
 @pytest.mark.parametrize("reply,reason", [
@@ -305,11 +307,11 @@ def _exchange(i: int, text: str = "ok") -> str:
 ])
 def test_transcript_bounds(tmp_path, lines, reason):
     path = _transcript(tmp_path, lines)
-    start = time.perf_counter()
+    start = time.process_time()
     with pytest.raises(TranscriptMismatchError) as info:
         ReplayBackend(path)
     assert reason in str(info.value) and len(str(info.value)) <= MAX_MESSAGE
-    assert time.perf_counter() - start < 5.0
+    assert time.process_time() - start < 5.0
 
 
 @pytest.mark.parametrize("loader", ["suite", "manifest"])
@@ -320,10 +322,10 @@ def test_suite_and_dataset_manifest_files_are_bounded_too(tmp_path, loader):
     path = tmp_path / "hostile.yaml"
     path.write_text(BOMB)
     load, error = (load_suite, SuiteError) if loader == "suite" else (load_manifest, DatasetError)
-    start = time.perf_counter()
+    start = time.process_time()
     with pytest.raises(error, match="more than 20000 nodes"):
         load(path)
-    assert time.perf_counter() - start < 1.0
+    assert time.process_time() - start < 1.0
 
 
 def test_a_committed_transcript_still_replays():
@@ -415,7 +417,7 @@ def _check_one(text: str, path: Path) -> None:
         path.write_bytes(text.encode("utf-8", "surrogatepass"))
     except UnicodeEncodeError:
         return
-    start = time.perf_counter()
+    start = time.process_time()
     try:
         spec = load_task_spec(path)
     except GenDexError as e:
@@ -424,7 +426,7 @@ def _check_one(text: str, path: Path) -> None:
         again = parse_task_spec(load_yaml_bounded(dump_task_spec(spec), "round trip"))
         assert again == spec
         assert all(math.isfinite(v) for o in spec.objects for v in (*o.pos_m, o.scale))
-    assert time.perf_counter() - start < 2.0
+    assert time.process_time() - start < 2.0
 
 
 FUZZ_CASES = 10_000
