@@ -77,7 +77,9 @@ def placed_task(a: dict, relation: str, refs: list[dict], region: str | None, co
     """The proposal: set ``a`` down ``relation`` to the reference objects ``refs`` (none for a region of the
     table); ``words(name)`` seeds the wording of task ``name``."""
     n = a["category"]
-    names = [r["category"] if r["category"] != n else r["id"] for r in refs]
+    names: list[str] = []
+    for r in refs:  # by category, by id where the category is taken (two bowls: 'bowl', 'bowl_large')
+        names.append(r["category"] if r["category"] not in (n, *names) else r["id"])
     cond = placed_condition(n, a, relation, *(refs[:1] or [None]), names=tuple(names), region=region,
                             c=refs[1] if len(refs) > 1 else None)
     parts = [relation if relation != "in_region" else region, *(r["id"] for r in refs)]
@@ -104,6 +106,7 @@ def placed_options(graspable: list[dict], marks: list[dict],
     for k, a in enumerate(graspable):
         rel = RELATIONS_IN_TURN[k % len(RELATIONS_IN_TURN)]
         refs = [b for b in marks[k % len(marks):] + marks if b["category"] != a["category"]]
+        refs = refs[:1] + [b for b in refs if b["category"] != refs[0]["category"]][:1]  # two kinds for between
         out.append(placed_task(a, rel, refs[:2 if rel == "between" else 1], None, (), words))
         out.append(placed_task(a, "in_region", [], REGIONS_IN_TURN[k % len(REGIONS_IN_TURN)], (), words))
     return out

@@ -534,3 +534,22 @@ def test_two_steps_in_order_are_one_composed_task_where_the_author_joins_them():
         with pytest.raises(InstructionError, match="two steps in order"):
             b.complete(ModelRequest(step="propose_guided", prompt="", context={
                 "reading": read_instruction(text, asset_dicts()).to_dict(), "assets": asset_dicts()}))
+
+
+def test_every_task_the_grammar_can_write_is_a_valid_proposal_with_distinct_object_names():
+    """All of them, not a sample; and a requested place between two bowls (it once named both 'bowl')."""
+    from generator.steps.propose import parse_proposal
+
+    reading = read_instruction("put the apple between the bowl and the large bowl", asset_dicts())
+    raw = json.loads(OfflineBackend(seed=3).complete(ModelRequest(step="propose_guided", prompt="", context={
+        "reading": reading.to_dict(), "assets": asset_dicts()})).text.split("```json\n")[1].split("```")[0])
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+    assert [o.name for o in p.objects] == ["apple", "bowl", "bowl_large"]
+
+    options = OfflineBackend(seed=1)._task_options(list(asset_dicts()))
+    kinds = {k for k, _ in options}
+    assert {"place_at", "open_part", "turn_part", "turn_off"} <= kinds
+    for _, raw in options:
+        p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+        assert len({o.name for o in p.objects}) == len(p.objects), raw["name"]
+    assert len({raw["name"] for _, raw in options}) == len(options)
