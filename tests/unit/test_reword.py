@@ -236,3 +236,15 @@ def test_a_reworded_version_differs_from_its_source_only_in_its_instruction(comm
             assert files[rel].read_bytes() == src[rel].read_bytes(), (env_id, rel)
         a, b = yaml.safe_load(source.files.spec.read_text()), yaml.safe_load(v.files.spec.read_text())
         assert dict(a, instruction=b["instruction"]) == b and v.provenance()["reword"]["new"] == b["instruction"]
+
+
+def test_a_place_task_is_framed_by_the_object_it_moves():
+    """A placed task's object is the one its rigid part moves: its command gets a situation and purpose like any
+    set-down (before: 'no object the task acts on', and the bare command was kept)."""
+    from generator.backends.offline import OfflineBackend
+    from generator.reword import proposal_frames
+
+    options = OfflineBackend(seed=1)._task_options(list(asset_dicts()))
+    placed = next(raw for kind, raw in options if kind == "place_at")
+    first, last = proposal_frames(placed)
+    assert first == last and first.domain and first.direction is None  # the moved object's domain
