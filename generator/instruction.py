@@ -393,12 +393,12 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
                          "moves; which one is not chosen by its place")
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
         at.append(i)
-    # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb; not the words of an amount
+    # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
     relation, region, at_place = read_place(words)
-    in_amount = amount_words(words) | at_place
+    no_object = amount_words(words) | at_place  # the words of an amount or a place
     unknown = []
     for k, w in enumerate(words):
-        if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in in_amount
+        if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in no_object
                 or (len(w) < 3 and not w.isdigit())):
             continue
         if w in _VERB_WORDS or w in _FILLER:

@@ -12,6 +12,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from gendex_envs.spec import RobotSpec
+from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
 from generator.backends.wording import camel, step, word
 from generator.phrasing import names_for, painted
 
@@ -30,10 +32,9 @@ RELATIONS_IN_TURN = ("left_of", "right_of", "in_front_of", "behind", "next_to", 
 """Relations the autonomous grammar gives its graspable objects in turn (one each)."""
 REGIONS_IN_TURN = ("far_left", "near_right", "left", "far", "right", "near_left", "centre", "far_right", "near")
 """Regions of the table the autonomous grammar sends its graspable objects to in turn."""
-TABLE_CENTRE = np.array([0.1, 0.0])
-"""The middle of the table's working area in world xy (``REGION_AHEAD_M`` ahead of the base at x = -0.8)."""
-REGION_POINT_M = 0.18
-"""How far from :data:`TABLE_CENTRE` the solver sets an object down in a side region (``REGION_DEPTH_M``)."""
+TABLE_CENTRE = np.array(RobotSpec().base_pos_m[:2]) + np.array([REGION_AHEAD_M, 0.0])
+"""The middle of the table's working area in world xy, where the regions are measured from (the default robot base,
+facing +x: the author's scenes keep it)."""
 
 
 def _radius(a: dict) -> float:
@@ -120,8 +121,8 @@ def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, 
         point = TABLE_CENTRE.copy()
         if cond["region"] != "centre":
             for part in cond["region"].split("_"):
-                axis, sign = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}[part]
-                point[axis] += sign * REGION_POINT_M
+                axis, sign = REGION_PARTS[part]
+                point[axis] += sign * REGION_DEPTH_M  # where the solver sets it down
         start = 2 * TABLE_CENTRE - point if cond["region"] != "centre" else TABLE_CENTRE + np.array([0.0, 0.22])
         return {held: [float(v) for v in start]}
     if rel == "between":
