@@ -369,7 +369,11 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
              ray: bool = ray_option(), ray_address: str = ray_address_option(),
              transcript: list[Path] = typer.Option(None, "--transcript",
                                                    help="replay: a recorded transcript (or a task folder holding "
-                                                        "one); repeat for several tasks.")) -> None:
+                                                        "one); repeat for several tasks."),
+             kind: list[str] = typer.Option(None, "--kind",
+                                            help="offline, without --instruction: draw only tasks of this kind "
+                                                 "(repeat for several), e.g. place_at, open_part, composed; "
+                                                 "generator.backends.offline.TASK_KINDS lists them.")) -> None:
     """Generate new tasks: propose, scene, render, critique/refine, plan, reward code, validate, commit."""
     from tqdm import tqdm
 
@@ -395,11 +399,20 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                     "sampler and a library of reward terms. It is NOT a language model; set ANTHROPIC_API_KEY or "
                     "pass --backend anthropic for Claude.", fg=typer.colors.YELLOW, err=True)
     pending = list(files)
+    kinds = {"kinds": tuple(kind)} if kind else {}
+    if kind and (name != "offline" or instruction is not None):
+        _die(ValueError("--kind chooses among the offline author's own proposals: it needs --backend offline and "
+                        "no --instruction"))
+    if kind:
+        try:
+            make_backend(name, seed=seed, **kinds)  # unknown kinds fail here, before anything runs
+        except GenDexError as exc:
+            _die(exc)
 
     def factory():
         if name == "replay":
             return ReplayBackend(pending.pop(0))
-        return make_backend(name, seed=seed, model=model)
+        return make_backend(name, seed=seed, model=model, **kinds)
 
     # several tasks on several workers (or Ray): the offline author's tasks in parallel. A parallel batch guesses
     # each task's proposal ahead of time, which needs an author that answers the same question the same way; a
@@ -407,7 +420,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
     # (each task's gate attempts still fan out)
     fan_out = workers > 1 or ray or ray_address is not None
     tasks_on = backend_of(workers, ray, ray_address) if n > 1 and fan_out and name == "offline" else None
-    picklable = functools.partial(make_backend, name, seed=seed, model=model)
+    picklable = functools.partial(make_backend, name, seed=seed, model=model, **kinds)
     if n > 1 and fan_out and tasks_on is None:
         typer.secho(f"{name}: tasks are generated one after another (only the offline author's tasks run in "
                     "parallel); --workers runs each task's gate attempts", fg=typer.colors.YELLOW, err=True)

@@ -29,10 +29,8 @@ validators as a model's:
 
 from __future__ import annotations
 
-import functools
 import json
 import zlib
-from typing import Any
 
 import numpy as np
 import yaml
@@ -40,7 +38,9 @@ import yaml
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
-from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
+from generator.backends.layouts import ARTICULATED_LAYOUTS
+from generator.backends.offline_scene import scene_spec
+from generator.backends.roles import _acts, _joint_at, _kind, _min_xy, _part, container, fits_in, graspable, openable
 from generator.backends.wording import camel as _camel
 from generator.backends.wording import fence as _fence
 from generator.backends.wording import step as _step
@@ -53,9 +53,6 @@ from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
 
-_OPENABLE_LINKS = ("door", "lid", "drawer")
-PUSH_M = 0.22
-"""How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
 STACK_PAIRS: dict[tuple[str, str], str | None] = {
     ("block_medium", "block_large"): "StackBlocks 93-100 % on unseen seeds", ("rubiks_cube", "block_large"): None,
     ("foam_brick", "block_large"): None, ("block_small", "block_medium"): None}
@@ -67,114 +64,17 @@ PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a genera
 """Objects the autonomous grammar pushes, as :data:`STACK_PAIRS`."""
 PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
+TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
+              "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "composed")
+"""The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
+or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
+(``composed``)."""
 COMPOSE_STRIDE = 12
 """Each articulated first part is composed with every COMPOSE_STRIDE-th rigid task (a different slice for each)."""
-COMPOSED_SIDE_M = 0.1
-"""Articulated object this far off the middle (|y|): a composed task's movables on the other side, else in front."""
 COMPOSED_WEIGHT = 2.0
 """How much likelier a composed task is drawn than the tasks of any one skill."""
-DISTRACTOR_P = 0.4
-"""Share of scenes with movable objects that get one object of clutter (``distractor: true``)."""
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
-
-
-def _part(a: dict) -> str:
-    """The kind of part an articulated asset's main joint moves: ``door``, ``drawer``, ``lid`` or ``lever``."""
-    return a["joints"][0]["handle_link"].split("_")[0]
-
-
-def _kind(skill: str, a: dict) -> str:
-    """The task skill of ``skill`` (open, close, turn, turn_off) on articulated ``a``: ``close_door``, ``open_lid``,
-    ``turn``, ``turn_off``."""
-    return skill if skill in ("turn", "turn_off") else f"{skill}_{_part(a)}"
-
-
-MOVABLE_REGION_M = ((-0.02, 0.18), (-0.26, 0.26))
-"""Where the offline author puts a movable object's nominal (x, y). With +-8 cm of randomization it stays close to
-where the solver was measured to work: benchmarks/grasp.py's region (x -0.02..0.22, y -0.22..0.22, 34 objects
-held >= 90 %) and the reference tasks' v1 layouts (y to +-0.24, 50/50). Sampling the whole table front (x -0.35..0.7,
-y -0.55..0.55, as before) put a plate 1.26 m from the base: 0/10 carries found an arm pose above it."""
-ARTICULATED_REGION_M = ((0.52, 0.68), (-0.2, 0.2))
-"""The same for articulated objects (their front faces the robot): OpenCabinet, OpenDrawer and CloseDrawer succeed
-48-50/50 at (0.55-0.6, 0-0.1) +-5 cm; a batch sampled over x 0.3..0.75, y +-0.45 lost 3/10 drawer openings to
-unreachable hook poses."""
-MIN_GRASP_RATE = 0.9
-"""Lift-and-hold rate (recorded by ``benchmarks/grasp.py --record``) an object needs to be proposed for grasping."""
-
-
-def _min_xy(a: dict) -> float:
-    return float(min(a["size_m"][:2]))
-
-
-def graspable(a: dict) -> bool:
-    """Objects the offline grammar lets the hand grasp: compact, not flat, not too heavy, and picked up and held by
-    the solver in >= 90 % of the recorded ``benchmarks/grasp.py`` attempts (when a record exists)."""
-    s = a["size_m"]
-    measured = _measured()
-    return ("graspable" in a["tags"] and "container" not in a["tags"] and a["category"] != "plate"
-            and 0.035 <= _min_xy(a) and max(s) <= 0.25 and s[2] >= 0.03 and a["mass_kg"] <= 0.6
-            and not a.get("joints") and (not measured or a["id"] in measured))
-
-
-@functools.cache
-def _measured() -> frozenset[str]:
-    from gendex.solve.lift_check import measured_graspable
-
-    return measured_graspable(MIN_GRASP_RATE)
-
-
-def _round(a: dict) -> bool:
-    """Round seen from above (a ball, a can, a bowl): any yaw is the same object."""
-    s = a["size_m"]
-    return abs(s[0] - s[1]) <= 0.1 * max(s[0], s[1])
-
-
-def container(a: dict) -> bool:
-    return "container" in a["tags"] and a["size_m"][2] <= 0.12 and _min_xy(a) >= 0.14 and not a.get("joints")
-
-
-def openable(a: dict) -> bool:
-    """Fixed articulated objects with a door or drawer handle, of a kind the solver's handle primitives open."""
-    from gendex.solve.articulated import SOLVED_CATEGORIES
-
-    joints = a.get("joints") or []
-    return (bool(a.get("fixed_base")) and bool(joints) and a["category"] in SOLVED_CATEGORIES
-            and any(k in joints[0]["handle_link"] for k in _OPENABLE_LINKS))
-
-
-def fits_in(g: dict, c: dict) -> bool:
-    """Grasped object ``g``, fitted to the hand, fits in container ``c`` with room around it."""
-    from gendex.solve.grasp import hand_fit_scale
-
-    return max(g["size_m"][:2]) * hand_fit_scale(g["size_m"][:2]) < 0.7 * _min_xy(c)
-
-
-def _acts(proposal: dict) -> dict[str, str]:
-    """What the proposal does to each articulated object, as a key of :data:`ARTICULATED_LAYOUTS`: its step's skill
-    (open, close, turn), ``turn_off`` for a turn whose success condition is the joint shut."""
-    shut = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ()))
-            if c["type"] == "joint_open" and c.get("negate")}
-    return {s["target"]: "turn_off" if s["skill"] == "turn" and s["target"] in shut else s["skill"]
-            for s in proposal["steps"] if s["skill"] in ("open", "close", "turn")}
-
-
-def _joint_at(n: str, fraction: float) -> dict:
-    return {"type": "joint_at", "object": n, "fraction": fraction, "max_error": 0.1}
-
-
-def _movable_region(proposal: dict, assets: dict[str, dict], acts: dict[str, str]) -> tuple:
-    """Where movable objects go: :data:`MOVABLE_REGION_M`, or in a composed task the half of it away from the
-    articulated object's measured layout (the hand works on that object first, and its door or lid swings there)."""
-    (x0, x1), (y0, y1) = MOVABLE_REGION_M
-    for o in proposal["objects"]:
-        layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
-        if layout is not None and len(proposal["objects"]) > 1:
-            y = layout["pos_m"][1]
-            if abs(y) >= COMPOSED_SIDE_M:
-                return (x0, x1), ((y0, 0.0) if y > 0 else (0.0, y1))
-            return (x0, min(x1, 0.08)), (y0, y1)
-    return MOVABLE_REGION_M
 
 
 class OfflineBackend:
@@ -185,8 +85,13 @@ class OfflineBackend:
     sees_images = False
     is_language_model = False
 
-    def __init__(self, seed: int = 0):
+    def __init__(self, seed: int = 0, kinds: tuple[str, ...] | list[str] | None = None):
         self.seed = int(seed)
+        unknown = sorted(set(kinds or ()) - set(TASK_KINDS))
+        if unknown:
+            raise BackendError(f"unknown kind(s) of task {unknown}; the offline grammar writes: {', '.join(TASK_KINDS)}")
+        self.kinds = tuple(kinds) if kinds else None
+        """The kinds of task :meth:`_propose` draws from (None: every kind, :data:`TASK_KINDS`)."""
         self._wording = ProposalWording()
 
     def _rng(self, request: ModelRequest, *keys: int) -> np.random.Generator:
@@ -212,11 +117,13 @@ class OfflineBackend:
         by_skill: dict[str, list[dict]] = {}
         options = self._task_options(ctx["assets"])
         for skill, proposal in options:
-            if proposal["name"] not in existing and proposal_signature(proposal) not in taken:
+            if (proposal["name"] not in existing and proposal_signature(proposal) not in taken
+                    and (self.kinds is None or skill in self.kinds)):
                 by_skill.setdefault(skill, []).append(proposal)
         if not by_skill:
-            raise BackendError(f"the offline task grammar is exhausted: all {len(options)} tasks it can write "
-                               "exist, or duplicate an existing task's skills and objects")
+            of = "" if self.kinds is None else f" of the kinds {list(self.kinds)}"
+            raise BackendError(f"the offline task grammar is exhausted: all tasks it can write{of} exist, or duplicate "
+                               "an existing task's skills and objects")
         skills = sorted(by_skill)
         weights = np.array([COMPOSED_WEIGHT if k == "composed" else 1.0 for k in skills])
         pool = by_skill[skills[int(rng.choice(len(skills), p=weights / weights.sum()))]]
@@ -546,83 +453,8 @@ class OfflineBackend:
 
     # ------------------------------------------------------------------ scene
     def _scene(self, request: ModelRequest, ctx: dict) -> str:
-        proposal = ctx["proposal"]
-        assets = {a["id"]: a for a in ctx["assets"]}
         rng = self._rng(request, ctx.get("index", 0), ctx["candidate_index"], ctx.get("attempt", 0))
-        objects = []
-        acts = _acts(proposal)
-        goal = None
-        movable = _movable_region(proposal, assets, acts)
-        place = next((c for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "placed"), None)
-        spots = {} if place is None else placed_tasks.placed_layout(place, place["object"], rng)
-        for o in proposal["objects"]:
-            a = assets[o["asset"]]
-            # articulated objects anywhere at the back, movable ones where the solver measurably works (module
-            # constant); overlaps and support are the critic's job
-            (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else movable
-            x, y = spots.get(o["name"]) or (rng.uniform(x0, x1), rng.uniform(y0, y1))
-            entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
-            if o.get("color"):
-                entry["color"] = o["color"]
-            layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
-            if layout is not None:  # the measured layout of this skill on this object, jittered a little
-                targets = [st["target"] for st in proposal["steps"]]
-                stays = o["name"] in targets and targets[::-1].index(o["name"]) > 0  # the hand moves on
-                at = layout.get("composed_pos_m", layout["pos_m"]) if stays else layout["pos_m"]
-                x, y = (v + rng.uniform(-LAYOUT_JITTER_M, LAYOUT_JITTER_M) for v in at)
-                entry["pos_m"] = [round(x, 3), round(y, 3), 0.0]
-                if layout["yaw_deg"]:
-                    half = np.radians(layout["yaw_deg"]) / 2
-                    entry["quat_wxyz"] = [round(float(np.cos(half)), 7), 0.0, 0.0, round(float(np.sin(half)), 7)]
-                entry["fixed"] = layout.get("fixed", True)
-                entry["joint_state"] = {a["joints"][0]["name"]: float(layout["start"])}
-                entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
-            elif o["role"] == "articulated":
-                j = a["joints"][0]
-                entry["fixed"] = True
-                entry["joint_state"] = {j["name"]: float(j["closed_qpos"])}
-                entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
-            else:  # what the solver issue asks of every task: +-8 cm, any yaw if round, else +-45 deg
-                entry["randomize"] = {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}
-                if proposal["success"].get("target") == "goal" and goal is None:
-                    # a push: the goal mark PUSH_M across the table, towards its middle
-                    gy = y - np.sign(y or 1.0) * PUSH_M
-                    goal = {"pos_m": [round(x, 3), round(float(gy), 3), 0.0], "radius_m": 0.03}
-            objects.append(entry)
-        if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P and not spots:
-            objects.append(self._distractor(proposal, assets, rng, movable))
-        stages = []
-        for i, s in enumerate(proposal["steps"]):
-            method = "motion_planning" if s["skill"] in ("reach", "carry", "place") else "RL"
-            repeated = i > 0 and s["skill"] == proposal["steps"][i - 1]["skill"]
-            stages.append({"name": f"{s['skill']}_{s['target']}" + (f"_{i}" if repeated else ""),
-                           "instruction": s["instruction"], "skill": s["skill"], "method": method,
-                           "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
-                           "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})
-        conds = [{k: v for k, v in c.items() if v is not None}
-                 for c in (proposal["success"], *(proposal.get("also") or ()))]
-        spec = {"name": proposal["name"], "instruction": proposal["description"], "objects": objects,
-                **({"goal": goal} if goal else {}),
-                "stages": stages, "success": {"description": proposal["success_text"], "conditions": conds},
-                # room for a re-planned approach, a regrasp or a slow door: twice the stages' horizons
-                "max_episode_steps": max(250, 2 * sum(st["horizon"] for st in stages))}
-        return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
-
-    @staticmethod
-    def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict:
-        """One object of clutter: a graspable catalog object the task does not use, in ``region``: where the task's
-        movable objects go, clear of a door the hand works first (the critic moves it if it overlaps)."""
-        from generator.catalog_view import asset_dicts
-
-        used = {o["asset"] for o in proposal["objects"]}
-        pool = sorted((a for a in asset_dicts() if graspable(a) and a["id"] not in used
-                       and a["category"] not in {assets[i]["category"] for i in used if i in assets}),
-                      key=lambda a: a["id"])
-        a = pool[int(rng.integers(len(pool)))]
-        (x0, x1), (y0, y1) = region
-        return {"name": f"distractor_{a['category']}", "asset": a["id"], "distractor": True,
-                "pos_m": [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0],
-                "randomize": {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}}
+        return scene_spec(ctx["proposal"], {a["id"]: a for a in ctx["assets"]}, rng)
 
     # ------------------------------------------------------------------ plan
     _PLAN = {"reach": ("motion_planning", "arm", 60), "carry": ("motion_planning", "arm", 60),

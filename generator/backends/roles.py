@@ -1,0 +1,86 @@
+"""What the offline author lets each catalog object be (its roles: graspable, container, openable; which part a
+joint moves) and what a proposal does to its articulated objects: the predicates the grammar, the guided author and
+the scene sampler share."""
+
+from __future__ import annotations
+
+import functools
+
+_OPENABLE_LINKS = ("door", "lid", "drawer")
+
+
+def _part(a: dict) -> str:
+    """The kind of part an articulated asset's main joint moves: ``door``, ``drawer``, ``lid`` or ``lever``."""
+    return a["joints"][0]["handle_link"].split("_")[0]
+
+
+def _kind(skill: str, a: dict) -> str:
+    """The task skill of ``skill`` (open, close, turn, turn_off) on articulated ``a``: ``close_door``, ``open_lid``,
+    ``turn``, ``turn_off``."""
+    return skill if skill in ("turn", "turn_off") else f"{skill}_{_part(a)}"
+
+
+MIN_GRASP_RATE = 0.9
+"""Lift-and-hold rate (recorded by ``benchmarks/grasp.py --record``) an object needs to be proposed for grasping."""
+
+
+def _min_xy(a: dict) -> float:
+    return float(min(a["size_m"][:2]))
+
+
+def graspable(a: dict) -> bool:
+    """Objects the offline grammar lets the hand grasp: compact, not flat, not too heavy, and picked up and held by
+    the solver in >= 90 % of the recorded ``benchmarks/grasp.py`` attempts (when a record exists)."""
+    s = a["size_m"]
+    measured = _measured()
+    return ("graspable" in a["tags"] and "container" not in a["tags"] and a["category"] != "plate"
+            and 0.035 <= _min_xy(a) and max(s) <= 0.25 and s[2] >= 0.03 and a["mass_kg"] <= 0.6
+            and not a.get("joints") and (not measured or a["id"] in measured))
+
+
+@functools.cache
+def _measured() -> frozenset[str]:
+    from gendex.solve.lift_check import measured_graspable
+
+    return measured_graspable(MIN_GRASP_RATE)
+
+
+def _round(a: dict) -> bool:
+    """Round seen from above (a ball, a can, a bowl): any yaw is the same object."""
+    s = a["size_m"]
+    return abs(s[0] - s[1]) <= 0.1 * max(s[0], s[1])
+
+
+def container(a: dict) -> bool:
+    return "container" in a["tags"] and a["size_m"][2] <= 0.12 and _min_xy(a) >= 0.14 and not a.get("joints")
+
+
+def openable(a: dict) -> bool:
+    """Fixed articulated objects with a door or drawer handle, of a kind the solver's handle primitives open."""
+    from gendex.solve.articulated import SOLVED_CATEGORIES
+
+    joints = a.get("joints") or []
+    return (bool(a.get("fixed_base")) and bool(joints) and a["category"] in SOLVED_CATEGORIES
+            and any(k in joints[0]["handle_link"] for k in _OPENABLE_LINKS))
+
+
+def fits_in(g: dict, c: dict) -> bool:
+    """Grasped object ``g``, fitted to the hand, fits in container ``c`` with room around it."""
+    from gendex.solve.grasp import hand_fit_scale
+
+    return max(g["size_m"][:2]) * hand_fit_scale(g["size_m"][:2]) < 0.7 * _min_xy(c)
+
+
+def _acts(proposal: dict) -> dict[str, str]:
+    """What the proposal does to each articulated object, as a key of :data:`ARTICULATED_LAYOUTS`: its step's skill
+    (open, close, turn), ``turn_off`` for a turn whose success condition is the joint shut."""
+    shut = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ()))
+            if c["type"] == "joint_open" and c.get("negate")}
+    return {s["target"]: "turn_off" if s["skill"] == "turn" and s["target"] in shut else s["skill"]
+            for s in proposal["steps"] if s["skill"] in ("open", "close", "turn")}
+
+
+def _joint_at(n: str, fraction: float) -> dict:
+    return {"type": "joint_at", "object": n, "fraction": fraction, "max_error": 0.1}
+
+
