@@ -5,6 +5,7 @@ catalog bounding box; its yaw noise turns it about the object's origin. :func:`p
 spec order, batched over envs: an env whose drawn object would overlap one placed before it (with :data:`GAP_M`
 between them) or leave the table (unless it is fixed) draws again, up to :data:`TRIES` times; an env where an object
 never finds room draws its whole layout again (:data:`ROUNDS`), and one that never succeeds keeps the nominal layout.
+An object that starts in a container (:attr:`Item.starts_in`) moves with it.
 The draws come from torch's RNG, which ManiSkill seeds from the reset seed, so a layout is a function of the seed.
 """
 
@@ -20,6 +21,8 @@ TRIES = 32
 """Draws per object and env before the env's layout is drawn again."""
 ROUNDS = 8
 """Whole-layout draws per env before it falls back to the nominal layout."""
+STARTS_IN_MIN_CLEARANCE_M = 0.005
+"""An object raised more than this off the table, over a container, starts in it (and moves with it at reset)."""
 
 
 @dataclass(frozen=True)
@@ -74,6 +77,25 @@ class Item:
     footprint: Footprint
     fixed: bool = False
     """Fixed objects (a cabinet against the table's back edge) may overhang the table; others must lie on it."""
+    starts_in: str | None = None
+    """The container this object starts in (*take the apple out of the bowl*): it moves with the container's xy
+    noise (drawn first), turns by its own yaw noise, and is not kept apart from anything (it is inside)."""
+
+
+def starts_in(obj, objects, records) -> str | None:
+    """The container spec object ``obj`` starts in: a rigid container (catalog tag ``container``) whose footprint
+    holds ``obj``'s origin, for a rigid object raised more than :data:`STARTS_IN_MIN_CLEARANCE_M` off the table (what
+    the physical checks call ``inside_container``); None otherwise. ``records``: each object's catalog record."""
+    if obj.pos_m[2] <= STARTS_IN_MIN_CLEARANCE_M or records[obj.name].articulated:
+        return None
+    for other in objects:
+        rec = records[other.name]
+        if other.name == obj.name or "container" not in rec.tags or rec.articulated:
+            continue
+        half = [v * other.scale / 2 for v in rec.size_m[:2]]
+        if all(abs(obj.pos_m[k] - other.pos_m[k]) < half[k] for k in (0, 1)):
+            return other.name
+    return None
 
 
 def place(items: list[Item], batch: int, table_half: tuple[float, float], device=None
@@ -104,10 +126,15 @@ def _draw(items: list[Item], batch: int, table_half: tuple[float, float], device
     placed: list[tuple[Item, torch.Tensor, torch.Tensor]] = []  # item, footprint centre [B, 2], yaw [B]
     out: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
     all_ok = torch.ones(batch, dtype=torch.bool, device=device)
-    for it in items:
+    for it in sorted(items, key=lambda it: it.starts_in is not None):  # containers before what starts in them
         base = torch.tensor(it.pos, dtype=torch.float32, device=device).expand(batch, 2)
         noise_xy = torch.zeros(batch, 2, device=device)
         noise_yaw = torch.zeros(batch, device=device)
+        if it.starts_in is not None:
+            if it.noise_yaw_rad > 0:
+                noise_yaw = (torch.rand(batch, device=device) * 2 - 1) * it.noise_yaw_rad
+            out[it.name] = (out[it.starts_in][0].clone(), noise_yaw)
+            continue
         todo = torch.ones(batch, dtype=torch.bool, device=device)
         moves = it.noise_xy[0] > 0 or it.noise_xy[1] > 0
         turns = it.noise_yaw_rad > 0

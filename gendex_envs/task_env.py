@@ -56,7 +56,7 @@ from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
 from gendex_envs.heap import freeze_long_lived
 from gendex_envs.observation import flat_float_state
 from gendex_envs.physx import read_pose
-from gendex_envs.placement import Footprint, Item, place
+from gendex_envs.placement import Footprint, Item, place, starts_in
 from gendex_envs.reward_checks import RESERVED_OBS_KEYS, check_obs_extra, check_reward
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.reward_view import reward_info
@@ -275,7 +275,8 @@ class TaskEnv(BaseEnv):
             self._init_pose[obj.name] = (torch.tensor(p, dtype=torch.float32, device=self.device),
                                          torch.tensor(q, dtype=torch.float32, device=self.device))
             self._layout.append(Item(obj.name, (float(p[0]), float(p[1])), obj.randomize.xy_m,
-                                     math.radians(obj.randomize.yaw_deg), self._footprint(obj, q), obj.fixed))
+                                     math.radians(obj.randomize.yaw_deg), self._footprint(obj, q), obj.fixed,
+                                     starts_in(obj, self.task_spec.objects, self._records)))
         with torch.device(self.device):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
             self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}

@@ -27,6 +27,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from gendex_envs.attributes import COLOR_WORDS
+from generator.compound import read_compound
 from generator.constructs import (
     DETERMINERS,
     GROUP_WORDS,
@@ -36,87 +37,12 @@ from generator.constructs import (
     is_off,
     read_amount,
     read_place,
-    split_steps,
 )
 from generator.errors import InstructionError
+from generator.vocabulary import FILLER_WORDS as _FILLER
+from generator.vocabulary import KINDS, ORDINALS, PARTS, SYNONYMS, TASK_SKILLS, TaskSkill
+from generator.vocabulary import STOP_WORDS as _STOP
 
-
-@dataclass(frozen=True)
-class TaskSkill:
-    """One thing a person can ask for."""
-
-    name: str
-    verbs: tuple[str, ...]
-    """Verb phrases that ask for it (lower case, matched on word boundaries)."""
-    objects: str
-    """What it acts on, in words (for messages and prompts)."""
-    example: str
-
-
-TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
-    TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get",
-                       "hoist"),
-              "a graspable object", "pick up the apple"),
-    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck"),
-              "a graspable object and a container (bowl, pot, mug), with 'in' or 'into'", "put the lemon in the bowl"),
-    TaskSkill("place_on", ("set", "put", "place", "lay", "move", "rest"),
-              "a graspable object and a plate, tray or cutting board, with 'on' or 'onto'",
-              "set the bottle on the plate"),
-    TaskSkill("stack", ("stack", "pile", "balance"), "two blocks", "stack the small block on the large block"),
-    TaskSkill("push", ("push", "slide", "shove", "nudge"), "an object on the table, pushed to a goal mark",
-              "push the block to the goal"),
-    TaskSkill("open", ("open", "pull open", "lift open", "unlatch", "raise the lid", "pull", "flip up", "flip open"),
-              "a door, drawer or lid (cabinet, microwave, refrigerator, drawer chest, trash can, box with lid)",
-              "open the top drawer"),
-    TaskSkill("close", ("close", "shut", "push shut", "push closed"),
-              "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
-    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing", "turn off", "switch off", "switch"),
-              "a faucet or valve lever, on or off", "turn on the faucet"),
-    TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
-              "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
-    TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
-              "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",
-              "put the apple to the left of the bowl"),
-)}
-"""The task skills a request may ask for, in the order verbs are tried (earlier skills win ties)."""
-
-SYNONYMS: dict[str, str] = {
-    # phrase -> catalog category (or id)
-    "fridge": "refrigerator", "refrigerator": "refrigerator", "cupboard": "cabinet", "cabinet": "cabinet",
-    "closet": "cabinet", "trash can": "trash_can", "trashcan": "trash_can", "trash bin": "trash_can",
-    "bin": "trash_can", "garbage can": "trash_can", "dustbin": "trash_can", "waste bin": "trash_can",
-    "tap": "faucet", "faucet": "faucet", "mixer tap": "faucet", "drawer": "drawer_chest", "drawers": "drawer_chest",
-    "dresser": "drawer_chest", "chest of drawers": "drawer_chest", "microwave oven": "microwave",
-    "coffee mug": "mug", "cup": "cup", "glass": "wine_glass", "wineglass": "wine_glass", "jug": "pitcher",
-    "saucepan": "pot", "pan": "pot", "cooking pot": "pot", "dish": "plate", "saucer": "plate", "cube": "block",
-    "brick": "foam_brick", "die": "dice", "notebook": "laptop", "computer": "laptop", "lidded box": "box_with_lid",
-    "box with a lid": "box_with_lid", "rubik's cube": "rubiks_cube", "rubik cube": "rubiks_cube",
-    "bottle of mustard": "mustard_bottle", "soup can": "can", "tin": "can", "tin can": "can", "duck": "toy_duck",
-    "rubber duck": "toy_duck", "pen": "marker", "felt pen": "marker", "dial": "knob",
-    "tin of tuna": "tuna_can", "serving bowl": "bowl", "mixing bowl": "bowl", "dinner plate": "plate",
-    "teacup": "cup", "soft brick": "foam_brick", "puzzle cube": "rubiks_cube", "drawer unit": "drawer_chest",
-    "storage box": "box_with_lid", "notebook computer": "laptop", "stove knob": "knob_stove",
-    "chopping board": "cutting_board", "serving tray": "tray", "ball valve": "valve", "shutoff valve": "valve",
-    "stopcock": "valve",
-}
-"""Words people use for catalog objects: phrase -> catalog category or id."""
-
-KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block": "block", "food": "food",
-                         "tool": "tool", "utensil": "utensil", "container": "container", "box": "box",
-                         "thing": "graspable", "object": "graspable", "item": "graspable"}
-"""Words naming a kind of object (a catalog tag): 'a fruit' is any fruit; which one is a recorded choice."""
-
-PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab")
-"""Words naming the part of an articulated object a skill acts on (recorded, never an object on their own)."""
-ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom", "first": "top", "second": "second"}
-
-_STOP = frozenset("a an the this that these those its it of to from with by and then please robot hand your my "
-                  "up down off out over at for some one along until toward towards near beside behind below above "
-                  "under between while without through so".split())
-_FILLER = frozenset("into inside onto top hand goal mark table shut closed open side around across upright away back "
-                    "there here target spot marked place position edge middle centre center surface counter worktop "
-                    "tabletop air way width tower floor".split())
-"""Words after the verb that name no object (places on the table among them)."""
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
 
 
@@ -257,6 +183,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
+    "take_out": ("graspable", "container"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -317,6 +244,11 @@ def _spans(words: list[str], names: dict[str, tuple[str, list[dict]]]) -> list[t
     return sorted(found)
 
 
+def _starts_with_verb(text: str) -> bool:
+    words = _words(text)
+    return any(words[:len(v.split())] == v.split() for s in TASK_SKILLS.values() for v in s.verbs)
+
+
 def _skill(words: list[str]) -> tuple[str, int] | None:
     """The skill the request's verb asks for and where the verb ends; None when no verb of any skill is there."""
     hits = []
@@ -343,6 +275,10 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
         if into:
             return "put_in", end
         return ("place_on" if "place_on" in names else "put_in"), end
+    if " out of " in rest and names[0] in ("lift", "put_in", "place_on", "open", "take_out"):
+        return "take_out", end  # take the apple out of the bowl, pull the can out of the pot
+    if "take_out" in names and " lid " in rest:
+        return "open", end  # remove the lid
     if names[0] in ("lift", "push", "turn") and (" open " in rest or " lid off " in rest):
         return "open", end  # lift the lid open, swing the door open, take the lid off
     if "turn" in names and "reorient" in names:
@@ -357,15 +293,10 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if not text:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
-    steps = split_steps(text)
-    if len(steps) > 1:  # each step read on its own; 'it' is the previous step's first object
-        readings: list[Reading] = []
-        for step in steps:
-            if readings and readings[-1].objects:
-                m = readings[-1].objects[0]
-                step = re.sub(r"\b(it|them)\b", f"the {m.color + ' ' if m.color else ''}{m.phrase}", step)
-            readings.append(read_instruction(step, assets))
-        return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
+    compound = read_compound(text, assets, lambda step: read_instruction(step, assets), _starts_with_verb,
+                             lambda step: _skill(_words(step)))
+    if compound is not None:  # steps in order, 'and' and a verb, several objects to one place
+        return compound
     words = _words(text)
     _refuse_unbuilt(text, words)
     found = _skill(words)
@@ -511,8 +442,6 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
         if skill not in ("open", "turn") and is_off(words):
             found.append(("a direction ('off')", f"turning off with the '{skill}' skill"))  # 'switch off the oven'
 
-        if skill in ("lift", "put_in", "place_on") and find(words, "out of") >= 0:  # not 'sticking out of'
-            found.append(("an object taken out of another ('out of')", "taking out of a container"))
     if found:
         what, construct = found[0]
         raise InstructionError(

@@ -63,7 +63,9 @@ def proposal_signature(proposal: dict) -> Signature:
         obj, target = objects.get(succ.get("object")), objects.get(succ.get("target"))
         found.add(condition_skill(succ["type"], target_category=target["category"] if target else None,
                                   target_is_goal=succ.get("target") == GOAL_TARGET, negate=bool(succ.get("negate")),
-                                  part=part_of(obj) if obj and obj.get("joints") else None))
+                                  part=part_of(obj) if obj and obj.get("joints") else None,
+                                  taken_out=any(o.get("starts_in") == succ.get("target") and o["name"] == succ["object"]
+                                                for o in proposal["objects"] if o.get("starts_in"))))
     found |= {s["skill"] for s in proposal["steps"] if s["skill"] in STAGE_TASK_SKILLS}
     return tuple(k for k in TASK_SKILLS if k in found), tuple(sorted({kind(a) for a in objects.values()}))
 

@@ -91,6 +91,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "deposit the {o} in the {d}",
         "pop the {o} into the {d}",
     ),
+    "take_out": (
+        "take the {o} out of the {d}",
+        "get the {o} out of the {d}",
+        "lift the {o} out of the {d} and leave it on the {s}",
+        "remove the {o} from the {d}",
+        "pull the {o} out of the {d}",
+    ),
     "place_on": (
         "set the {o} down on the {d}",
         "lay the {o} on the {d}",

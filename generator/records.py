@@ -23,6 +23,8 @@ class ProposedObject:
     role: str
     color: str | None = None
     """The named colour the task paints it (``gendex_envs.attributes.COLORS``); None: the asset's own."""
+    starts_in: str | None = None
+    """The name of the proposal's container this object starts inside (*take the apple out of the bowl*)."""
 
 
 @dataclass(frozen=True)

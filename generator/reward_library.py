@@ -192,39 +192,67 @@ def _get_obs_extra(env, info):
     return src
 
 
-_COMPOSED = '''REWARD_MAX = 7.0
-LIFT_M = 0.1
 
 
-def evaluate(env):
-{fail}    return {{"fail": fail, "open_fraction": env.joint_open_fraction({art!r}), "height": env.obj_height({obj!r})}}
+def _composed(spec: dict, conds: list[dict], fail: str) -> str:
+    """Reward of a task of several parts done in turn (``conds``, one success condition each): each part's terms
+    count once the parts before it are done, and a done part counts its whole weight. A joint part is done at its
+    progress 0.99, a lift at its height; a part that sets an object down, once the object is over where it goes
+    (:func:`rt.place` above :data:`PART_DONE_PLACE`) and back down (below half the lift)."""
+    keys, lines = [], []
+    for k, c in enumerate(conds):
+        obj = c["object"]
+        if c["type"] in ("joint_open", "joint_at"):
+            keys.append(f'"open_fraction_{k}": env.joint_open_fraction({obj!r})')
+            lines.append(f"    d = rt.fraction({_progress(c, f'open_fraction_{k}')})\n"
+                         f"    done = d > 0.99\n"
+                         f"    reward = reward + gate * torch.where(done, torch.full_like(d, 2.0), 2.0 * d)\n"
+                         f"    gate = gate * done\n")
+            continue
+        keys.append(f'"height_{k}": env.obj_height({obj!r})')
+        carry = _carry_term(c.get("target"), placed_goal(c, spec)).strip()
+        lines.append(f"    p = env.obj_pose({obj!r}).p\n"
+                     f"    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))\n"
+                     f"    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj({obj!r})))\n"
+                     f"    lifted = rt.lift(info[\"height_{k}\"], LIFT_M)\n"
+                     f"    {carry}\n"
+                     + ("    done = lifted > 0.99\n" if c["type"] == "lifted" else
+                        f"    over = rt.place(p, {_goal_point(c, spec)})\n"
+                        f"    done = (over > PART_DONE_PLACE) & (info[\"height_{k}\"] < LIFT_M / 2)\n")
+                     +
+                     "    reward = reward + gate * torch.where(done, torch.full_like(reach, 4.0), "
+                     "reach + grasp + lifted + carry)\n"
+                     "    gate = gate * done\n")
+    weights = sum(2.0 if c["type"] in ("joint_open", "joint_at") else 4.0 for c in conds)
+    return (f"REWARD_MAX = {weights + 1.0}\nLIFT_M = 0.1\nPART_DONE_PLACE = {PART_DONE_PLACE}\n\n\n"
+            f"def evaluate(env):\n{fail}    return {{\"fail\": fail, {', '.join(keys)}}}\n\n\n"
+            "def compute_dense_reward(env, obs, action, info):\n"
+            "    reward = torch.zeros(env.num_envs, device=env.device)\n"
+            "    gate = torch.ones(env.num_envs, device=env.device)\n"
+            + "".join(lines)
+            + "    return torch.where(info[\"success\"], torch.full_like(reward, REWARD_MAX), reward)\n")
 
 
-def compute_dense_reward(env, obs, action, info):
-    first = rt.fraction({progress})
-    p = env.obj_pose({obj!r}).p
-    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
-    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj({obj!r})))
-    lifted = rt.lift(info["height"], LIFT_M)
-{carry}    reward = 2.0 * first + (first > 0.99) * (reach + grasp + lifted + carry)
-    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+def _goal_point(cond: dict, spec: dict) -> str:
+    """Code for the [N, 3] point a part's object is set down at: its target's position, or a place's point."""
+    return placed_goal(cond, spec) or f"env.obj_pose({cond['target']!r}).p"
 
 
-def _get_obs_extra(env, info):
-    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p, "open_fraction": info["open_fraction"][:, None]}}
-'''
-"""Reward of a composed task: the articulated part's progress first, then the rigid part's staged terms."""
-
-
-def _progress(cond: dict) -> str:
-    """A joint condition's progress in [0, 1] as code: a shut joint from open (0) to shut past the fraction (1); a
-    joint set part way (``joint_at``) from the far end of its range (0) to the fraction (1)."""
+def _progress(cond: dict, key: str = "open_fraction") -> str:
+    """A joint condition's progress in [0, 1] as code, from ``info[key]`` (the joint's open fraction): a shut joint
+    from open (0) to shut past the fraction (1); a joint set part way (``joint_at``) from the far end of its range
+    (0) to the fraction (1)."""
+    x = f'info["{key}"]'
     if cond["type"] == "joint_at":
         frac = float(cond["fraction"])
-        return f'1.0 - (info["open_fraction"] - {frac!r}).abs() / {max(frac, 1.0 - frac)!r}'
+        return f'1.0 - ({x} - {frac!r}).abs() / {max(frac, 1.0 - frac)!r}'
     frac = float(cond.get("min_fraction") or 0.8)
-    return (f'(1.0 - info["open_fraction"]) / {1.0 - frac!r}' if cond.get("negate")
-            else f'info["open_fraction"] / {frac!r}')
+    return f'(1.0 - {x}) / {1.0 - frac!r}' if cond.get("negate") else f'{x} / {frac!r}'
+
+
+PART_DONE_PLACE = 0.8
+"""A composed task's part that carries an object is done once :func:`rt.place` of the object and where it goes is
+above this (within about 2 cm)."""
 
 
 def _carry_term(target: str | None, goal: str | None = None) -> str:
@@ -265,13 +293,9 @@ def compose_task_module(spec: dict, roles: dict[str, str]) -> str:
     the articulated part's condition first, then the rigid part's)."""
     conds = _parts(spec)
     if len(conds) > 1:
-        joint = next(c for c in conds if c["type"] in ("joint_open", "joint_at"))
-        rest = next(c for c in conds if c is not joint)
         rigid = _rigid(spec, roles)
         fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
-        return _header(f"{spec['name']}: {spec['instruction']}") + _COMPOSED.format(
-            fail=fail, art=joint["object"], obj=rest["object"], progress=_progress(joint),
-            carry=_carry_term(rest.get("target"), placed_goal(rest, spec)))
+        return _header(f"{spec['name']}: {spec['instruction']}") + _composed(spec, conds, fail)
     cond = _success_condition(spec)
     rigid = _rigid(spec, roles)
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE

@@ -1,7 +1,7 @@
 """What the task library holds, in numbers: ``gendex stats [--json]``.
 
 Per task (the latest version of each, or every version): the task skills it exercises (:func:`task_skills`, the
-thirteen of ``docs/solving.md``), its objects and stages. Over the library:
+thirteen of ``docs/solving.md``, places and take-outs), its objects and stages. Over the library:
 
 - tasks per skill, skills covered, assets used, stages per task, tasks with an articulated object vs rigid only;
 - **instruction diversity**: the mean pairwise cosine similarity of the task instructions' all-MiniLM-L6-v2
@@ -31,8 +31,9 @@ from generator.instruction import part_kinds
 from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
-               "close_drawer", "open_lid", "close_lid", "turn", "reorient")
-"""The thirteen task skills (the solver issue's list, in its order)."""
+               "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out")
+"""The task skills: the solver issue's thirteen in its order, then the task language's places (``place_at``: set
+down beside, between or in a region) and taking an object out of a container (``take_out``)."""
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
@@ -61,8 +62,11 @@ def part_of(asset: dict, joint: str | None = None) -> str:
 
 
 def condition_skill(kind: str, *, target_category: str | None = None, target_is_goal: bool = False,
-                    part: str | None = None, negate: bool = False) -> str | None:
-    """The task skill a success condition of type ``kind`` asks for (None for conditions that name none)."""
+                    part: str | None = None, negate: bool = False, taken_out: bool = False) -> str | None:
+    """The task skill a success condition of type ``kind`` asks for (None for conditions that name none);
+    ``taken_out``: a ``placed`` object starts in its target (a take-out)."""
+    if kind == "placed":
+        return "take_out" if taken_out else "place_at"
     if kind == "lifted":
         return "lift"
     if kind == "inside":
@@ -82,6 +86,20 @@ STAGE_TASK_SKILLS = ("reorient", "push", "turn")
 """Stage skills that are task skills by themselves, whatever the success condition."""
 
 
+def _starts_in(spec: TaskSpec, name: str | None, target: str | None) -> bool:
+    """Whether spec object ``name`` starts inside container ``target`` (raised off the table over its footprint:
+    :func:`gendex_envs.placement.starts_in`)."""
+    from gendex_envs.placement import STARTS_IN_MIN_CLEARANCE_M
+
+    objs = {o.name: o for o in spec.objects}
+    if name not in objs or target not in objs or objs[name].pos_m[2] <= STARTS_IN_MIN_CLEARANCE_M:
+        return False
+    o, t = objs[name], objs[target]
+    a = asset_dict(t.asset)
+    return "container" in a["tags"] and all(abs(o.pos_m[k] - t.pos_m[k]) < a["size_m"][k] * t.scale / 2
+                                            for k in (0, 1))
+
+
 def task_skills(spec: TaskSpec) -> tuple[str, ...]:
     """The task skills ``spec`` exercises, from its success conditions and stage skills (in :data:`TASK_SKILLS`
     order)."""
@@ -92,7 +110,8 @@ def task_skills(spec: TaskSpec) -> tuple[str, ...]:
         target = assets.get(c.target) if c.target is not None else None
         found.add(condition_skill(c.type, target_category=target["category"] if target else None,
                                   target_is_goal=c.target == GOAL_TARGET, negate=bool(c.negate),
-                                  part=part_of(obj, c.joint) if obj and obj.get("joints") else None))
+                                  part=part_of(obj, c.joint) if obj and obj.get("joints") else None,
+                                  taken_out=c.type == "placed" and _starts_in(spec, c.object, c.target)))
     found |= {s.skill for s in spec.stages if s.skill in STAGE_TASK_SKILLS}
     return tuple(k for k in TASK_SKILLS if k in found)
 

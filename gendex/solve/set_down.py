@@ -49,7 +49,11 @@ def set_down_point(env, c: ConditionSpec) -> np.ndarray:
     if c.relation == "next_to":
         d = p - a
         n = float(np.linalg.norm(d))
-        return a + gap * (d / n if n > 1e-6 else -fwd)
+        if n >= lo:  # beside it already, out of the band: set down on the side it comes from
+            return a + gap * d / n
+        # it starts in or against the target (taken out of a bowl): sideways, towards the middle of the robot's reach
+        side = -float(np.sign(np.dot(a - base, left))) or 1.0
+        return a + gap * side * left
     axis = {"left_of": left, "right_of": -left, "behind": fwd, "in_front_of": -fwd}[c.relation]
     return a + gap * axis
 

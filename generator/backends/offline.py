@@ -48,7 +48,7 @@ from generator.backends.wording import word as _w
 from generator.constructs import amount_text, amount_word, joint_fraction
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
-from generator.phrasing import Part, painted, phrase, phrase_parts, qualifiers
+from generator.phrasing import MODEL_WORDS, Part, names_for, painted, phrase, phrase_parts, qualifiers
 from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
@@ -65,10 +65,13 @@ PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a genera
 PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
-              "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "composed")
+              "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "several",
+              "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
-(``composed``)."""
+(``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
+TWO_IN_M = 0.2
+"""A container the autonomous grammar puts two objects in is at least this wide (the large bowl, the pot)."""
 COMPOSE_STRIDE = 12
 """Each articulated first part is composed with every COMPOSE_STRIDE-th rigid task (a different slice for each)."""
 COMPOSED_WEIGHT = 2.0
@@ -89,7 +92,8 @@ class OfflineBackend:
         self.seed = int(seed)
         unknown = sorted(set(kinds or ()) - set(TASK_KINDS))
         if unknown:
-            raise BackendError(f"unknown kind(s) of task {unknown}; the offline grammar writes: {', '.join(TASK_KINDS)}")
+            raise BackendError(f"unknown kind(s) of task {unknown}; the offline grammar writes: "
+                               f"{', '.join(TASK_KINDS)}")
         self.kinds = tuple(kinds) if kinds else None
         """The kinds of task :meth:`_propose` draws from (None: every kind, :data:`TASK_KINDS`)."""
         self._wording = ProposalWording()
@@ -158,6 +162,18 @@ class OfflineBackend:
         out += [("turn_part", self._articulated_task("turn", by_id[i], PART_TURN)) for (s, i), lay
                 in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]]
         out += [("place_at", t) for t in placed_tasks.placed_options(g, c + p, self._words)]
+        # several objects: two put in one large container (each gets 80 % of it to itself: the second lands beside
+        # the first); a tower of the three blocks, the smallest on top
+        names = lambda i: names_for(by_id[i], MODEL_WORDS.get(i, ""))  # noqa: E731
+        for k, a in enumerate(g):
+            b, box = g[(3 * k + 5) % len(g)], [x for x in c if _min_xy(x) >= TWO_IN_M]
+            if box and a["category"] != b["category"] and all(fits_in(x, box[k % len(box)]) for x in (a, b)):
+                parts = [self._put_task(a, box[k % len(box)]), self._put_task(b, box[k % len(box)])]
+                out.append(("several", sequence.join_steps(parts, _acts, set(), names)))
+        blocks = sorted((x for x in g if x["category"] == "block"), key=_min_xy)
+        if len(blocks) >= 3:
+            out.append(("several", sequence.join_steps([self._stack_task(blocks[1], blocks[2]),
+                                                        self._stack_task(blocks[0], blocks[1])], _acts, set(), names)))
         # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
@@ -357,11 +373,19 @@ class OfflineBackend:
                                "(generator.instruction.read_instruction) in the request context")
         assets = {a["id"]: a for a in ctx["assets"]}
         existing = set(ctx.get("existing_tasks", []))
-        if reading.get("then"):  # steps in order: each its own task, joined where the solver does them in turn
-            step = lambda r: sequence.parse_step(self._propose_guided(request, ctx | {"reading": r}))  # noqa: E731
-            return _fence("json", json.dumps(sequence.sequence_task(step, reading, _acts, existing), indent=2))
+        # steps in order (and towers: one stack per block): each its own task, joined where the solver does them
+        # in turn; a step is named as if alone, the joined task apart from the existing ones
+        step = lambda r: sequence.parse_step(self._propose_guided(request, ctx | {"reading": r,  # noqa: E731
+                                                                                 "existing_tasks": []}))
+        names = lambda i: names_for(assets[i], MODEL_WORDS.get(i, ""))  # noqa: E731
+        if reading.get("then"):
+            return _fence("json", json.dumps(sequence.sequence_task(step, reading, _acts, existing, names), indent=2))
         skill = reading["skill"]
         mentions = reading["objects"]
+        if skill == "stack" and len(mentions) > 2:  # a tower, top first: the base's neighbour on it first
+            steps = [step(reading | {"objects": [mentions[k - 1], mentions[k]]})
+                     for k in range(len(mentions) - 1, 0, -1)]
+            return _fence("json", json.dumps(sequence.join_steps(steps, _acts, existing, names), indent=2))
         subs: dict[str, str] = {}
 
         def pick(k: int, ok, what: str, smallest: bool = False) -> dict:
@@ -402,6 +426,10 @@ class OfflineBackend:
             refs = [pick(k, lambda x: not x.get("joints"), "object to set it by") for k in range(1, len(mentions))]
             a = pick(0, graspable, "object to set down")
             proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
+        elif skill == "take_out":
+            g = pick(0, graspable, "object to take out")
+            proposal = placed_tasks.take_out_task(g, pick(1, lambda x: container(x) and fits_in(g, x),
+                                                          "container it fits in"), colors, self._words)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))

@@ -14,6 +14,7 @@ from generator.backends import placed as placed_tasks
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
 from generator.backends.roles import _acts, _round, graspable
 from generator.backends.wording import fence as _fence
+from generator.critic.physical import CONTAINER_FLOOR_M
 
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
@@ -53,7 +54,9 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     goal = None
     movable = _movable_region(proposal, assets, acts)
     place = next((c for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "placed"), None)
-    spots = {} if place is None else placed_tasks.placed_layout(place, place["object"], rng)
+    inside = {o["name"]: o["starts_in"] for o in proposal["objects"] if o.get("starts_in")}
+    spots = ({} if place is None else placed_tasks.take_out_layout(place, place["object"], rng)
+             if place["object"] in inside else placed_tasks.placed_layout(place, place["object"], rng))
     for o in proposal["objects"]:
         a = assets[o["asset"]]
         # articulated objects anywhere at the back, movable ones where the solver measurably works (module
@@ -83,6 +86,9 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
             entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
         else:  # what the solver issue asks of every task: +-8 cm, any yaw if round, else +-45 deg
             entry["randomize"] = {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}
+            if o["name"] in inside:  # on the floor of its container, moving with it at reset
+                entry["pos_m"][2] = CONTAINER_FLOOR_M
+                entry["randomize"]["xy_m"] = [0.0, 0.0]
             if proposal["success"].get("target") == "goal" and goal is None:
                 # a push: the goal mark PUSH_M across the table, towards its middle
                 gy = y - np.sign(y or 1.0) * PUSH_M
@@ -93,8 +99,10 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     stages = []
     for i, s in enumerate(proposal["steps"]):
         method = "motion_planning" if s["skill"] in ("reach", "carry", "place") else "RL"
-        repeated = i > 0 and s["skill"] == proposal["steps"][i - 1]["skill"]
-        stages.append({"name": f"{s['skill']}_{s['target']}" + (f"_{i}" if repeated else ""),
+        name = f"{s['skill']}_{s['target']}"
+        repeated = (i > 0 and s["skill"] == proposal["steps"][i - 1]["skill"]) or any(st["name"] == name
+                                                                                       for st in stages)
+        stages.append({"name": name + (f"_{i}" if repeated else ""),
                        "instruction": s["instruction"], "skill": s["skill"], "method": method,
                        "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
                        "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})

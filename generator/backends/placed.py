@@ -15,13 +15,17 @@ import numpy as np
 from gendex_envs.spec import RobotSpec
 from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
 from generator.backends.wording import camel, step, word
-from generator.phrasing import names_for, painted
+from generator.phrasing import names_for, painted, phrase, qualifiers
 
 HAND_ROOM_M = 0.06
 """Centre distance beyond touching that a side relation's band starts at: room for the fingers round the held object
 (at 2 cm the hand setting a lemon down in front of a cutting board pushed the board out of the band, dev seeds)."""
 BAND_M = 0.15
 """Width of a side or ``next_to`` relation's band of centre distances."""
+TAKE_OUT_ROOM_M = 0.03
+"""A taken-out object lies at least this far beyond touching its container (out of it, not leaning on its rim)."""
+TAKE_OUT_BAND_M = 0.12
+"""Width of a take-out's ``next_to`` band."""
 REGION_WORDS = {"left": "left side", "right": "right side", "near": "near side", "far": "far side",
                 "centre": "middle", "near_left": "near left corner", "near_right": "near right corner",
                 "far_left": "far left corner", "far_right": "far right corner"}
@@ -42,16 +46,48 @@ def _radius(a: dict) -> float:
 
 
 def placed_condition(n: str, a: dict, relation: str, b: dict | None = None, names: tuple[str, ...] = (),
-                     region: str | None = None, c: dict | None = None) -> dict:
-    """The ``placed`` success condition for object ``n`` (asset ``a``); ``names``: the reference objects' names."""
+                     region: str | None = None, c: dict | None = None, room: float = HAND_ROOM_M,
+                     band: float = BAND_M) -> dict:
+    """The ``placed`` success condition for object ``n`` (asset ``a``); ``names``: the reference objects' names;
+    ``room`` and ``band``: a side relation's room beyond touching and its width."""
     cond: dict = {"type": "placed", "object": n, "relation": relation}
     if relation == "in_region":
         return cond | {"region": region}
     cond["target"] = names[0]
     if relation == "between":
         return cond | {"other": names[1], "min_gap_m": round(max(_radius(b), _radius(c)) + _radius(a) + 0.02, 3)}
-    lo = _radius(b) + _radius(a) + HAND_ROOM_M
-    return cond | {"min_gap_m": round(lo, 3), "max_gap_m": round(lo + BAND_M, 3)}
+    lo = _radius(b) + _radius(a) + room
+    return cond | {"min_gap_m": round(lo, 3), "max_gap_m": round(lo + band, 3)}
+
+
+def take_out_task(a: dict, b: dict, colors: tuple[str | None, ...], words: Callable[[str], np.random.Generator]
+                  ) -> dict:
+    """The proposal: ``a`` starts inside container ``b`` and is taken out and set down on the table next to it
+    (``next_to`` with :data:`TAKE_OUT_ROOM_M` and :data:`TAKE_OUT_BAND_M`)."""
+    n, t = a["category"], b["category"] if b["category"] != a["category"] else b["id"]
+    name = camel("take", *painted(a, colors, 0), "out", "of", *painted(b, colors, 1))
+    return {
+        "name": name,
+        "description": phrase("take_out", a, words(name), other=b, **qualifiers(a, b, colors)),
+        "objects": [{"name": n, "asset": a["id"], "role": "graspable", "starts_in": t}
+                    | ({"color": colors[0]} if colors and colors[0] else {}),
+                    {"name": t, "asset": b["id"], "role": "container"}
+                    | ({"color": colors[1]} if len(colors) > 1 and colors[1] else {})],
+        "steps": [step("reach", n, "arm", f"Bring the open hand to the {word(n)} in the {word(t)}."),
+                  step("grasp", n, "hand", f"Close the fingers around the {word(n)}."),
+                  step("carry", t, "arm", f"Lift the {word(n)} out of the {word(t)} and carry it beside it."),
+                  step("release", n, "hand", f"Set the {word(n)} down on the table and let go of it.")],
+        "success": placed_condition(n, a, "next_to", b, (t,), room=TAKE_OUT_ROOM_M, band=TAKE_OUT_BAND_M),
+        "success_text": f"The {word(n)} is out of the {word(t)}, on the table next to it.",
+    }
+
+
+def take_out_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, list[float]]:
+    """Nominal (x, y) of a take-out's container, to one side of the table's middle (the object is set down on the
+    side towards the middle, :func:`gendex.solve.set_down.set_down_point`), and of the object in it."""
+    side = float(np.sign(rng.uniform(-1, 1)) or 1.0)
+    x, y = float(rng.uniform(0.0, 0.15)), side * float(rng.uniform(0.1, 0.2))
+    return {cond["target"]: [x, y], held: [x, y]}
 
 
 def command(rng: np.random.Generator, a: dict, relation: str, b: dict | None, c: dict | None,
@@ -146,5 +182,6 @@ def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, 
     return {cond["target"]: [0.1, y_ref], held: [0.1, y_ref + cond["max_gap_m"] + 0.18]}
 
 
-__all__ = ["BAND_M", "HAND_ROOM_M", "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS", "command",
-           "placed_condition", "placed_layout", "placed_options", "placed_task"]
+__all__ = ["BAND_M", "HAND_ROOM_M", "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS",
+           "TAKE_OUT_BAND_M", "TAKE_OUT_ROOM_M", "command", "placed_condition", "placed_layout", "placed_options",
+           "placed_task", "take_out_layout", "take_out_task"]

@@ -1,20 +1,30 @@
 """The offline author's tasks for requests of several steps in order (*close the microwave, then set the bottle on
-the plate*): each step written as its own guided task, then joined into one composed task (both success conditions,
-the steps in turn) where the solver measurably does the two in turn, else refused saying what it writes."""
+the plate*; *put the lemon and the plum in the bowl*) and for towers: each step written as its own guided task, then
+joined into one composed task (every step's success condition, the steps in turn) where the solver measurably does
+them in turn, else refused saying what it joins.
+
+What it joins (:data:`WRITES`): first, at most one door or lid the open hand closes (or a lid it opens); then up to
+:data:`MAX_RIGID_STEPS` rigid steps, each moving another object (lifted, put in a container, set down on or by
+something, stacked), where later steps may put things in or on what earlier ones used; a lift only last (the object
+is still held at the end). A lift followed by a step that moves the same object is that step (*pick up the apple,
+then put it in the bowl* is the put)."""
 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Callable
 
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.errors import InstructionError
 from generator.phrasing import split
 
-SECOND_SUCCESS = ("lifted", "inside", "near", "over", "placed")
-"""Success types a second step may have: a rigid object lifted or set down somewhere."""
-WRITES = ("a door or lid the open hand closes (or a lid it opens), then lifting an object, putting it in a "
-          "container or setting it down on or by something")
+RIGID_SUCCESS = ("lifted", "inside", "near", "over", "placed")
+"""Success types of a rigid step: an object lifted or set down somewhere."""
+MAX_RIGID_STEPS = 3
+"""Rigid steps one task joins (each a reach, grasp, carry and release: three fit the episode's time)."""
+WRITES = ("a door or lid the open hand closes (or a lid it opens) first, then up to three steps that each lift, put "
+          "in, set down or stack another object")
 
 
 def _first_is_composable(first: dict, acts: dict[str, str]) -> bool:
@@ -27,37 +37,97 @@ def _first_is_composable(first: dict, acts: dict[str, str]) -> bool:
             and acts.get(o["name"]) in ("close", "open") and layout.get("composed", True))
 
 
-def sequence_task(propose_step: Callable[[dict], dict], reading: dict, acts: Callable[[dict], dict[str, str]],
-                  existing: set[str]) -> dict:
-    """The proposal for a two-step ``reading`` (its ``then``), from ``propose_step(step_reading)`` (one step's
-    guided proposal); :class:`InstructionError` when the steps are not ones this author joins."""
-    then = reading.get("then") or []
-    if len(then) != 1:
-        raise InstructionError(f"the offline author writes at most two steps in order ({WRITES}); the request has "
-                               f"{len(then) + 1}")
-    first = propose_step(reading | {"then": []})
-    second = propose_step(then[0])
-    if not _first_is_composable(first, acts(first)) or any(o["role"] == "articulated" for o in second["objects"]) \
-            or second["success"]["type"] not in SECOND_SUCCESS:
-        raise InstructionError(f"the offline author writes two steps in order only as {WRITES}; it cannot write "
-                               f"'{first['name']}' then '{second['name']}' as one task yet")
-    if {o["name"] for o in first["objects"]} & {o["name"] for o in second["objects"]}:
-        raise InstructionError("the two steps name the same object; the offline author joins steps on different "
-                               "objects only")
-    name, k = f"{first['name']}Then{second['name']}", 2
-    base = name
-    while name in existing:
-        name, k = f"{base}{k}", k + 1
-    commands = [split(p["description"])[1].rstrip(".") for p in (first, second)]
+def _is_rigid(step: dict) -> bool:
+    return (not any(o["role"] == "articulated" for o in step["objects"])
+            and step["success"]["type"] in RIGID_SUCCESS and not step.get("also"))
+
+
+def _moves(step: dict) -> str:
+    """The name of the object a rigid step moves (its success condition's object)."""
+    return step["success"]["object"]
+
+
+def _one_word_each(commands: list[str], steps: list[dict], names_of: Callable[[str], tuple[str, ...]]) -> list[str]:
+    """``commands`` with an object that several steps name called by the word the first of them used (each step is
+    worded on its own: *the mixing bowl*, then *the serving bowl* would read as two bowls); not where another object
+    of the task has the same words."""
+    out = list(commands)
+    assets = [o["asset"] for s in steps for o in s["objects"]]
+    for k, step in enumerate(steps[1:], 1):
+        for o in step["objects"]:
+            words = sorted(names_of(o["asset"]), key=len, reverse=True)
+            others = {a for a in assets if a != o["asset"]}
+            if any(set(words) & set(names_of(a)) for a in others):
+                continue
+            earlier = next((c for c, st in zip(commands[:k], steps[:k], strict=True)
+                            if any(x["asset"] == o["asset"] for x in st["objects"])), None)
+            said = next((w for w in words if earlier and re.search(rf"\b{re.escape(w)}\b", earlier)), None)
+            if said is not None:
+                out[k] = re.sub("|".join(rf"\b{re.escape(w)}\b" for w in words), said, out[k])
+    return out
+
+
+def join_steps(steps: list[dict], acts: Callable[[dict], dict[str, str]], existing: set[str],
+               names_of: Callable[[str], tuple[str, ...]] = lambda asset: ()) -> dict:
+    """One composed proposal of the step proposals ``steps`` (in order), or :class:`InstructionError` when this
+    author does not join them (see the module docstring). ``names_of``: the words a command may call an asset by
+    (one word for an object several steps name)."""
+    kept: list[dict] = []
+    for s in steps:  # a lift, then a step that moves the same object: that step alone
+        if kept and kept[-1]["success"]["type"] == "lifted" and _is_rigid(s) and _moves(s) == _moves(kept[-1]):
+            kept.pop()
+        kept.append(s)
+    if len(kept) == 1:
+        return _unique(kept[0], existing)
+    first, rest = (kept[0], kept[1:]) if _first_is_composable(kept[0], acts(kept[0])) else (None, kept)
+    if not all(_is_rigid(s) for s in rest) or len(rest) > MAX_RIGID_STEPS:
+        names = ", then ".join(f"'{s['name']}'" for s in kept)
+        raise InstructionError(f"the offline author writes steps in order only as {WRITES}; it cannot write {names} "
+                               "as one task yet")
+    if any(s["success"]["type"] == "lifted" for s in rest[:-1]):
+        raise InstructionError("a lifted object must still be held when the task ends, so the offline author writes a "
+                               "lift as the last step only (one hand cannot hold it and work on)")
+    moved = [_moves(s) for s in rest]
+    if len(set(moved)) != len(moved):
+        raise InstructionError(f"two steps move the same object ({', '.join(moved)}); the offline author joins steps "
+                               "that each move another object")
+    objects: dict[str, dict] = {}
+    for s in kept:
+        for o in s["objects"]:
+            seen = objects.setdefault(o["name"], o)
+            if seen["asset"] != o["asset"]:
+                raise InstructionError(f"two steps name '{o['name']}' for different objects ({seen['asset']}, "
+                                       f"{o['asset']}); name them apart")
+    if first is not None and first["objects"][0]["name"] in moved:
+        raise InstructionError("a step moves the object whose door or lid the first step works; the offline author "
+                               "joins steps on different objects only")
+    commands = _one_word_each([split(s["description"])[1].rstrip(".") for s in kept], kept, names_of)
     text = ", then ".join(commands)
-    rest = second["success_text"]
-    return {
-        "name": name, "description": text[:1].upper() + text[1:] + ".",
-        "objects": first["objects"] + second["objects"], "steps": first["steps"] + second["steps"],
-        "success": first["success"], "also": [second["success"]],
-        "success_text": f"{first['success_text'][:-1]}, and {rest[:1].lower()}{rest[1:]}",
-        "substitutions": {**first.get("substitutions", {}), **second.get("substitutions", {})},
-    }
+    texts = [s["success_text"].rstrip(".") for s in kept]
+    return _unique({
+        "name": "Then".join(s["name"] for s in kept), "description": text[:1].upper() + text[1:] + ".",
+        "objects": list(objects.values()), "steps": [st for s in kept for st in s["steps"]],
+        "success": kept[0]["success"], "also": [s["success"] for s in kept[1:]],
+        "success_text": ", and ".join([texts[0]] + [t[:1].lower() + t[1:] for t in texts[1:]]) + ".",
+        "substitutions": {k: v for s in kept for k, v in s.get("substitutions", {}).items()},
+    }, existing)
+
+
+def _unique(proposal: dict, existing: set[str]) -> dict:
+    """``proposal`` named apart from the ``existing`` tasks (a number after its name)."""
+    base, k = proposal["name"], 2
+    while proposal["name"] in existing:
+        proposal = proposal | {"name": f"{base}{k}"}
+        k += 1
+    return proposal
+
+
+def sequence_task(propose_step: Callable[[dict], dict], reading: dict, acts: Callable[[dict], dict[str, str]],
+                  existing: set[str], names_of: Callable[[str], tuple[str, ...]] = lambda asset: ()) -> dict:
+    """The proposal for a reading of several steps (its ``then``), from ``propose_step(step_reading)`` (one step's
+    guided proposal); :class:`InstructionError` when the steps are not ones this author joins."""
+    readings = [reading | {"then": []}, *(reading.get("then") or [])]
+    return join_steps([propose_step(r) for r in readings], acts, existing, names_of)
 
 
 def parse_step(text: str) -> dict:
@@ -65,4 +135,4 @@ def parse_step(text: str) -> dict:
     return json.loads(text.split("```json\n", 1)[1].rsplit("```", 1)[0])
 
 
-__all__ = ["SECOND_SUCCESS", "WRITES", "parse_step", "sequence_task"]
+__all__ = ["MAX_RIGID_STEPS", "RIGID_SUCCESS", "WRITES", "join_steps", "parse_step", "sequence_task"]

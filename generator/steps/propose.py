@@ -31,11 +31,13 @@ from generator.steps.common import ask, parse_json_block
 
 log = logging.getLogger(__name__)
 
-MAX_OBJECTS = 3
-MAX_STEPS = 8
-"""Steps of a proposal: up to 4 for one skill (reach, grasp, carry, release), up to 8 for a composed task."""
-MAX_PARTS = 2
-"""Success conditions of a proposal: one, or one per part of a composed task (``success`` and ``also``)."""
+MAX_OBJECTS = 6
+"""Objects of a proposal: up to three for one part (a place between two others), more for parts done in turn."""
+MAX_PARTS = 4
+"""Success conditions of a proposal: one, or one per part of a composed task (``success`` and ``also``): a door or
+lid and three rigid parts at most (:data:`generator.backends.sequence.MAX_RIGID_STEPS`)."""
+MAX_STEPS = 4 * MAX_PARTS
+"""Steps of a proposal: up to 4 for a part (reach, grasp, carry, release)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
                 "min_dz_m", "max_dz_m", "fraction", "max_error", "relation", "other", "region", "min_gap_m",
                 "max_gap_m", "max_offset_m")
@@ -78,12 +80,18 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
             raise ProposalError(f"objects[{i}]: asset {o['asset']!r} {kind} articulated but has role {o['role']!r}")
         if o.get("color") is not None and o["color"] not in COLORS:
             raise ProposalError(f"objects[{i}]: color {o['color']!r} is not one of {list(COLORS)}")
-        objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"]), o.get("color")))
+        objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"]), o.get("color"),
+                                      None if o.get("starts_in") is None else str(o["starts_in"])))
     if not 1 <= len(objects) <= MAX_OBJECTS:
         raise ProposalError(f"a task uses 1 to {MAX_OBJECTS} objects, the proposal has {len(objects)}")
     names = [o.name for o in objects]
     if len(set(names)) != len(names):
         raise ProposalError(f"object names must be unique: {names}")
+    holders = {o.name for o in objects if o.role == "container"}
+    for i, o in enumerate(objects):
+        if o.starts_in is not None and (o.starts_in not in holders or o.role != "graspable"):
+            raise ProposalError(f"objects[{i}]: starts_in {o.starts_in!r} must name a container of the proposal "
+                                f"({sorted(holders) or 'none'}), for a graspable object")
     steps = []
     for i, s in enumerate(raw["steps"] or []):
         if not isinstance(s, dict):

@@ -174,7 +174,7 @@ def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused
     ("open the fridge on the left", "a place (in region, left)"),
     ("lift the apple halfway", "an amount ('half')"),
     ("put the apple in the bowl before closing the microwave", "steps out of order ('before')"),
-    ("take the apple out of the bowl", "out of another"),
+    ("put all the fruit in the pot", "several objects ('all fruit')"),
 ])
 def test_constructs_not_built_yet_are_refused_never_built_without_them(text, asks):
     """A request whose direction, place, amount, order or retrieval the author cannot build is refused saying what
@@ -193,6 +193,55 @@ def test_steps_in_order_are_read_one_by_one_and_it_is_the_object_before():
     assert [x.skill for x in (r, *r.then)] == ["lift", "put_in", "push"]
     assert [m.asset for m in r.then[0].objects] == ["apple", "bowl"]  # 'it': the apple
     assert [m.asset for m in r.all_objects] == ["apple", "apple", "bowl", "block_large"]
+
+
+@pytest.mark.parametrize("text, steps", [
+    ("put the lemon and the plum in the bowl", [("put_in", ["lemon", "bowl"]), ("put_in", ["plum", "bowl"])]),
+    ("put the apple, the lemon and the plum in the large bowl",
+     [("put_in", ["apple", "bowl_large"]), ("put_in", ["lemon", "bowl_large"]), ("put_in", ["plum", "bowl_large"])]),
+    ("pick up the apple and put it in the bowl", [("lift", ["apple"]), ("put_in", ["apple", "bowl"])]),
+    ("put the orange in the bowl and close the fridge",
+     [("put_in", ["orange", "bowl"]), ("close", ["refrigerator_left_hinge"])]),
+    ("close the microwave, then put the can and the apple on the plate",
+     [("close", ["microwave_compact"]), ("place_on", ["can", "plate"]), ("place_on", ["apple", "plate"])]),
+    ("take hold of the lemon and raise it", [("lift", ["lemon"])]),  # one step said twice
+    ("stack the three blocks into a tower", [("stack", ["block_small", "block_medium", "block_large"])]),
+    ("build a tower of the medium and large blocks", [("stack", ["block_medium", "block_large"])]),
+])
+def test_several_objects_and_steps_joined_by_and_are_read_one_step_each(text, steps):
+    """*A and B in C* is one put per object; *..., and <verb> ...* is a second step; a tower is one stack of its
+    blocks, the smallest on top; 'it' is the object before that can play the part (*close it*: the fridge)."""
+    r = read(text)
+    assert [(x.skill, [m.asset for m in x.objects]) for x in (r, *r.then)] == steps, r.lines()
+
+
+def test_it_is_the_first_object_before_that_can_play_the_part():
+    r = read("put the orange in the bowl and then lift it")
+    assert [m.asset for m in r.then[0].objects] == ["orange"]
+    r = read("open the small trash can, then shut its lid")  # a bare part: the part of the object before
+    assert [(x.skill, x.objects[0].asset) for x in (r, *r.then)] == [("open", "trash_can_small"),
+                                                                      ("close", "trash_can_small")]
+
+
+@pytest.mark.parametrize("text, refused", [
+    ("close the fridge and the cabinet", "has no part in a 'close' task"),  # one close, two objects
+    ("stack the four blocks into a tower", "a tower of 4 blocks: the catalog has 3"),
+    ("stack the red, green and blue blocks into a tower", "named by colour is not built yet"),
+])
+def test_groups_the_catalog_cannot_make_are_refused_saying_why(text, refused):
+    with pytest.raises(InstructionError, match=re.escape(refused)):
+        read(text)
+
+
+@pytest.mark.parametrize("text, objects", [
+    ("take the apple out of the bowl", ["apple", "bowl"]), ("get the lemon out of the pot", ["lemon", "pot"]),
+    ("remove the plum from the large bowl", ["plum", "bowl_large"]),
+    ("pull the tennis ball out of the bowl", ["tennis_ball", "bowl"]),
+])
+def test_taking_out_of_a_container_is_read(text, objects):
+    r = read(text)
+    assert (r.skill, [m.asset for m in r.objects]) == ("take_out", objects), r.lines()
+    assert read("remove the lid from the box").skill == "open"  # a lid removed is a lid opened
 
 
 @pytest.mark.parametrize("text, relation, region, objects", [

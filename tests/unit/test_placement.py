@@ -75,3 +75,37 @@ def test_failures_are_typed_and_survive_pickling():
     assert by_cause(counts) == {"slipped": 5, "timeout": 1}
     assert breakdown(counts)[0] == ("b/carry/slipped", 3)
     assert set(by_cause(counts)) <= set(FAILURE_CAUSES)
+
+
+def test_an_object_that_starts_in_a_container_moves_with_it_and_is_never_kept_apart_from_it():
+    """*Take the apple out of the bowl*: the apple's nominal place is in the bowl; drawn apart like two objects on
+    the table, every layout would fail and fall back to the nominal one (no randomization at all)."""
+    torch.manual_seed(0)
+    bowl, apple = Footprint((0.0, 0.0), (0.075, 0.075)), Footprint((0.0, 0.0), (0.04, 0.04))
+    block = Footprint((0.0, 0.0), (0.03, 0.03))
+    items = [Item("apple", (0.1, 0.1), (0.0, 0.0), math.pi, apple, starts_in="bowl"),  # before its container
+             Item("bowl", (0.1, 0.1), (0.08, 0.08), math.pi, bowl),
+             Item("block", (0.1, -0.15), (0.08, 0.08), 0.0, block)]
+    noise = place(items, 300, (0.8, 0.6))
+    assert torch.equal(noise["apple"][0], noise["bowl"][0])  # the container's xy noise
+    assert noise["bowl"][0].abs().max() > 0.05 and noise["apple"][1].abs().max() > 1.0  # randomized, own yaw
+    bowl_at = torch.tensor((0.1, 0.1)) + noise["bowl"][0]
+    block_at = torch.tensor((0.1, -0.15)) + noise["block"][0]
+    assert not overlap(bowl_at, noise["bowl"][1], bowl, block_at, noise["block"][1], block).any()
+
+
+def test_starts_in_is_a_rigid_container_under_a_raised_object():
+    from types import SimpleNamespace as NS
+
+    from gendex_envs.placement import starts_in
+
+    rec = {"apple": NS(articulated=False, tags=("fruit",), size_m=(0.08, 0.08, 0.08)),
+           "bowl": NS(articulated=False, tags=("container",), size_m=(0.15, 0.15, 0.06)),
+           "plate": NS(articulated=False, tags=("plate",), size_m=(0.2, 0.2, 0.02))}
+    apple = NS(name="apple", pos_m=(0.12, 0.1, 0.01), scale=1.0)
+    bowl = NS(name="bowl", pos_m=(0.1, 0.1, 0.0), scale=1.0)
+    plate = NS(name="plate", pos_m=(0.1, 0.1, 0.0), scale=1.0)
+    assert starts_in(apple, [apple, bowl], rec) == "bowl"
+    assert starts_in(NS(name="apple", pos_m=(0.12, 0.1, 0.0), scale=1.0), [bowl], rec) is None  # on the table
+    assert starts_in(NS(name="apple", pos_m=(0.2, 0.1, 0.01), scale=1.0), [bowl], rec) is None  # beside it
+    assert starts_in(apple, [apple, plate], rec) is None  # a plate holds nothing in it

@@ -1,0 +1,150 @@
+"""Requests of several steps: steps said in order (*A, then B*; *A and then B*), a step joined by *and* and a verb
+(*put the dice in the box and shut the lid*), towers of blocks (*stack the three blocks into a tower*: one stack
+reading, its objects top first) and several objects moved to one place (*put the lemon and the plum in
+the bowl*: one put-in per object, in the order named). Each step is read on its own by the one-step reader; a
+pronoun (*it*, *them*) or a bare part (*the lid*) in a step stands for an object of the step before it, the first that
+can play its part in the step (*put the orange in the fridge and close it*: the fridge).
+
+:mod:`generator.instruction` calls :func:`read_compound` before reading a request as one step."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
+
+from generator.constructs import split_steps
+from generator.errors import InstructionError
+
+if TYPE_CHECKING:
+    from generator.instruction import Reading
+
+GROUP_SKILLS = ("put_in", "place_on")
+"""Skills whose request may name several objects for one place (*put the lemon and the plum in the bowl*)."""
+PLACE_WORDS = ("into", "in", "inside", "onto", "on", "on top of")
+"""Words that start the place of a put or a set-down (where a list of objects ends)."""
+TOWER_OF = {"blocks": "block", "cubes": "block"}
+"""Plurals a tower is built of, and the catalog category they name."""
+GROUP_WORD = re.compile(r"\b(\w+)\s+(\w+\s+)?(blocks|cubes)\b")
+NUMBERS = {**{w: i for i, w in enumerate("zero one two three four five six seven eight nine ten".split())},
+           **{str(i): i for i in range(11)}}
+"""How many blocks a tower request asks for (*the three blocks*, *4 cubes*)."""
+GOES_ON = ("hold", "keep", "leave", "stay")
+"""Verbs that go on with the step before rather than start one (*open the door halfway and hold it there*)."""
+_PRONOUN = re.compile(r"\b(it|them)\b", re.IGNORECASE)
+_BARE_PART = re.compile(r"\b(the|its)\s+(lid|door|drawer)\b", re.IGNORECASE)
+
+
+def and_steps(text: str, starts_with_verb: Callable[[str], bool]) -> list[str]:
+    """``text`` split where *and* is followed by a verb of a skill (*pick up the apple and put it in the bowl*);
+    one part when no *and* is."""
+    parts = re.split(r"\s*,?\s+and\s+", text)
+    out = [parts[0]]
+    for p in parts[1:]:
+        if starts_with_verb(p) and p.split()[0].lower() not in GOES_ON:
+            out.append(p)
+        else:
+            out[-1] += " and " + p
+    return out
+
+
+def group_steps(text: str, verb_end: int) -> list[str]:
+    """One step per object of a list before the place (*put the apple, the lemon and the plum in the bowl* -> three
+    puts into the bowl); ``[text]`` when the request names one object. ``verb_end``: where the verb's words end."""
+    words = text.split()
+    verb, rest = words[:verb_end], words[verb_end:]
+    at = next((i for i, w in enumerate(rest) if w.lower() in PLACE_WORDS and i > 0), None)
+    if at is None or "and" not in (w.lower() for w in rest[:at]):
+        return [text]
+    items = [i.strip() for i in re.split(r"\s*,\s*(?:and\s+)?|\s+and\s+", " ".join(rest[:at])) if i.strip()]
+    place = " ".join(rest[at:])
+    return [" ".join([*verb, item, place]) for item in items] if len(items) > 1 else [text]
+
+
+def _with_previous(step: str, previous: Reading, read_one: Callable[[str], Reading]) -> Reading:
+    """``step`` read with its pronoun or bare part standing for an object of ``previous``: the first of them that
+    reads (the error of the first try when none does)."""
+    pronoun, part = _PRONOUN.search(step), _BARE_PART.search(step)
+    if pronoun is None and part is None:
+        return read_one(step)
+    first_error: InstructionError | None = None
+    for m in previous.objects:
+        name = f"the {m.color + ' ' if m.color else ''}{m.phrase}"
+        tried = _PRONOUN.sub(name, step) if pronoun else _BARE_PART.sub(f"{name} {part.group(2)}", step)
+        try:
+            return read_one(tried)
+        except InstructionError as exc:
+            first_error = first_error or exc
+    if part is not None and pronoun is None:
+        return read_one(step)  # 'the lid' may name its object by itself
+    assert first_error is not None
+    raise first_error
+
+
+def _same_step(a: Reading, b: Reading) -> bool:
+    return (a.skill, [m.asset for m in a.objects], a.direction, a.amount, a.relation, a.region) == (
+        b.skill, [m.asset for m in b.objects], b.direction, b.amount, b.relation, b.region)
+
+
+def read_tower(text: str, assets: Sequence[dict]) -> Reading | None:
+    """A tower of blocks (*stack the three blocks into a tower*, *build a tower of the small, medium and large
+    blocks*): one ``stack`` reading whose objects go top first, the smallest on top; None when ``text`` asks for no
+    tower; :class:`InstructionError` for a tower the catalog's blocks cannot make."""
+    from generator.instruction import Mention, Reading
+
+    words = re.findall(r"[a-z0-9]+", text.lower())
+    plural = next((w for w in words if w in TOWER_OF), None)
+    if plural is None or not ("tower" in words or (words[:1] == ["stack"] and GROUP_WORD.search(text.lower()))):
+        return None
+    blocks = sorted((a for a in assets if a["category"] == TOWER_OF[plural]), key=lambda a: a["size_m"][2])
+    sizes = [w for w in words if w in ("small", "medium", "large")]
+    count = next((NUMBERS[w] for w in words if w in NUMBERS), None)
+    chosen = [a for a in blocks if any(a["id"].endswith("_" + z) for z in sizes)] if sizes else blocks
+    from gendex_envs.attributes import COLOR_WORDS
+
+    if any(w in COLOR_WORDS for w in words):
+        raise InstructionError(f'"{text}": a tower of blocks named by colour is not built yet; name them by size '
+                               "(small, medium, large) or by number")
+    if count is not None and count != len(chosen):
+        raise InstructionError(f'"{text}" asks for a tower of {count} {plural}: the catalog has {len(chosen)} '
+                               f"({', '.join(a['id'] for a in chosen)}), each of another size")
+    if len(chosen) < 2:
+        raise InstructionError(f'"{text}": a tower needs two or more {plural}; the catalog has '
+                               f"{', '.join(a['id'] for a in blocks)}")
+    mentions = tuple(Mention(plural, a["id"], "name", options=(a["id"],)) for a in chosen)
+    return Reading(text, "stack", mentions)
+
+
+def read_compound(text: str, assets: Sequence[dict], read_one: Callable[[str], Reading],
+                  starts_with_verb: Callable[[str], bool],
+                  group_of: Callable[[str], tuple[str, int] | None]) -> Reading | None:
+    """The reading of a request of several steps or objects (see the module docstring), or None when ``text`` is
+    one step of one object. ``read_one`` reads one step, ``starts_with_verb`` tells whether a part begins with a
+    skill's verb, and ``group_of`` gives the skill and verb end of a step (None: no verb)."""
+    tower = read_tower(text, assets)
+    if tower is not None:
+        return tower
+    steps = [s for part in split_steps(text) for s in and_steps(part, starts_with_verb)]
+    if len(steps) == 1:
+        found = group_of(text)
+        if found is None or found[0] not in GROUP_SKILLS:
+            return None
+        steps = group_steps(text, found[1])
+        if len(steps) == 1:
+            return None
+        readings = [read_one(s) for s in steps]
+        if len({(r.skill, r.objects[-1].asset) for r in readings}) != 1:
+            return None  # not one place for all of them: read as one step (and refused there, saying why)
+    else:
+        readings = []
+        for step in steps:
+            r = _with_previous(step, readings[-1], read_one) if readings else read_one(step)
+            for part in (dataclasses.replace(r, then=()), *r.then):  # a step of several objects: one per object
+                if readings and _same_step(readings[-1], part):
+                    continue  # the step said again in other words: 'take hold of the cube and raise it'
+                readings.append(part)
+    return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
+
+
+__all__ = ["GROUP_SKILLS", "PLACE_WORDS", "TOWER_OF", "and_steps", "group_steps", "read_compound", "read_tower"]

@@ -1,0 +1,95 @@
+"""The words of requests: the task skills with their verbs (:data:`TASK_SKILLS`), what people call catalog objects
+(:data:`SYNONYMS`), kinds of object (:data:`KINDS`) and the parts of articulated objects (:data:`PARTS`).
+:mod:`generator.instruction` reads requests with them; the language-model prompts list them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class TaskSkill:
+    """One thing a person can ask for."""
+
+    name: str
+    verbs: tuple[str, ...]
+    """Verb phrases that ask for it (lower case, matched on word boundaries)."""
+    objects: str
+    """What it acts on, in words (for messages and prompts)."""
+    example: str
+
+
+TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
+    TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get",
+                       "hoist"),
+              "a graspable object", "pick up the apple"),
+    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck"),
+              "a graspable object and a container (bowl, pot, mug), with 'in' or 'into'", "put the lemon in the bowl"),
+    TaskSkill("place_on", ("set", "put", "place", "lay", "move", "rest"),
+              "a graspable object and a plate, tray or cutting board, with 'on' or 'onto'",
+              "set the bottle on the plate"),
+    TaskSkill("stack", ("stack", "pile", "balance"), "two blocks", "stack the small block on the large block"),
+    TaskSkill("push", ("push", "slide", "shove", "nudge"), "an object on the table, pushed to a goal mark",
+              "push the block to the goal"),
+    TaskSkill("open", ("open", "pull open", "lift open", "unlatch", "raise the lid", "pull", "flip up", "flip open"),
+              "a door, drawer or lid (cabinet, microwave, refrigerator, drawer chest, trash can, box with lid)",
+              "open the top drawer"),
+    TaskSkill("close", ("close", "shut", "push shut", "push closed"),
+              "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
+    TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing", "turn off", "switch off", "switch"),
+              "a faucet or valve lever, on or off", "turn on the faucet"),
+    TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
+              "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
+    TaskSkill("take_out", ("take out", "get out", "lift out", "pull out", "fish out", "remove"),
+              "a graspable object taken out of a container (bowl, pot) and set down on the table beside it",
+              "take the apple out of the bowl"),
+    TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
+              "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",
+              "put the apple to the left of the bowl"),
+)}
+"""The task skills a request may ask for, in the order verbs are tried (earlier skills win ties)."""
+
+SYNONYMS: dict[str, str] = {
+    # phrase -> catalog category (or id)
+    "fridge": "refrigerator", "refrigerator": "refrigerator", "cupboard": "cabinet", "cabinet": "cabinet",
+    "closet": "cabinet", "trash can": "trash_can", "trashcan": "trash_can", "trash bin": "trash_can",
+    "bin": "trash_can", "garbage can": "trash_can", "dustbin": "trash_can", "waste bin": "trash_can",
+    "tap": "faucet", "faucet": "faucet", "mixer tap": "faucet", "drawer": "drawer_chest", "drawers": "drawer_chest",
+    "dresser": "drawer_chest", "chest of drawers": "drawer_chest", "microwave oven": "microwave",
+    "coffee mug": "mug", "cup": "cup", "glass": "wine_glass", "wineglass": "wine_glass", "jug": "pitcher",
+    "saucepan": "pot", "pan": "pot", "cooking pot": "pot", "dish": "plate", "saucer": "plate", "cube": "block",
+    "brick": "foam_brick", "die": "dice", "notebook": "laptop", "computer": "laptop", "lidded box": "box_with_lid",
+    "box with a lid": "box_with_lid", "rubik's cube": "rubiks_cube", "rubik cube": "rubiks_cube",
+    "bottle of mustard": "mustard_bottle", "soup can": "can", "tin": "can", "tin can": "can", "duck": "toy_duck",
+    "rubber duck": "toy_duck", "pen": "marker", "felt pen": "marker", "dial": "knob",
+    "tin of tuna": "tuna_can", "serving bowl": "bowl", "mixing bowl": "bowl", "dinner plate": "plate",
+    "teacup": "cup", "soft brick": "foam_brick", "puzzle cube": "rubiks_cube", "drawer unit": "drawer_chest",
+    "storage box": "box_with_lid", "notebook computer": "laptop", "stove knob": "knob_stove",
+    "chopping board": "cutting_board", "serving tray": "tray", "ball valve": "valve", "shutoff valve": "valve",
+    "stopcock": "valve",
+}
+"""Words people use for catalog objects: phrase -> catalog category or id."""
+
+KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block": "block", "food": "food",
+                         "tool": "tool", "utensil": "utensil", "container": "container", "box": "box",
+                         "thing": "graspable", "object": "graspable", "item": "graspable"}
+"""Words naming a kind of object (a catalog tag): 'a fruit' is any fruit; which one is a recorded choice."""
+
+PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab")
+"""Words naming the part of an articulated object a skill acts on (recorded, never an object on their own)."""
+ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom", "first": "top", "second": "second"}
+
+STOP_WORDS = frozenset(
+    "a an the this that these those its it of to from with by and then please robot hand your my up "
+    "down off out over at for some one along until toward towards near beside behind below above "
+    "under between while without through so"
+    .split())
+FILLER_WORDS = frozenset(
+    "into inside onto top hand goal mark table shut closed open side around across upright away back "
+    "there here target spot marked place position edge middle centre center surface counter worktop "
+    "tabletop air way width tower floor"
+    .split())
+"""Words after the verb that name no object (places on the table among them)."""
+
+
+__all__ = ["FILLER_WORDS", "KINDS", "ORDINALS", "PARTS", "STOP_WORDS", "SYNONYMS", "TASK_SKILLS", "TaskSkill"]
