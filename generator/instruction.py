@@ -307,6 +307,9 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     in_hand = find(words, "in the hand") >= 0 or find(words, "in hand") >= 0 or find(words, "in its hand") >= 0
     names = _names(assets)
     spans = _spans(words, names)
+    # a colour that is also a name ('orange') right before another name is its colour: 'the orange block'
+    spans = [sp for k, sp in enumerate(spans) if not (sp[2] in COLOR_WORDS and k + 1 < len(spans)
+                                                      and spans[k + 1][0] == sp[1])]
     notes: list[str] = []
     mentions: list[Mention] = []
     at: list[int] = []  # where each mention starts in the words

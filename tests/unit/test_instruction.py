@@ -233,6 +233,13 @@ def test_groups_the_catalog_cannot_make_are_refused_saying_why(text, refused):
         read(text)
 
 
+def test_a_colour_that_is_also_a_name_before_another_name_is_its_colour():
+    r = read("set the orange block on the grey tray")
+    assert [(m.asset, m.color) for m in r.objects] == [("block_large", "orange"), ("tray", "grey")]
+    assert [(m.asset, m.color) for m in read("put the orange in the orange bowl").objects] == [
+        ("orange", None), ("bowl", "orange")]
+
+
 @pytest.mark.parametrize("text, objects", [
     ("take the apple out of the bowl", ["apple", "bowl"]), ("get the lemon out of the pot", ["lemon", "pot"]),
     ("remove the plum from the large bowl", ["plum", "bowl_large"]),
