@@ -35,7 +35,7 @@ NEAR_DUPLICATE_COSINE = 0.9
 task score 0.7-0.9, the same wording with another fruit about 0.8, different skills 0.3-0.5."""
 
 Signature = tuple[tuple[str, ...], tuple[str, ...]]
-"""(task skills, sorted object kinds) of a task: see :func:`kind`."""
+"""(task skills and how its joints move, sorted object kinds) of a task: see :func:`kind` and :func:`_how`."""
 
 
 def kind(asset: dict) -> str:
@@ -50,9 +50,20 @@ class ExistingTask:
     instruction: str
 
 
+def _how(kind_: str, negate: bool, part: str | None) -> str | None:
+    """How a joint condition moves its part, beyond its task skill: ``part_way`` (held at a fraction), ``off`` (a
+    lever turned back shut); None for all the way (a half-open door is another task than an open one)."""
+    if kind_ == "joint_at":
+        return "part_way"
+    return "off" if kind_ == "joint_open" and negate and part == "lever" else None
+
+
 def spec_signature(spec: TaskSpec) -> Signature:
     cats = sorted({kind(asset_dict(o.asset)) for o in spec.objects if not o.distractor})
-    return task_skills(spec), tuple(cats)
+    objs = {o.name: asset_dict(o.asset) for o in spec.objects}
+    how = {_how(c.type, bool(c.negate), part_of(objs[c.object], c.joint) if objs.get(c.object, {}).get("joints")
+                else None) for c in spec.success.conditions if c.object in objs} - {None}
+    return task_skills(spec) + tuple(sorted(how)), tuple(cats)
 
 
 def proposal_signature(proposal: dict) -> Signature:
@@ -67,7 +78,10 @@ def proposal_signature(proposal: dict) -> Signature:
                                   taken_out=any(o.get("starts_in") == succ.get("target") and o["name"] == succ["object"]
                                                 for o in proposal["objects"] if o.get("starts_in"))))
     found |= {s["skill"] for s in proposal["steps"] if s["skill"] in STAGE_TASK_SKILLS}
-    return tuple(k for k in TASK_SKILLS if k in found), tuple(sorted({kind(a) for a in objects.values()}))
+    how = {_how(c["type"], bool(c.get("negate")), part_of(objects[c["object"]]) if objects.get(
+        c.get("object"), {}).get("joints") else None) for c in (proposal["success"], *(proposal.get("also") or ()))}
+    return (tuple(k for k in TASK_SKILLS if k in found) + tuple(sorted(how - {None})),
+            tuple(sorted({kind(a) for a in objects.values()})))
 
 
 def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:

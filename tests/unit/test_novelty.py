@@ -86,3 +86,19 @@ def test_an_extension_equals_adding_one_by_one_leaves_the_original_and_is_made_o
     assert one.existing == by_add.existing[:-1] and novelty.existing == before
     assert novelty.extended(added) is two and novelty.extended(()) is novelty
     assert two.near_duplicate(("x",), added[1].instruction) is not None  # the added instruction is known
+
+
+def test_a_part_way_or_turned_off_joint_is_another_task_than_all_the_way():
+    """A half-open door and a lever turned off are new beside the open door and the lever turned on (before, the
+    grammar's turn-offs and half-open doors were all skipped as duplicates of TurnFaucet and the open tasks)."""
+    from generator.backends.offline import OfflineBackend
+    from generator.catalog_view import asset_dicts
+    from generator.novelty import proposal_signature
+
+    by_kind: dict[str, set] = {}
+    for k, p in OfflineBackend(seed=0)._task_options(list(asset_dicts())):
+        by_kind.setdefault(k, set()).add(proposal_signature(p))
+    assert all(("part_way" in s[0]) for s in by_kind["open_part"] | by_kind["turn_part"])
+    assert all(("off" in s[0]) for s in by_kind["turn_off"])
+    assert not (by_kind["turn"] & (by_kind["turn_off"] | by_kind["turn_part"]))
+    assert not ((by_kind["open_door"] | by_kind["open_drawer"]) & by_kind["open_part"])
