@@ -40,7 +40,19 @@ from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
-from generator.backends.roles import _acts, _joint_at, _kind, _min_xy, _part, container, fits_in, graspable, openable
+from generator.backends.roles import (
+    STICK_OUT_M,
+    _acts,
+    _joint_at,
+    _kind,
+    _min_xy,
+    _part,
+    container,
+    fits_in,
+    graspable,
+    openable,
+    sticks_out,
+)
 from generator.backends.wording import camel as _camel
 from generator.backends.wording import fence as _fence
 from generator.backends.wording import step as _step
@@ -65,8 +77,8 @@ PUSHED: dict[str, str | None] = {"block_large": "PushBlockToGoal 50/50, a genera
 PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
-              "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "several",
-              "composed")
+              "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
+              "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -162,6 +174,8 @@ class OfflineBackend:
         out += [("turn_part", self._articulated_task("turn", by_id[i], PART_TURN)) for (s, i), lay
                 in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]]
         out += [("place_at", t) for t in placed_tasks.placed_options(g, c + p, self._words)]
+        out += [("take_out", placed_tasks.take_out_task(a, b, (), self._words))
+                for a in g for b in c if fits_in(a, b) and sticks_out(a, b)]
         # several objects: two put in one large container (each gets 80 % of it to itself: the second lands beside
         # the first); a tower of the three blocks, the smallest on top
         names = lambda i: names_for(by_id[i], MODEL_WORDS.get(i, ""))  # noqa: E731
@@ -428,8 +442,15 @@ class OfflineBackend:
             proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
         elif skill == "take_out":
             g = pick(0, graspable, "object to take out")
-            proposal = placed_tasks.take_out_task(g, pick(1, lambda x: container(x) and fits_in(g, x),
-                                                          "container it fits in"), colors, self._words)
+            box = pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in")
+            if not sticks_out(g, box):
+                able = sorted(a["id"] for a in assets.values()
+                              if graspable(a) and fits_in(a, box) and sticks_out(a, box))
+                raise InstructionError(
+                    f"the offline author takes out of a container only objects that stand {STICK_OUT_M * 100:.0f} cm "
+                    f"above its rim, where the fingers close ('{mentions[0]['phrase']}' ({g['id']}) in the "
+                    f"{box['id']} does not); from the {box['id']} it takes out: {', '.join(able) or 'nothing'}")
+            proposal = placed_tasks.take_out_task(g, box, colors, self._words)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))

@@ -84,3 +84,16 @@ def _joint_at(n: str, fraction: float) -> dict:
     return {"type": "joint_at", "object": n, "fraction": fraction, "max_error": 0.1}
 
 
+
+
+STICK_OUT_M = 0.03
+"""An object the offline author takes out of a container stands at least this far above the container's rim, fitted
+to the hand: the fingers close on it above the rim (a can from the bowl: 6/6 in the gate; an apple, whose top is
+level with the rim: 3 of 9 held)."""
+
+
+def sticks_out(g: dict, c: dict) -> bool:
+    """Graspable ``g``, fitted to the hand, stands :data:`STICK_OUT_M` above container ``c``'s rim."""
+    from gendex.solve.grasp import hand_fit_scale
+
+    return g["size_m"][2] * hand_fit_scale(g["size_m"][:2]) >= c["size_m"][2] + STICK_OUT_M

@@ -578,3 +578,43 @@ def test_every_task_the_grammar_can_write_is_a_valid_proposal_with_distinct_obje
         p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
         assert len({o.name for o in p.objects}) == len(p.objects), raw["name"]
     assert len({raw["name"] for _, raw in options}) == len(options)
+
+
+def test_a_take_out_starts_the_object_in_its_container_and_succeeds_with_it_beside():
+    """*Take the can out of the bowl*: the can on the bowl's floor, moving with the bowl at reset; success is the can
+    set down next to the bowl, false at every reset. An object whose top is level with the rim is refused (the
+    fingers close on it above the rim: an apple in a bowl held 3 of 9 gate attempts, a can 6 of 6)."""
+    import torch
+
+    from gendex_envs.success import _holds
+    from gendex_envs.task_env import TaskEnv
+    from generator.critic.physical import CONTAINER_FLOOR_M
+    from generator.steps.propose import parse_proposal
+
+    b = OfflineBackend(seed=4)
+
+    def guided(text: str) -> str:
+        return b.complete(ModelRequest(step="propose_guided", prompt="", context={
+            "reading": read_instruction(text, asset_dicts()).to_dict(), "assets": asset_dicts()})).text
+
+    with pytest.raises(InstructionError, match="stand 3 cm above its rim.*takes out: bottle, can"):
+        guided("take the apple out of the bowl")
+    p = parse_proposal(guided("take the can out of the bowl"))
+    assert p.name == "TakeCanOutOfBowl" and p.objects[0].starts_in == "bowl"
+    assert (p.success["type"], p.success["relation"], p.success["target"]) == ("placed", "next_to", "bowl")
+    ids = {o.asset for o in p.objects}
+    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+               "candidate_index": 0, "index": 0, "attempt": 0}
+    spec = adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
+    can, bowl = (next(o for o in spec.objects if o.name == n) for n in ("can", "bowl"))
+    assert can.pos_m[:2] == bowl.pos_m[:2] and can.pos_m[2] == CONTAINER_FLOOR_M and can.randomize.xy_m == (0, 0)
+    placed = next(c for c in spec.success.conditions if c.type == "placed")
+    env = TaskEnv(task_spec=spec, obs_mode="none", render_backend="none")
+    try:
+        for seed in range(4):
+            env.reset(seed=seed)
+            pc, pb = env.obj_pose("can").p[0], env.obj_pose("bowl").p[0]
+            assert float(torch.linalg.norm(pc[:2] - pb[:2])) < 0.01  # in the bowl wherever the bowl was drawn
+            assert not bool(_holds(env, placed)[0])
+    finally:
+        env.close()
