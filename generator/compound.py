@@ -127,24 +127,33 @@ def read_compound(text: str, assets: Sequence[dict], read_one: Callable[[str], R
         return tower
     steps = [s for part in split_steps(text) for s in and_steps(part, starts_with_verb)]
     if len(steps) == 1:
-        found = group_of(text)
-        if found is None or found[0] not in GROUP_SKILLS:
+        readings = _group(text, read_one, group_of)
+        if readings is None:
             return None
-        steps = group_steps(text, found[1])
-        if len(steps) == 1:
-            return None
-        readings = [read_one(s) for s in steps]
-        if len({(r.skill, r.objects[-1].asset) for r in readings}) != 1:
-            return None  # not one place for all of them: read as one step (and refused there, saying why)
     else:
         readings = []
-        for step in steps:
-            r = _with_previous(step, readings[-1], read_one) if readings else read_one(step)
-            for part in (dataclasses.replace(r, then=()), *r.then):  # a step of several objects: one per object
+        for step in steps:  # a step of several objects is one step per object, each with its own words
+            parts = _group(step, read_one, group_of) or [
+                _with_previous(step, readings[-1], read_one) if readings else read_one(step)]
+            for part in parts:
                 if readings and _same_step(readings[-1], part):
                     continue  # the step said again in other words: 'take hold of the cube and raise it'
                 readings.append(part)
     return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
 
+
+def _group(text: str, read_one: Callable[[str], Reading], group_of: Callable[[str], tuple[str, int] | None]
+           ) -> list[Reading] | None:
+    """One reading per object of a step that moves several objects to one place, or None (not such a step)."""
+    found = group_of(text)
+    if found is None or found[0] not in GROUP_SKILLS:
+        return None
+    steps = group_steps(text, found[1])
+    if len(steps) == 1:
+        return None
+    readings = [read_one(s) for s in steps]
+    if len({(r.skill, r.objects[-1].asset) for r in readings}) != 1:
+        return None  # not one place for all of them: read as one step (and refused there, saying why)
+    return readings
 
 __all__ = ["GROUP_SKILLS", "PLACE_WORDS", "TOWER_OF", "and_steps", "group_steps", "read_compound", "read_tower"]

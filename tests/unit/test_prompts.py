@@ -53,3 +53,20 @@ def test_rendered_guided_prompt_carries_the_instruction_the_skills_the_reading_a
     assert '"grab the apple"' in text and "- apple | apple" in text and "{{" not in text
     assert "'apple' is apple" in text  # the reading
     assert "close: close, shut" in text and "turn on the faucet" in text  # the vocabulary of every task skill
+
+
+def test_the_guided_prompt_describes_parts_in_turn_towers_and_take_outs():
+    """The Claude backend is told the task language the offline author writes: a reading of several steps is one
+    task with an 'also' list, a tower is two stacks, a take-out starts its object in the container."""
+    from generator.catalog_view import asset_dicts
+    from generator.instruction import read_instruction, skill_vocabulary
+
+    request = "take the can out of the bowl, then put the lemon and the plum in the large bowl"
+    reading = read_instruction(request, asset_dicts())
+    assert [r.skill for r in (reading, *reading.then)] == ["take_out", "put_in", "put_in"]
+    text = render("propose_guided", instruction=request, asset_guidance="-", existing_tasks="- (none)",
+                  skills="-", condition_types="placed, inside", control_joints="arm, hand",
+                  task_skills=skill_vocabulary(), reading="\n".join(reading.lines()))
+    assert '"starts_in": "<the container\'s name>"' in text and '"also" list' in text
+    assert 'then "put the lemon in the large bowl"' in text and "take_out" in text
+    assert "tower" in text and "a lifted object only in the last part" in text
