@@ -171,6 +171,7 @@ def part_kinds(a: dict) -> tuple[str, ...]:
 
 ROLE_TESTS = {
     "graspable": is_graspable, "container": is_container, "surface": is_surface, "block": is_block,
+    "receptacle": lambda a: is_container(a) or ("container" in a["tags"] and "lid" in part_kinds(a)),
     "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
@@ -180,7 +181,7 @@ ROLE_TESTS = {
 """What an object must be to play each role."""
 
 SKILL_ROLES: dict[str, tuple[str, ...]] = {
-    "lift": ("graspable",), "put_in": ("graspable", "container"), "place_on": ("graspable", "surface"),
+    "lift": ("graspable",), "put_in": ("graspable", "receptacle"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "container"),

@@ -64,6 +64,9 @@ log = logging.getLogger(__name__)
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
                     "release": "release", "push": "push"}
 """Skill -> primitive for a rigid target."""
+TO_A_PLACE = ("carry", "place")
+"""Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object
+(a lidded box whose lid is open: carried over its body's box)."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull", "close": "shut"}
 """Skill -> primitive for an articulated target that a stage grasps (hooks by its handle)."""
 PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press"}
@@ -177,7 +180,7 @@ class StageExecutor:
         if stage.target is None:
             raise ExecutionError(f"stage {stage.name!r} has no target object: the executor cannot act on it",
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
-        if stage.target not in self._env.articulations:
+        if stage.target not in self._env.articulations or stage.skill in TO_A_PLACE:
             table, kind = RIGID_PRIMITIVES, "a rigid"
         elif self._grasped(stage.target):
             table, kind = ARTICULATED_PRIMITIVES, "a hooked articulated"

@@ -51,6 +51,7 @@ from generator.backends.roles import (
     fits_in,
     graspable,
     openable,
+    receptacle,
     sticks_out,
 )
 from generator.backends.wording import camel as _camel
@@ -254,7 +255,7 @@ class OfflineBackend:
             "name": name, "description": phrase("put_in", a, self._words(name), other=b,
                                                 **qualifiers(a, b, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
-                        {"name": t, "asset": b["id"], "role": "container"}],
+                        {"name": t, "asset": b["id"], "role": "articulated" if b.get("joints") else "container"}],
             "steps": self._carry_steps(n, t, "above"),
             "success": {"type": "inside", "object": n, "target": t, "min_height_m": None, "min_fraction": None,
                         "max_dist_m": None},
@@ -391,7 +392,7 @@ class OfflineBackend:
         # in turn; a step is named as if alone, the joined task apart from the existing ones
         step = lambda r: sequence.parse_step(self._propose_guided(request, ctx | {"reading": r,  # noqa: E731
                                                                                  "existing_tasks": []}))
-        names = lambda i: names_for(assets[i], MODEL_WORDS.get(i, ""))  # noqa: E731
+        names = lambda i: names_for(assets[i], MODEL_WORDS.get(i, "")) + names_for(assets[i])  # noqa: E731
         if reading.get("then"):
             return _fence("json", json.dumps(sequence.sequence_task(step, reading, _acts, existing, names), indent=2))
         skill = reading["skill"]
@@ -426,8 +427,8 @@ class OfflineBackend:
             proposal = self._lift_task(pick(0, graspable, "object to lift"), colors)
         elif skill == "put_in":
             g = pick(0, graspable, "object to put in")
-            proposal = self._put_task(g, pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in"),
-                                      colors)
+            proposal = self._put_task(g, pick(1, lambda x: (container(x) or receptacle(x)) and fits_in(g, x),
+                                              "container it fits in"), colors)
         elif skill == "place_on":
             proposal = self._plate_task(pick(0, graspable, "object to set down"),
                                         pick(1, is_surface, "plate, tray or board"), colors)

@@ -55,6 +55,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     movable = _movable_region(proposal, assets, acts)
     place = next((c for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "placed"), None)
     inside = {o["name"]: o["starts_in"] for o in proposal["objects"] if o.get("starts_in")}
+    receivers = {c.get("target") for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "inside"}
     spots = ({} if place is None else placed_tasks.take_out_layout(place, place["object"], rng)
              if place["object"] in inside else placed_tasks.placed_layout(place, place["object"], rng))
     for o in proposal["objects"]:
@@ -66,7 +67,9 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
         entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
         if o.get("color"):
             entry["color"] = o["color"]
-        layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
+        # a box or bin something is put in starts with its lid open (the layout its shutting was measured on)
+        act = acts.get(o["name"]) or ("close" if o["role"] == "articulated" and o["name"] in receivers else "")
+        layout = ARTICULATED_LAYOUTS.get((act, o["asset"]))
         if layout is not None:  # the measured layout of this skill on this object, jittered a little
             targets = [st["target"] for st in proposal["steps"]]
             stays = o["name"] in targets and targets[::-1].index(o["name"]) > 0  # the hand moves on

@@ -97,3 +97,14 @@ def sticks_out(g: dict, c: dict) -> bool:
     from gendex.solve.grasp import hand_fit_scale
 
     return g["size_m"][2] * hand_fit_scale(g["size_m"][:2]) >= c["size_m"][2] + STICK_OUT_M
+
+
+def receptacle(a: dict) -> bool:
+    """A box or bin whose lid opens (catalog tag ``container``, a lid joint) that the offline author puts things in:
+    one with a measured layout that starts its lid open (:data:`~generator.backends.layouts.ARTICULATED_LAYOUTS`'s
+    ``close`` entry: the same layout the press that shuts it afterwards was measured on)."""
+    from generator.backends.layouts import ARTICULATED_LAYOUTS
+
+    joints = a.get("joints") or []
+    return ("container" in a["tags"] and bool(joints) and joints[0]["handle_link"].startswith("lid")
+            and bool((ARTICULATED_LAYOUTS.get(("close", a["id"])) or {}).get("measured")))

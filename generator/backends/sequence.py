@@ -6,8 +6,9 @@ them in turn, else refused saying what it joins.
 What it joins (:data:`WRITES`): first, at most one door or lid the open hand closes (or a lid it opens); then up to
 :data:`MAX_RIGID_STEPS` rigid steps, each moving another object (lifted, put in a container, set down on or by
 something, stacked), where later steps may put things in or on what earlier ones used; a lift only last (the object
-is still held at the end). A lift followed by a step that moves the same object is that step (*pick up the apple,
-then put it in the bowl* is the put)."""
+is still held at the end); last, the lid of a box or bin a step put something in, shut by the open hand (*put the
+dice in the box and shut the lid*). A lift followed by a step that moves the same object is that step (*pick up the
+apple, then put it in the bowl* is the put)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ RIGID_SUCCESS = ("lifted", "inside", "near", "over", "placed")
 MAX_RIGID_STEPS = 3
 """Rigid steps one task joins (each a reach, grasp, carry and release: three fit the episode's time)."""
 WRITES = ("a door or lid the open hand closes (or a lid it opens) first, then up to three steps that each lift, put "
-          "in, set down or stack another object")
+          "in, set down or stack another object, then the lid of a box or bin they put something in shut")
 
 
 def _first_is_composable(first: dict, acts: dict[str, str]) -> bool:
@@ -38,8 +39,21 @@ def _first_is_composable(first: dict, acts: dict[str, str]) -> bool:
 
 
 def _is_rigid(step: dict) -> bool:
-    return (not any(o["role"] == "articulated" for o in step["objects"])
-            and step["success"]["type"] in RIGID_SUCCESS and not step.get("also"))
+    """A step that moves a rigid object (into a box or bin with a lid, too)."""
+    roles = {o["name"]: o["role"] for o in step["objects"]}
+    return (step["success"]["type"] in RIGID_SUCCESS and not step.get("also")
+            and roles.get(step["success"]["object"]) != "articulated")
+
+
+def _shuts_what_was_filled(step: dict, before: list[dict], acts: dict[str, str]) -> bool:
+    """Whether ``step`` shuts the lid of a box or bin a step ``before`` put something into, by the press measured on
+    it (*put the dice in the box and shut the lid*)."""
+    if len(step["objects"]) != 1 or step["objects"][0]["role"] != "articulated":
+        return False
+    o = step["objects"][0]
+    layout = ARTICULATED_LAYOUTS.get(("close", o["asset"]))
+    return (acts.get(o["name"]) == "close" and layout is not None and bool(layout["measured"])
+            and any(b["success"].get("target") == o["name"] and b["success"]["type"] == "inside" for b in before))
 
 
 def _moves(step: dict) -> str:
@@ -79,12 +93,16 @@ def join_steps(steps: list[dict], acts: Callable[[dict], dict[str, str]], existi
         kept.append(s)
     if len(kept) == 1:
         return _unique(kept[0], existing)
-    first, rest = (kept[0], kept[1:]) if _first_is_composable(kept[0], acts(kept[0])) else (None, kept)
+    first, rest = (kept[0], kept[1:]) if _first_is_composable(kept[0], acts(kept[0])) else (None, list(kept))
+    last = rest.pop() if len(rest) > 1 and _shuts_what_was_filled(rest[-1], rest[:-1], acts(rest[-1])) else None
+    if first is not None and last is not None and first["objects"][0]["name"] == last["objects"][0]["name"]:
+        raise InstructionError("the offline author opens a lid first or shuts it last, not both (the lid starts shut "
+                               "for the one, open for the other)")
     if not all(_is_rigid(s) for s in rest) or len(rest) > MAX_RIGID_STEPS:
         names = ", then ".join(f"'{s['name']}'" for s in kept)
         raise InstructionError(f"the offline author writes steps in order only as {WRITES}; it cannot write {names} "
                                "as one task yet")
-    if any(s["success"]["type"] == "lifted" for s in rest[:-1]):
+    if any(s["success"]["type"] == "lifted" for s in (rest if last is not None else rest[:-1])):
         raise InstructionError("a lifted object must still be held when the task ends, so the offline author writes a "
                                "lift as the last step only (one hand cannot hold it and work on)")
     moved = [_moves(s) for s in rest]
@@ -127,7 +145,13 @@ def sequence_task(propose_step: Callable[[dict], dict], reading: dict, acts: Cal
     """The proposal for a reading of several steps (its ``then``), from ``propose_step(step_reading)`` (one step's
     guided proposal); :class:`InstructionError` when the steps are not ones this author joins."""
     readings = [reading | {"then": []}, *(reading.get("then") or [])]
-    return join_steps([propose_step(r) for r in readings], acts, existing, names_of)
+    steps: list[dict] = []
+    for r in readings:  # an object of an earlier step is the same model later ('open the bin, then drop ... in it')
+        used = {o["asset"] for s in steps for o in s["objects"]}
+        objects = [m | {"asset": a, "options": [a]} if (a := next((x for x in m.get("options") or () if x in used),
+                                                                    None)) else m for m in r["objects"]]
+        steps.append(propose_step(r | {"objects": objects}))
+    return join_steps(steps, acts, existing, names_of)
 
 
 def parse_step(text: str) -> dict:

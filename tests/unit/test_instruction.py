@@ -233,6 +233,17 @@ def test_groups_the_catalog_cannot_make_are_refused_saying_why(text, refused):
         read(text)
 
 
+def test_a_box_or_bin_with_a_lid_is_something_to_put_in_a_drawer_or_an_appliance_not_yet():
+    r = read("put the lemon in the box and shut the lid")
+    assert [(x.skill, [m.asset for m in x.objects]) for x in (r, *r.then)] == [
+        ("put_in", ["lemon", "box_with_lid_large"]), ("close", ["box_with_lid_large"])]
+    r = read("first open the trash can, then drop the banana into it")
+    assert [x.skill for x in (r, *r.then)] == ["open", "put_in"] and r.then[0].objects[1].asset.startswith("trash")
+    for text in ("put the apple in the drawer", "put the can in the microwave"):
+        with pytest.raises(InstructionError, match="cannot be its receptacle object"):
+            read(text)
+
+
 def test_a_colour_that_is_also_a_name_before_another_name_is_its_colour():
     r = read("set the orange block on the grey tray")
     assert [(m.asset, m.color) for m in r.objects] == [("block_large", "orange"), ("tray", "grey")]

@@ -350,7 +350,7 @@ def test_a_lift_success_is_written_with_a_grasp_so_a_knocked_object_does_not_cou
     lifted = p.success["object"]
     assert ("grasped", lifted, LIFT_HOLD_FINGERS) in conds and ("lifted", lifted, None) in conds
     assert hold_lifted(spec) == spec  # already held: nothing added twice
-    put = next(p for p in proposals if p.success.get("type") == "inside")
+    put = next(p for p in proposals if p.success.get("type") == "inside" and not p.also)
     context["proposal"] = dataclasses.asdict(put)
     context["assets"] = [a for a in asset_dicts() if a["id"] in {o.asset for o in put.objects}]
     other = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, put)
@@ -366,7 +366,8 @@ def test_a_set_down_success_is_written_with_a_release_held_while_it_settles():
     proposals = _proposals(3, 80)
     b = OfflineBackend(seed=3)
     for kind in ("inside", "near", "placed"):
-        p = next(p for p in proposals if p.success.get("type") == kind and p.success.get("target") != "goal")
+        p = next(p for p in proposals if p.success.get("type") == kind and p.success.get("target") != "goal"
+                 and not p.also)
         context = {"proposal": dataclasses.asdict(p), "candidate_index": 0, "index": 0, "attempt": 0,
                    "assets": [a for a in asset_dicts() if a["id"] in {o.asset for o in p.objects}]}
         spec = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p)
@@ -618,3 +619,34 @@ def test_a_take_out_starts_the_object_in_its_container_and_succeeds_with_it_besi
             assert not bool(_holds(env, placed)[0])
     finally:
         env.close()
+
+
+def test_a_box_or_bin_with_a_lid_is_put_into_with_its_lid_open_and_shut_after_if_asked():
+    """*Put the lemon in the box and shut the lid*: the box starts with its lid open (the layout its shutting was
+    measured on), the lemon goes in, the open hand shuts the lid; both conditions are the task's success."""
+    from generator.steps.propose import parse_proposal
+
+    b = OfflineBackend(seed=5)
+
+    def guided(text: str) -> dict:
+        return json.loads(b.complete(ModelRequest(step="propose_guided", prompt="", context={
+            "reading": read_instruction(text, asset_dicts()).to_dict(), "assets": asset_dicts()})).text.split(
+                "```json\n")[1].split("```")[0])
+
+    raw = guided("put the lemon in the box and shut the lid")
+    assert [s["skill"] for s in raw["steps"]] == ["reach", "grasp", "carry", "release", "reach", "close"]
+    assert [(c["type"], c.get("negate")) for c in (raw["success"], *raw["also"])] == [("inside", None),
+                                                                                       ("joint_open", True)]
+    assert raw["description"].count("lidded box") == 2  # one word for the box in both steps
+    p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
+    ids = {o.asset for o in p.objects}
+    for text in ("put the lemon in the box and shut the lid", "put the apple in the small bin"):
+        p = parse_proposal("```json\n" + json.dumps(guided(text)) + "\n```")
+        ids = {o.asset for o in p.objects}
+        context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
+                   "candidate_index": 0, "index": 0, "attempt": 0}
+        spec = parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p)
+        lidded = next(o for o in spec.objects if o.joint_state)
+        assert next(iter(lidded.joint_state.values())) > 1.5, text  # the lid starts open
+    with pytest.raises(InstructionError, match="opens a lid first or shuts it last, not both"):
+        guided("open the small trash can, then put the apple in it, then close its lid")

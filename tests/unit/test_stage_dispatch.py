@@ -1,0 +1,29 @@
+"""Which primitive runs a stage (gendex.solve.executor.StageExecutor.primitive): by the stage's skill and what its
+target is."""
+
+from types import SimpleNamespace as NS
+
+import pytest
+
+from gendex.solve.executor import StageExecutor
+from gendex_envs.errors import ExecutionError
+
+
+def _executor(stages) -> StageExecutor:
+    ex = StageExecutor()
+    ex._env = NS(articulations={"box": object(), "cabinet": object()}, task_spec=NS(stages=stages))
+    return ex
+
+
+def test_a_carry_to_an_articulated_box_is_the_rigid_carry_and_its_lid_is_pressed():
+    """*Put the lemon in the box and shut the lid*: the carry's target is where the lemon goes (the box's body), so
+    the rigid carry runs; the box's lid is pushed by the open hand (no stage grasps it)."""
+    stages = [NS(name=n, skill=k, target=t) for n, k, t in (
+        ("reach_lemon", "reach", "lemon"), ("grasp_lemon", "grasp", "lemon"), ("carry_box", "carry", "box"),
+        ("release_lemon", "release", "lemon"), ("reach_box", "reach", "box"), ("close_box", "close", "box"))]
+    ex = _executor(stages)
+    assert [ex.primitive(s) for s in stages] == ["approach", "grasp", "carry", "release", "approach_press", "press"]
+    grasped = [NS(name="grasp_cabinet", skill="grasp", target="cabinet"), NS(name="o", skill="open", target="cabinet")]
+    assert [_executor(grasped).primitive(s) for s in grasped] == ["hook", "pull"]
+    with pytest.raises(ExecutionError, match="no primitive for skill 'lift' on an ungrasped articulated target"):
+        ex.primitive(NS(name="lift_box", skill="lift", target="box"))
