@@ -52,7 +52,7 @@ from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.press import PressPrimitives
 from gendex.solve.rigid import CARRY_M_PER_STEP, RigidConfig, RigidPrimitives
-from gendex.solve.set_down import POINT, placed_condition, set_down_point
+from gendex.solve.set_down import POINT, free_spot, placed_condition, set_down_point
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.success import SET_DOWN_CONDITIONS
@@ -369,7 +369,9 @@ class StageExecutor:
         if point is not None and self.rigid.placed_on != POINT:
             yield from self.rigid.place(held, point)
         elif held is not None and onto is not None and self.rigid.placed_on != onto:
-            yield from self.rigid.place(onto)
+            inside = any(c.type == "inside" and c.object == held and c.target == onto
+                         for c in (*(stage.success or ()), *self._env.task_spec.success.conditions))
+            yield from self.rigid.place(onto, at=free_spot(self._env, onto, held) if inside else None)
         yield from self.rigid.release()
 
 

@@ -477,16 +477,17 @@ class RigidPrimitives:
             raise ExecutionError(f"{held!r} slipped in the hand while carried to {target!r} (drifted {drift:.3f} m)",
                                  cause="slipped")
 
-    def place(self, target: str, point: np.ndarray | None = None) -> Iterator[np.ndarray]:
-        """Lower the held object onto ``target`` (a surface, another object, a container's floor), or onto the
-        table at ``point`` (xy), until it rests there: the palm descends (grip guarded) to where the object's bottom
-        meets the top under it; the descent goes a little below the surface and stops once the object stops
-        following the palm (it is supported, and pressed flat)."""
+    def place(self, target: str, point: np.ndarray | None = None, at: np.ndarray | None = None
+              ) -> Iterator[np.ndarray]:
+        """Lower the held object onto ``target`` (a surface, an object, a container's floor; at its spot ``at`` or
+        middle), or onto the table at ``point`` (xy), until it rests: the palm descends (grip guarded) to where the
+        object's bottom meets the top under it, a little below, and stops once the object stops following it."""
         c, m, held = self.config, self.m, self.held
         if held is None:
             raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing", "slipped")
         yield from self._stand_as_before(held)
-        goal_xy = self.shape(target).footprint().center if point is None else np.asarray(point, dtype=np.float64)
+        goal_xy = (np.asarray(point, dtype=np.float64) if point is not None
+                   else np.asarray(at, dtype=np.float64) if at is not None else self.shape(target).footprint().center)
         for _ in range(PLACE_CORRECTIONS):  # the carry ends within a few cm: centre the object over the target
             lo, hi = m.world_aabb(held)
             error = goal_xy - (lo[:2] + hi[:2]) / 2

@@ -58,4 +58,27 @@ def set_down_point(env, c: ConditionSpec) -> np.ndarray:
     return a + gap * axis
 
 
-__all__ = ["POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "placed_condition", "set_down_point"]
+def free_spot(env, container: str, held: str) -> np.ndarray | None:
+    """[2] where in ``container`` to set ``held`` down when other objects already lie in it (*put the lemon and the
+    plum in the bowl*: the plum beside the lemon, not on it): across the container's middle from them, as far as
+    ``held`` stays within the space an ``inside`` condition checks; None when the container holds nothing else."""
+    radius = env.container_extent(container)[0]
+    c = rest_point(env, container)[0, :2].double().cpu().numpy()
+    inside = []
+    for name in env.objects:
+        if name in (container, held) or name in env.articulations:
+            continue
+        xy = rest_point(env, name)[0, :2].double().cpu().numpy()
+        if float(np.linalg.norm(xy - c)) < radius:
+            inside.append(xy)
+    if not inside:
+        return None
+    d = np.mean(inside, axis=0) - c
+    n = float(np.linalg.norm(d))
+    d = d / n if n > 1e-3 else np.array([1.0, 0.0])
+    size = np.asarray(env.asset_record(held).size_m[:2]) * env.task_spec.object(held).scale
+    room = max(0.0, radius - 0.5 * float(np.max(size)))
+    return c - room * d
+
+
+__all__ = ["POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "placed_condition", "set_down_point", "free_spot"]

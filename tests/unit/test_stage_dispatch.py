@@ -27,3 +27,34 @@ def test_a_carry_to_an_articulated_box_is_the_rigid_carry_and_its_lid_is_pressed
     assert [_executor(grasped).primitive(s) for s in grasped] == ["hook", "pull"]
     with pytest.raises(ExecutionError, match="no primitive for skill 'lift' on an ungrasped articulated target"):
         ex.primitive(NS(name="lift_box", skill="lift", target="box"))
+
+
+def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
+    import numpy as np
+    import torch
+
+    from gendex.solve.set_down import free_spot
+
+    poses = {"bowl": (0.1, 0.0), "lemon": (0.13, 0.0), "plum": (0.3, 0.3), "apple": (0.5, 0.5)}
+
+    class Env:
+        objects = {n: None for n in poses}
+        articulations: dict = {}
+        task_spec = NS(object=lambda n: NS(scale=1.0))
+
+        @staticmethod
+        def container_extent(name):
+            return (0.08, 0.06)
+
+        @staticmethod
+        def asset_record(name):
+            return NS(size_m=(0.05, 0.05, 0.05))
+
+    from gendex.solve import set_down
+
+    monkeypatch.setattr(set_down, "rest_point", lambda env, n: torch.tensor([[*poses[n], 0.0]]))
+    spot = free_spot(Env, "bowl", "plum")  # the lemon lies 3 cm beyond the middle: the plum goes to the near side
+    assert np.allclose(spot, (0.1 - (0.08 - 0.025), 0.0))  # as far as it stays within the checked space
+    del poses["lemon"]
+    Env.objects = {n: None for n in poses}
+    assert free_spot(Env, "bowl", "plum") is None  # nothing in it yet: its middle
