@@ -27,6 +27,7 @@ PLACE_WORDS = ("into", "in", "inside", "onto", "on", "on top of")
 TOWER_OF = {"blocks": "block", "cubes": "block"}
 """Plurals a tower is built of, and the catalog category they name."""
 GROUP_WORD = re.compile(r"\b(\w+)\s+(\w+\s+)?(blocks|cubes)\b")
+"""Blocks in the plural after a word (*stack the blocks*, *stack the three wooden cubes*): a tower without the word."""
 NUMBERS = {**{w: i for i, w in enumerate("zero one two three four five six seven eight nine ten".split())},
            **{str(i): i for i in range(11)}}
 """How many blocks a tower request asks for (*the three blocks*, *4 cubes*)."""
