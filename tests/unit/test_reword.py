@@ -159,7 +159,8 @@ def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse(
 
 
 def test_the_offline_author_words_a_proposal_least_like_the_library(task_version, committed_tasks):
-    library = [v.spec.instruction for v in latest_versions(committed_tasks).values()]
+    # the library without the task itself (its own instruction is in no option's way then)
+    library = [v.spec.instruction for v in latest_versions(committed_tasks).values() if v.name != "PutPlumInPot"]
     spec = task_version("PutPlumInPot").spec
     proposal = {"name": "PutPlumInPot", "description": spec.instruction,
                 "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
@@ -171,7 +172,6 @@ def test_the_offline_author_words_a_proposal_least_like_the_library(task_version
     assert apart  # some framing reads like no task of the library
     assert worded["description"] == options[min(apart, key=lambda k: sims[k].mean())]
     assert worded["description"] == LibraryWording(library)(options)
-    assert sims[options.index(spec.instruction)].mean() > sims[options.index(worded["description"])].mean()
     assert ProposalWording()(proposal, []) is proposal
 
 
