@@ -126,20 +126,33 @@ def read_compound(text: str, assets: Sequence[dict], read_one: Callable[[str], R
     tower = read_tower(text, assets)
     if tower is not None:
         return tower
-    steps = [s for part in split_steps(text) for s in and_steps(part, starts_with_verb)]
-    if len(steps) == 1:
+    ordered = split_steps(text)
+    steps = [s for part in ordered for s in and_steps(part, starts_with_verb)]
+    if len(steps) > len(ordered):  # split at 'and' + verb; where a part does not read ('grip the handle and pull
+        try:                       # the door open'), the words around 'and' are one step
+            return _read_steps(text, steps, read_one, group_of)
+        except InstructionError:
+            if len(ordered) == 1:
+                return None
+    if len(ordered) == 1:
         readings = _group(text, read_one, group_of)
-        if readings is None:
-            return None
-    else:
-        readings = []
-        for step in steps:  # a step of several objects is one step per object, each with its own words
-            parts = _group(step, read_one, group_of) or [
-                _with_previous(step, readings[-1], read_one) if readings else read_one(step)]
-            for part in parts:
-                if readings and _same_step(readings[-1], part):
-                    continue  # the step said again in other words: 'take hold of the cube and raise it'
-                readings.append(part)
+        return None if readings is None else dataclasses.replace(readings[0], instruction=text,
+                                                                 then=tuple(readings[1:]))
+    return _read_steps(text, ordered, read_one, group_of)
+
+
+def _read_steps(text: str, steps: list[str], read_one: Callable[[str], Reading],
+                group_of: Callable[[str], tuple[str, int] | None]) -> Reading:
+    """The reading of ``steps`` in order: a step of several objects is one step per object, each with its own
+    words; a step said again in other words is one step."""
+    readings: list[Reading] = []
+    for step in steps:
+        parts = _group(step, read_one, group_of) or [
+            _with_previous(step, readings[-1], read_one) if readings else read_one(step)]
+        for part in parts:
+            if readings and _same_step(readings[-1], part):
+                continue  # 'take hold of the cube and raise it'
+            readings.append(part)
     return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
 
 

@@ -276,8 +276,9 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
         if into:
             return "put_in", end
         return ("place_on" if "place_on" in names else "put_in"), end
-    if " out of " in rest and names[0] in ("lift", "put_in", "place_on", "open", "take_out"):
-        return "take_out", end  # take the apple out of the bowl, pull the can out of the pot
+    moved = next((w for w in words[end:] if w not in DETERMINERS), "")
+    if " out of " in rest and names[0] in ("lift", "put_in", "place_on", "open", "take_out") and moved not in PARTS:
+        return "take_out", end  # take the apple out of the bowl; not 'pull the drawer out of the chest' (an open)
     if "take_out" in names and " lid " in rest:
         return "open", end  # remove the lid
     if names[0] in ("lift", "push", "turn") and (" open " in rest or " lid off " in rest):

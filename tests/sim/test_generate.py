@@ -336,3 +336,20 @@ def test_anthropic_backend_runs_the_pipeline_with_images_and_its_directives_are_
     again = generate(lambda: ReplayBackend(version.files.transcript), tmp_path / "replay", n=1, command="test",
                      candidates=1, gate_attempts=0)
     assert _tree(again[0].committed.root) == _tree(folder)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("request_text, name, conditions", [
+    ("put the lemon and the plum in the bowl", "PutLemonInBowlThenPutPlumInBowl", ["inside", "inside"]),
+    ("take the can out of the bowl", "TakeCanOutOfBowl", ["placed"]),
+    ("stack the three blocks into a tower", "StackBlockMediumOnBlockLargeThenStackBlockSmallOnBlockMedium",
+     ["over", "over"]),
+])
+def test_a_sample_of_the_dev_set_is_generated_and_solved(tmp_path, no_renders, request_text, name, conditions):
+    """Issue 45's slow check: requests of the dev set (tests/data/instructions/dev.yaml) in the new constructs go
+    through the whole pipeline, the solvability gate included (5 seeds, >= 80 %), and are committed as asked."""
+    [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction=request_text, command="test",
+                   gate_attempts=GATE_SEEDS)
+    assert s.committed.name == name and s.gate is not None and s.gate.passed
+    spec = s.committed.spec
+    assert [c.type for c in spec.success.conditions if c.type not in ("released", "grasped")] == conditions

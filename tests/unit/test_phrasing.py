@@ -22,7 +22,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "open_lid": ("trash_can_small", None), "close_lid": ("box_with_lid_large", None),
     "turn": ("faucet_lever_swivel", None), "turn_off": ("valve_lever", None),
     "open_door_part": ("cabinet_left_hinge", None), "open_drawer_part": ("drawer_chest_2", None),
-    "turn_part": ("valve_lever_short", None),
+    "turn_part": ("valve_lever_short", None), "take_out": ("can", "bowl"),
 }
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees")}
