@@ -198,7 +198,8 @@ def _composed(spec: dict, conds: list[dict], fail: str) -> str:
     """Reward of a task of several parts done in turn (``conds``, one success condition each): each part's terms
     count once the parts before it are done, and a done part counts its whole weight. A joint part is done at its
     progress 0.99, a lift at its height; a part that sets an object down, once the object is over where it goes
-    (:func:`rt.place` above :data:`PART_DONE_PLACE`) and back down (below half the lift)."""
+    (:func:`rt.place` above :data:`PART_DONE_PLACE`) and back down (below half the lift; a stacked object, once over
+    its base)."""
     keys, lines = [], []
     for k, c in enumerate(conds):
         obj = c["object"]
@@ -218,7 +219,9 @@ def _composed(spec: dict, conds: list[dict], fail: str) -> str:
                      f"    {carry}\n"
                      + ("    done = lifted > 0.99\n" if c["type"] == "lifted" else
                         f"    over = rt.place(p, {_goal_point(c, spec)})\n"
-                        f"    done = (over > PART_DONE_PLACE) & (info[\"height_{k}\"] < LIFT_M / 2)\n")
+                        # a stacked object stays risen by its base's height: over its base is done
+                        + ("    done = over > PART_DONE_PLACE\n" if c["type"] == "over" else
+                           f"    done = (over > PART_DONE_PLACE) & (info[\"height_{k}\"] < LIFT_M / 2)\n"))
                      +
                      "    reward = reward + gate * torch.where(done, torch.full_like(reach, 4.0), "
                      "reach + grasp + lifted + carry)\n"
