@@ -350,6 +350,7 @@ def test_a_sample_of_the_dev_set_is_generated_and_solved(tmp_path, no_renders, r
     through the whole pipeline, the solvability gate included (5 seeds, >= 80 %), and are committed as asked."""
     [s] = generate(_offline(0), tmp_path, n=1, seed=0, instruction=request_text, command="test",
                    gate_attempts=GATE_SEEDS)
-    assert s.committed.name == name and s.gate is not None and s.gate.passed
+    assert s.gate is not None and s.gate.passed, s.gate
+    assert s.committed.name.removeprefix(name) in ("", "2")  # '2': the library holds a task of that name
     spec = s.committed.spec
     assert [c.type for c in spec.success.conditions if c.type not in ("released", "grasped")] == conditions
