@@ -336,6 +336,12 @@ def names_for(asset: dict, qualifier: str = "") -> tuple[str, ...]:
     return tuple(f"{qualifier} {w}" if qualifier else w for w in words)
 
 
+def object_words(asset: dict) -> tuple[str, ...]:
+    """Every word a command may call ``asset`` by: its synonyms with its model word (*compact microwave*) and
+    without it."""
+    return tuple(dict.fromkeys(names_for(asset, MODEL_WORDS.get(asset["id"], "")) + names_for(asset)))
+
+
 def _pick(rng: np.random.Generator, options: Sequence[str]) -> str:
     return options[int(rng.integers(len(options)))]
 
@@ -495,5 +501,5 @@ def split(instruction: str) -> tuple[str | None, str, str | None]:
 
 
 __all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS", "SITUATIONS_DIRECTED",
-           "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for", "phrase",
-           "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]
+           "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for", "object_words",
+           "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]

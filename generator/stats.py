@@ -87,17 +87,14 @@ STAGE_TASK_SKILLS = ("reorient", "push", "turn")
 
 
 def _starts_in(spec: TaskSpec, name: str | None, target: str | None) -> bool:
-    """Whether spec object ``name`` starts inside container ``target`` (raised off the table over its footprint:
-    :func:`gendex_envs.placement.starts_in`)."""
-    from gendex_envs.placement import STARTS_IN_MIN_CLEARANCE_M
+    """Whether spec object ``name`` starts inside container ``target`` (:func:`gendex_envs.placement.starts_in`)."""
+    from gendex_envs.assets.catalog import get_asset
+    from gendex_envs.placement import starts_in
 
     objs = {o.name: o for o in spec.objects}
-    if name not in objs or target not in objs or objs[name].pos_m[2] <= STARTS_IN_MIN_CLEARANCE_M:
+    if name not in objs or target not in objs:
         return False
-    o, t = objs[name], objs[target]
-    a = asset_dict(t.asset)
-    return "container" in a["tags"] and all(abs(o.pos_m[k] - t.pos_m[k]) < a["size_m"][k] * t.scale / 2
-                                            for k in (0, 1))
+    return starts_in(objs[name], spec.objects, {o.name: get_asset(o.asset) for o in spec.objects}) == target
 
 
 def task_skills(spec: TaskSpec) -> tuple[str, ...]:

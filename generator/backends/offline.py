@@ -61,7 +61,7 @@ from generator.backends.wording import word as _w
 from generator.constructs import amount_text, amount_word, joint_fraction
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
-from generator.phrasing import MODEL_WORDS, Part, names_for, painted, phrase, phrase_parts, qualifiers
+from generator.phrasing import Part, object_words, painted, phrase, phrase_parts, qualifiers
 from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
@@ -179,7 +179,7 @@ class OfflineBackend:
                 for a in g for b in c if fits_in(a, b) and sticks_out(a, b)]
         # several objects: two put in one large container (each gets 80 % of it to itself: the second lands beside
         # the first); a tower of the three blocks, the smallest on top
-        names = lambda i: names_for(by_id[i], MODEL_WORDS.get(i, ""))  # noqa: E731
+        names = lambda i: object_words(by_id[i])  # noqa: E731
         for k, a in enumerate(g):
             b, box = g[(3 * k + 5) % len(g)], [x for x in c if _min_xy(x) >= TWO_IN_M]
             if box and a["category"] != b["category"] and all(fits_in(x, box[k % len(box)]) for x in (a, b)):
@@ -392,7 +392,7 @@ class OfflineBackend:
         # in turn; a step is named as if alone, the joined task apart from the existing ones
         step = lambda r: sequence.parse_step(self._propose_guided(request, ctx | {"reading": r,  # noqa: E731
                                                                                  "existing_tasks": []}))
-        names = lambda i: names_for(assets[i], MODEL_WORDS.get(i, "")) + names_for(assets[i])  # noqa: E731
+        names = lambda i: object_words(assets[i])  # noqa: E731
         if reading.get("then"):
             return _fence("json", json.dumps(sequence.sequence_task(step, reading, _acts, existing, names), indent=2))
         skill = reading["skill"]
