@@ -41,7 +41,8 @@ class ConditionSpec:
     """grasped, released, hand_at, fingertips_near: 'handle' = the handle of an articulated object's joint instead
     of the object itself."""
     joint: str | None = None
-    """joint_open, or with ``part: handle``: the joint (default: the asset's main joint)."""
+    """joint_open, joint_at, or with ``part: handle``: the joint (default: the asset's main joint); inside: the joint
+    whose link holds the object (a drawer's slide: the object lies in the drawer's bin, open or shut)."""
     min_height_m: float | None = None
     """lifted: required rise above the object's height at reset (m), > 0."""
     min_fraction: float | None = None
@@ -104,7 +105,8 @@ CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_forc
 
 CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
     "lifted": (("object", "min_height_m"), (), "the object has risen at least min_height_m since reset"),
-    "inside": (("object", "target"), (), "the object rests inside the container target"),
+    "inside": (("object", "target"), ("joint",), "the object rests inside the container target (with joint: in the "
+               "space that joint's link holds, a drawer)"),
     "near": (("object", "target", "max_dist_m"), (), "the object is within max_dist_m of target (or the goal)"),
     "joint_open": (("object", "min_fraction"), ("joint",), "the joint is open at least min_fraction of its range"),
     "rotated": (("object", "min_deg"), (), "the object has turned min_deg about world z since reset"),

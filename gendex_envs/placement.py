@@ -11,6 +11,7 @@ The draws come from torch's RNG, which ManiSkill seeds from the reset seed, so a
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import torch
@@ -84,18 +85,40 @@ class Item:
 
 def starts_in(obj, objects, records) -> str | None:
     """The container spec object ``obj`` starts in: a rigid container (catalog tag ``container``) whose footprint
-    holds ``obj``'s origin, for a rigid object raised more than :data:`STARTS_IN_MIN_CLEARANCE_M` off the table (what
-    the physical checks call ``inside_container``); None otherwise. ``records``: each object's catalog record."""
+    holds ``obj``'s origin, or a chest whose slid-out drawer's bin does (:func:`in_drawer`), for a rigid object
+    raised more than :data:`STARTS_IN_MIN_CLEARANCE_M` off the table (what the physical checks call
+    ``inside_container``); None otherwise. ``records``: each object's catalog record."""
     if obj.pos_m[2] <= STARTS_IN_MIN_CLEARANCE_M or records[obj.name].articulated:
         return None
     for other in objects:
         rec = records[other.name]
+        if other.name != obj.name and rec.articulated and in_drawer(obj, other, rec):
+            return other.name
         if other.name == obj.name or "container" not in rec.tags or rec.articulated:
             continue
         half = [v * other.scale / 2 for v in rec.size_m[:2]]
         if all(abs(obj.pos_m[k] - other.pos_m[k]) < half[k] for k in (0, 1)):
             return other.name
     return None
+
+
+def in_drawer(obj, chest, rec) -> bool:
+    """Object ``obj``'s nominal origin lies in the bin of a drawer of articulated ``chest`` (catalog record ``rec``)
+    slid out as far as the chest's ``joint_state`` says (a drawer slides its link along -x of the asset frame)."""
+    w, z = chest.quat_wxyz[0], chest.quat_wxyz[3]
+    yaw = 2.0 * math.atan2(z, w)
+    dx, dy = obj.pos_m[0] - chest.pos_m[0], obj.pos_m[1] - chest.pos_m[1]
+    x = (math.cos(yaw) * dx + math.sin(yaw) * dy) / chest.scale  # in the chest's frame, at scale 1
+    y = (-math.sin(yaw) * dx + math.cos(yaw) * dy) / chest.scale
+    for j in rec.joints:
+        if j.holds_m is None or j.link_origin_m is None:
+            continue
+        q = chest.joint_state.get(j.name, j.closed_qpos)
+        lx, ly = x - j.link_origin_m[0] + q, y - j.link_origin_m[1]
+        (x0, y0, _), (x1, y1, _) = j.holds_m
+        if x0 <= lx <= x1 and y0 <= ly <= y1:
+            return True
+    return False
 
 
 def place(items: list[Item], batch: int, table_half: tuple[float, float], device=None
@@ -126,6 +149,7 @@ def _draw(items: list[Item], batch: int, table_half: tuple[float, float], device
     placed: list[tuple[Item, torch.Tensor, torch.Tensor]] = []  # item, footprint centre [B, 2], yaw [B]
     out: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
     all_ok = torch.ones(batch, dtype=torch.bool, device=device)
+    by_name = {it.name: it for it in items}
     for it in sorted(items, key=lambda it: it.starts_in is not None):  # containers before what starts in them
         base = torch.tensor(it.pos, dtype=torch.float32, device=device).expand(batch, 2)
         noise_xy = torch.zeros(batch, 2, device=device)
@@ -133,7 +157,13 @@ def _draw(items: list[Item], batch: int, table_half: tuple[float, float], device
         if it.starts_in is not None:
             if it.noise_yaw_rad > 0:
                 noise_yaw = (torch.rand(batch, device=device) * 2 - 1) * it.noise_yaw_rad
-            out[it.name] = (out[it.starts_in][0].clone(), noise_yaw)
+            # it moves with its container, and turns with it about the container's origin (a drawer's bin lies
+            # 30 cm out of its chest's)
+            dxy, dyaw = out[it.starts_in]
+            rel = base - torch.tensor(by_name[it.starts_in].pos, dtype=torch.float32, device=device)
+            c, s = torch.cos(dyaw), torch.sin(dyaw)
+            turned = torch.stack([c * rel[:, 0] - s * rel[:, 1], s * rel[:, 0] + c * rel[:, 1]], dim=-1)
+            out[it.name] = (dxy + turned - rel, noise_yaw)
             continue
         todo = torch.ones(batch, dtype=torch.bool, device=device)
         moves = it.noise_xy[0] > 0 or it.noise_xy[1] > 0

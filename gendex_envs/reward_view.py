@@ -31,6 +31,8 @@ from typing import TYPE_CHECKING, Any
 
 import torch
 
+from gendex_envs.holds import holds_point
+
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
 
@@ -296,6 +298,10 @@ class RewardView:
 
     def joint_open_fraction(self, name: str, joint: str | None = None) -> torch.Tensor:
         return _fresh(_env(self).joint_open_fraction(name, joint))
+
+    def holds_point(self, name: str, joint: str | None = None) -> torch.Tensor:
+        """[N, 3] the middle of the floor of the space the joint's link holds things in (a drawer's bin)."""
+        return _fresh(holds_point(_env(self), name, joint))
 
     # ---- goal and success
     @property

@@ -27,6 +27,7 @@ import torch
 
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import box_rest_point, xy_distance, z_twist
+from gendex_envs.holds import in_holds
 from gendex_envs.reward_checks import check_evaluate
 from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, SuccessSpec, TaskSpec
 
@@ -139,6 +140,8 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
         target = env.goal_pos if c.target == GOAL_TARGET else env.obj_pose(c.target).p
         return torch.linalg.norm(rest_point(env, c.object) - target, dim=-1) <= c.max_dist_m
     if t == "inside":
+        if c.joint is not None:
+            return in_holds(env, c.target, c.joint, rest_point(env, c.object))
         inner_r, top = env.container_extent(c.target)
         box, p = env.obj_pose(c.target).p, rest_point(env, c.object)
         dz = p[:, 2] - box[:, 2]

@@ -268,7 +268,10 @@ def _carry_term(target: str | None, goal: str | None = None) -> str:
 
 def placed_goal(cond: dict, spec: dict) -> str | None:
     """Code for the [N, 3] point a ``placed`` condition sets its object down at (the solver's
-    :func:`gendex.solve.set_down.set_down_point`, in the robot's frame from the spec's base yaw), else None."""
+    :func:`gendex.solve.set_down.set_down_point`, in the robot's frame from the spec's base yaw), or an ``inside``
+    condition with a joint (a drawer's bin: the middle of its floor), else None."""
+    if cond.get("type") == "inside" and cond.get("joint"):
+        return f"env.holds_point({cond['target']!r}, {cond['joint']!r})"
     if cond.get("type") != "placed":
         return None
     yaw = math.radians(float(spec.get("robot", {}).get("base_yaw_deg", 0.0)))

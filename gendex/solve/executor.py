@@ -52,7 +52,15 @@ from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.press import PressPrimitives
 from gendex.solve.rigid import CARRY_M_PER_STEP, RigidConfig, RigidPrimitives
-from gendex.solve.set_down import POINT, free_spot, placed_condition, set_down_point
+from gendex.solve.set_down import (
+    POINT,
+    free_spot,
+    holds_condition,
+    holds_height,
+    holds_spot,
+    placed_condition,
+    set_down_point,
+)
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.success import SET_DOWN_CONDITIONS
@@ -67,6 +75,9 @@ RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carr
 TO_A_PLACE = ("carry", "place")
 """Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object
 (a lidded box whose lid is open: carried over its body's box)."""
+DRAWER_CLEAR_M = 0.15
+"""After letting go in a drawer the palm rises to this far over the drawer's walls: the fingers hang about 12 cm under
+it, and fingers left in the bin caught its front wall on the way to its handle and pulled it out (2 of 8)."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull", "close": "shut"}
 """Skill -> primitive for an articulated target that a stage grasps (hooks by its handle)."""
 PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press"}
@@ -327,12 +338,21 @@ class StageExecutor:
     def _point(self, stage, held: str | None) -> np.ndarray | None:
         """The table point a ``placed`` condition on ``held`` wants it set down at (:mod:`gendex.solve.set_down`),
         fixed when first asked for in an episode (the target does not move under the carry), else None."""
-        c = None if held is None else placed_condition(self._env, held, stage)
-        if c is None:
+        if held is None:
+            return None
+        c = placed_condition(self._env, held, stage)
+        bin_ = None if c is not None else holds_condition(self._env, held, stage)
+        if c is None and bin_ is None:
             return None
         if self._points.get(held) is None:
-            self._points[held] = set_down_point(self._env, c)
+            self._points[held] = set_down_point(self._env, c) if c is not None else holds_spot(self._env, bin_)[:2]
         return self._points[held]
+
+    def _floor(self, stage, held: str | None) -> float | None:
+        """World z of the floor a held object is set down on at its :meth:`_point`: a drawer's bin's for an
+        ``inside`` condition with a joint, else None (the table)."""
+        c = None if held is None else holds_condition(self._env, held, stage)
+        return None if c is None else float(holds_spot(self._env, c)[2])
 
     def _carry(self, stage) -> Iterator[np.ndarray]:
         yield from self.rigid.carry(stage.target, self._point(stage, self.rigid.held))
@@ -367,12 +387,19 @@ class StageExecutor:
         onto = self._set_down_on(stage, held)
         point = self._point(stage, held)
         if point is not None and self.rigid.placed_on != POINT:
-            yield from self.rigid.place(held, point)
+            yield from self.rigid.place(held, point, floor=self._floor(stage, held))
         elif held is not None and onto is not None and self.rigid.placed_on != onto:
             inside = any(c.type == "inside" and c.object == held and c.target == onto
                          for c in (*(stage.success or ()), *self._env.task_spec.success.conditions))
             yield from self.rigid.place(onto, at=free_spot(self._env, onto, held) if inside else None)
         yield from self.rigid.release()
+        drawer = None if held is None else holds_condition(self._env, held, stage)
+        if drawer is not None:  # out of the drawer before anything else: fingers left in it catch its front
+            m = self.rigid.m
+            top = float(holds_spot(self._env, drawer)[2]) + float(holds_height(self._env, drawer))
+            up = top + DRAWER_CLEAR_M - float(m.ik.fk(m.target()).p[2])
+            if up > 0:
+                yield from m.cartesian(np.array([0.0, 0.0, up]), 0.01, partial=True)
 
 
 __all__ = ["ARTICULATED_PRIMITIVES", "PRESS_PRIMITIVES", "RIGID_PRIMITIVES", "SKILL_STEPS", "ExecutionError",

@@ -477,11 +477,11 @@ class RigidPrimitives:
             raise ExecutionError(f"{held!r} slipped in the hand while carried to {target!r} (drifted {drift:.3f} m)",
                                  cause="slipped")
 
-    def place(self, target: str, point: np.ndarray | None = None, at: np.ndarray | None = None
-              ) -> Iterator[np.ndarray]:
-        """Lower the held object onto ``target`` (a surface, an object, a container's floor; at its spot ``at`` or
-        middle), or onto the table at ``point`` (xy), until it rests: the palm descends (grip guarded) to where the
-        object's bottom meets the top under it, a little below, and stops once the object stops following it."""
+    def place(self, target: str, point: np.ndarray | None = None, at: np.ndarray | None = None,
+              floor: float | None = None) -> Iterator[np.ndarray]:
+        """Lower the held object onto ``target`` (a surface, an object, a container's floor; at ``at`` or its middle),
+        or at ``point`` (xy) onto the table or a ``floor`` that high (a drawer's), until it rests: the palm descends
+        (grip guarded) to a little below the top under the object, and stops once the object stops following it."""
         c, m, held = self.config, self.m, self.held
         if held is None:
             raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing", "slipped")
@@ -498,7 +498,7 @@ class RigidPrimitives:
             yield from m.hold(c.motion.settle_steps)
         lo, hi = m.world_aabb(held)
         xy = (lo[:2] + hi[:2]) / 2
-        surface = self.shape(target).top_at(xy) if point is None else self.env.table_height
+        surface = self.shape(target).top_at(xy) if point is None else self.env.table_height if floor is None else floor
         if surface is None:
             raise ExecutionError(f"the held {held!r} is not over {target!r} (nothing of it under {xy.round(3)})",
                                  cause="target_not_reached")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from gendex_envs.conditions import CONDITION_DEFAULTS, ConditionSpec
+from gendex_envs.holds import holds_box, holds_point, in_holds
 from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS, rest_point, robot_axes
 
 POINT_CARRY_M = 0.05
@@ -25,6 +26,54 @@ def placed_condition(env, held: str, stage=None) -> ConditionSpec | None:
     """The ``placed`` condition on ``held`` (the stage's first, then the task's), if any."""
     conds = (*((stage.success or ()) if stage is not None else ()), *env.task_spec.success.conditions)
     return next((c for c in conds if c.type == "placed" and c.object == held and not c.negate), None)
+
+
+def holds_condition(env, held: str, stage=None) -> ConditionSpec | None:
+    """The ``inside`` condition on ``held`` with a joint (*put the can in the drawer*; the stage's first, then the
+    task's), if any."""
+    conds = (*((stage.success or ()) if stage is not None else ()), *env.task_spec.success.conditions)
+    return next((c for c in conds if c.type == "inside" and c.object == held and c.joint is not None
+                 and not c.negate), None)
+
+
+def holds_spot(env, c: ConditionSpec) -> np.ndarray:
+    """[3] the world point to set ``c.object`` down at for ``c`` (an ``inside`` condition with a joint): the middle
+    of the floor of the drawer's bin, from the first env's state."""
+    return holds_point(env, c.target, c.joint)[0].double().cpu().numpy()
+
+
+DRAWER_SIDE_M = 0.1
+"""An object taken out of a drawer is set down this far beyond the drawer's side wall (centre)."""
+
+
+def drawer_of(env, name: str, chest: str) -> str | None:
+    """The joint of ``chest``'s drawer whose bin object ``name`` lay in at reset (first env), if any."""
+    if chest not in env.articulations:
+        return None
+    point = env.init_obj_pos(name)
+    for j in env.asset_record(chest).joints:
+        if j.holds_m is not None and bool(in_holds(env, chest, j.name, point)[0]):
+            return j.name
+    return None
+
+
+def drawer_side(env, chest: str, joint: str, base: np.ndarray, left: np.ndarray) -> np.ndarray:
+    """[2] the table point beside ``chest``'s slid-out drawer ``joint`` (:data:`DRAWER_SIDE_M` beyond its side wall,
+    level with the middle of its part out of the chest), on the side towards the robot's middle."""
+    middle = holds_point(env, chest, joint)[0, :2].double().cpu().numpy()
+    lo, hi = holds_box(env, chest, joint)
+    q = env.obj_pose(chest).q[0].double().cpu().numpy()
+    yaw = 2.0 * np.arctan2(q[3], q[0])
+    across = np.array([-np.sin(yaw), np.cos(yaw)])  # the chest's +y
+    side = -float(np.sign(np.dot(middle - base, left))) or 1.0
+    across = across * (side if np.dot(across, left) >= 0 else -side)
+    return middle + (float(hi[1] - lo[1]) / 2 + DRAWER_SIDE_M) * across
+
+
+def holds_height(env, c: ConditionSpec) -> float:
+    """How high the walls of the drawer's bin of ``c`` (an ``inside`` condition with a joint) stand over its floor."""
+    lo, hi = holds_box(env, c.target, c.joint)
+    return float(hi[2] - lo[2])
 
 
 def set_down_point(env, c: ConditionSpec) -> np.ndarray:
@@ -47,6 +96,9 @@ def set_down_point(env, c: ConditionSpec) -> np.ndarray:
     lo, hi = (CONDITION_DEFAULTS[k] if getattr(c, k) is None else getattr(c, k) for k in ("min_gap_m", "max_gap_m"))
     gap = (lo + hi) / 2
     if c.relation == "next_to":
+        out = drawer_of(env, c.object, c.target)
+        if out is not None:  # out of a chest's drawer: beside the drawer, towards the middle of the robot's reach
+            return drawer_side(env, c.target, out, base, left)
         d = p - a
         n = float(np.linalg.norm(d))
         if n >= lo:  # beside it already, out of the band: set down on the side it comes from
@@ -81,4 +133,5 @@ def free_spot(env, container: str, held: str) -> np.ndarray | None:
     return c - room * d
 
 
-__all__ = ["POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "placed_condition", "set_down_point", "free_spot"]
+__all__ = ["DRAWER_SIDE_M", "POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "drawer_of", "drawer_side", "free_spot",
+           "holds_condition", "holds_height", "holds_spot", "placed_condition", "set_down_point"]

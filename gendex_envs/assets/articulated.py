@@ -162,6 +162,8 @@ class Joint:
     friction: float = 0.02
     effort: float = 50.0
     velocity: float = 3.0
+    holds: tuple[Vec3, Vec3] | None = None
+    """The space the child link holds things in (a drawer's bin), (low, high) corners in the child link frame."""
 
 
 @dataclass(frozen=True)
@@ -225,7 +227,8 @@ class Model:
         lo, hi = self.bounds()
         r6 = lambda xs: tuple(round(float(x), 6) + 0.0 for x in xs)  # noqa: E731
         joints = tuple(JointEntry(j.name, j.type, r6(j.limits), round(j.closed, 6), round(j.open, 6), j.child,
-                                  r6(j.handle_point)) for j in self.joints)
+                                  r6(j.handle_point), None if j.holds is None else (r6(j.holds[0]), r6(j.holds[1])),
+                                  None if j.holds is None else r6(j.origin)) for j in self.joints)
         return AssetEntry(id=self.id, category=self.category, kind="articulated", source=SOURCE, licence=LICENCE,
                           tags=("articulated",) + self.tags, bbox_min_m=r6(lo), bbox_max_m=r6(hi),
                           mass_kg=round(self.mass, 6), friction=self.friction,
@@ -348,7 +351,8 @@ def drawer_chest(id: str, n: int, depth: float = 0.40, width: float = 0.45, heig
         links.append(Link(f"drawer_{i}", 1.2, tuple(shapes + handle)))
         joints.append(Joint(f"drawer_{i}_slide", "prismatic", "body", f"drawer_{i}", (-d / 2, 0.0, bot),
                             (-1.0, 0.0, 0.0),
-                            (0.0, 0.3), 0.0, 0.2, grip, damping=1.0, friction=0.05))
+                            (0.0, 0.3), 0.0, 0.2, grip, damping=1.0, friction=0.05,
+                            holds=((wt, -bw + wt, 0.003 + wt), (bd - wt, bw - wt, bh))))
     return Model(id, "drawer_chest", ("furniture", "container", "drawer"),
                  (Link("body", 9.0, tuple(body)), *links), tuple(joints),
                  params={"depth": d, "width": w, "height": h, "drawers": float(n)})

@@ -47,6 +47,13 @@ class JointEntry:
     """URDF link carrying the handle that operates this joint."""
     handle_point_m: tuple[float, float, float]
     """Centre of the handle's grip, in the handle link's frame at scale 1 (m)."""
+    holds_m: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+    """The space the handle link holds things in (a drawer's bin: its floor's top to its walls' top), as the (low,
+    high) corners of a box in that link's frame at scale 1 (m); None for a link that holds nothing (a door, a lid).
+    An ``inside`` condition with this joint checks it (:func:`gendex_envs.holds.in_holds`)."""
+    link_origin_m: tuple[float, float, float] | None = None
+    """Where a joint with ``holds_m`` puts its link's frame in the asset frame at qpos 0 (m, scale 1; a drawer slides
+    it along -x by its qpos): what an object set in the drawer is placed by before the scene is built."""
 
 
 @dataclass(frozen=True)

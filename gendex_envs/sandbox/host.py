@@ -104,6 +104,7 @@ MEMBERS = {
     "handle_pos": (2, lambda v, n, j: v.handle_pos(n, j)),
     "joint_qpos": (2, lambda v, n, j: v.joint_qpos(n, j)),
     "joint_open_fraction": (2, lambda v, n, j: v.joint_open_fraction(n, j)),
+    "holds_point": (2, lambda v, n, j: v.holds_point(n, j)),
     "goal_pos": (0, lambda v: v.goal_pos),
     "spec_success": (0, lambda v: v.spec_success()),
 }

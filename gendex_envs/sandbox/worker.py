@@ -213,6 +213,9 @@ class RemoteView:
     def joint_open_fraction(self, name: str, joint: str | None = None) -> torch.Tensor:
         return self._get("joint_open_fraction", name, joint).clone()
 
+    def holds_point(self, name: str, joint: str | None = None) -> torch.Tensor:
+        return self._get("holds_point", name, joint).clone()
+
     @property
     def goal_pos(self) -> torch.Tensor:
         return self._get("goal_pos").clone()

@@ -41,12 +41,15 @@ def _check(value, shape: str, n: int, expr: str) -> None:
             assert value.dtype.is_floating_point, f"{expr}: {value.dtype}"
 
 
-@pytest.mark.parametrize("env_id, placeholder, name", [
-    ("GenDex/PutAppleBowl-v0", "NAME", "apple"),
-    ("GenDex/OpenCabinet-v0", "ARTICULATED", "cabinet"),
-    ("GenDex/PushBlockToGoal-v0", "NAME", "block"),
+@pytest.mark.parametrize("env_id, placeholder, name, joint", [
+    ("GenDex/PutAppleBowl-v0", "NAME", "apple", None),
+    ("GenDex/OpenCabinet-v0", "ARTICULATED", "cabinet", None),
+    ("GenDex/PushBlockToGoal-v0", "NAME", "block", None),
+    ("GenDex/OpenDrawer-v1", "ARTICULATED", "drawer_chest", "drawer_0_slide"),
 ])
-def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, name):
+def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, name, joint):
+    """Each documented member, evaluated on a task's objects (JOINT: a drawer's, on a task that has one), has the
+    documented shape and dtype."""
     env = make_env(env_id, control_mode="pd_joint_delta_pos")
     env.reset(seed=0)
     env.step(env.action_space.sample())
@@ -55,9 +58,9 @@ def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, n
     checked = 0
     for expr, shape in _members():
         other = "ARTICULATED" if placeholder == "NAME" else "NAME"
-        if other in expr or ("goal_pos" in expr and u.goal_site is None):
+        if other in expr or ("goal_pos" in expr and u.goal_site is None) or ("JOINT" in expr and joint is None):
             continue
-        code = expr.replace(placeholder, repr(name))
+        code = expr.replace(placeholder, repr(name)).replace("JOINT", repr(joint))
         value = eval(code, {"torch": torch}, {"env": view})
         _check(value, shape, u.num_envs, expr)
         checked += 1
