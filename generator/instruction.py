@@ -171,7 +171,9 @@ def part_kinds(a: dict) -> tuple[str, ...]:
 
 ROLE_TESTS = {
     "graspable": is_graspable, "container": is_container, "surface": is_surface, "block": is_block,
-    "receptacle": lambda a: is_container(a) or ("container" in a["tags"] and "lid" in part_kinds(a)),
+    "receptacle": lambda a: is_container(a) or ("container" in a["tags"] and "lid" in part_kinds(a))
+    or any(j.get("holds_m") for j in a.get("joints") or ()),
+    "holder": lambda a: is_container(a) or any(j.get("holds_m") for j in a.get("joints") or ()),
     "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
@@ -184,7 +186,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "lift": ("graspable",), "put_in": ("graspable", "receptacle"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
-    "take_out": ("graspable", "container"),
+    "take_out": ("graspable", "holder"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -324,7 +326,10 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         if phrase in ("drawer", "drawers"):
             part = "drawer"
         ordinal = next((ORDINALS[w] for w in words[max(0, i - 2):i] if w in ORDINALS), None)
-        if ordinal:
+        if ordinal in ("top", "bottom") and part == "drawer" and skill in ("put_in", "take_out"):
+            # things go in (and come out of) a chest's lowest drawer: its bottom one, the top one of a chest of one
+            match = [a for a in match if ordinal == "bottom" or len(a.get("joints") or ()) == 1] or match
+        elif ordinal:
             notes.append(f"'{ordinal} {phrase}': the solver acts on the {part or 'part'} the task's first joint "
                          "moves; which one is not chosen by its place")
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
@@ -547,7 +552,8 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
             continue
         named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and (
             a["category"] == _by_id(assets, m.asset)["category"]))]
-        if m.qualifier and m.options:  # 'the right fridge': only the models the qualifier chose
+        if m.options and (m.qualifier or m.part == "drawer"):  # 'the right fridge', 'the top drawer': only the
+            # models the qualifier or the drawer's place chose
             named = [a for a in named if a["id"] in m.options]
         fit = [a for a in named if test(a)]
         if m.part is not None and role in ("openable",):

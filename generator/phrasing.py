@@ -91,6 +91,19 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "deposit the {o} in the {d}",
         "pop the {o} into the {d}",
     ),
+    "put_in_drawer": (
+        "put the {o} in the {a}drawer of the {d}",
+        "drop the {o} into the {d}'s open {a}drawer",
+        "place the {o} inside the open {a}drawer of the {d}",
+        "tuck the {o} away in the {d}'s {a}drawer",
+        "store the {o} in the {a}drawer of the {d}",
+    ),
+    "take_out_drawer": (
+        "take the {o} out of the {a}drawer of the {d}",
+        "get the {o} out of the {d}'s open {a}drawer",
+        "remove the {o} from the {a}drawer of the {d}",
+        "lift the {o} out of the {d}'s {a}drawer and leave it on the {s}",
+    ),
     "take_out": (
         "take the {o} out of the {d}",
         "get the {o} out of the {d}",

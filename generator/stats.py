@@ -70,7 +70,7 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
     if kind == "lifted":
         return "lift"
     if kind == "inside":
-        return "put_in"
+        return None if negate else "put_in"  # negated: out of a drawer, said by a take-out's own condition
     if kind == "near":
         return "push" if target_is_goal else "place_on"
     if kind == "over":

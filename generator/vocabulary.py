@@ -23,8 +23,10 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("lift", ("pick up", "pick", "grab", "grasp", "lift", "raise", "hold up", "hold", "take", "get",
                        "hoist"),
               "a graspable object", "pick up the apple"),
-    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck"),
-              "a graspable object and a container (bowl, pot, mug, or a box or bin with a lid), with 'in' or 'into'",
+    TaskSkill("put_in", ("put", "place", "drop", "insert", "move", "transfer", "deposit", "pop", "stow", "tuck",
+                         "store"),
+              "a graspable object and a container (bowl, pot, mug, a box or bin with a lid, a drawer), with 'in' or "
+              "'into'",
               "put the lemon in the bowl"),
     TaskSkill("place_on", ("set", "put", "place", "lay", "move", "rest"),
               "a graspable object and a plate, tray or cutting board, with 'on' or 'onto'",
@@ -42,7 +44,7 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
     TaskSkill("take_out", ("take out", "get out", "lift out", "pull out", "fish out", "remove"),
-              "a graspable object taken out of a container (bowl, pot) and set down on the table beside it",
+              "a graspable object taken out of a container (bowl, pot) or a drawer and set down on the table beside it",
               "take the apple out of the bowl"),
     TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
               "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",

@@ -48,6 +48,8 @@ from generator.backends.roles import (
     _min_xy,
     _part,
     container,
+    drawer_joint,
+    drawer_words,
     fits_in,
     graspable,
     openable,
@@ -160,6 +162,7 @@ class OfflineBackend:
         o = [a for a in assets if openable(a)]
         out = [("lift", self._lift_task(a)) for a in g]
         out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
+        out += [("put_in", self._put_task(a, b)) for a in g for b in assets if drawer_joint(b)]  # a chest's drawer
         out += [("place_on", self._plate_task(a, b)) for a in g for b in p]
         out += [("open_" + _part(a), self._open_task(a)) for a in o]
         usable = {a["id"]: a for a in g}
@@ -250,16 +253,18 @@ class OfflineBackend:
     def _put_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n, t = a["category"], b["category"]
         t = t if t != n else t + "_2"
+        drawer = drawer_joint(b)
         name = _camel("put", *painted(a, colors, 0), "in", *painted(b, colors, 1))
         return {
-            "name": name, "description": phrase("put_in", a, self._words(name), other=b,
-                                                **qualifiers(a, b, colors)),
+            "name": name, "description": phrase("put_in_drawer" if drawer else "put_in", a, self._words(name), other=b,
+                                                amount=drawer_words(b) if drawer else "", **qualifiers(a, b, colors)),
             "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
                         {"name": t, "asset": b["id"], "role": "articulated" if b.get("joints") else "container"}],
             "steps": self._carry_steps(n, t, "above"),
             "success": {"type": "inside", "object": n, "target": t, "min_height_m": None, "min_fraction": None,
-                        "max_dist_m": None},
-            "success_text": f"The {_w(n)} rests inside the {_w(t)}.",
+                        "max_dist_m": None, **({"joint": drawer} if drawer else {})},
+            "success_text": (f"The {_w(n)} rests in the {drawer_words(b)}drawer of the {_w(t)}." if drawer else
+                             f"The {_w(n)} rests inside the {_w(t)}."),
         }
 
     def _plate_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
@@ -443,7 +448,14 @@ class OfflineBackend:
             proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
         elif skill == "take_out":
             g = pick(0, graspable, "object to take out")
-            box = pick(1, lambda x: container(x) and fits_in(g, x), "container it fits in")
+            box = pick(1, lambda x: (container(x) and fits_in(g, x)) or drawer_joint(x) is not None,
+                       "container or drawer it fits in")
+            if drawer_joint(box):
+                raise InstructionError(
+                    f"the offline author does not take things out of a drawer yet: the solver's grasps of an object "
+                    f"lying in a drawer's bin, between its walls, failed (an apple and a can in the {box['id']} "
+                    f"and its like: 0 of 12 attempts); it puts things into one ('put the {g['category']} in the "
+                    f"drawer') and takes them out of a bowl or a pot")
             if not sticks_out(g, box):
                 able = sorted(a["id"] for a in assets.values()
                               if graspable(a) and fits_in(a, box) and sticks_out(a, box))

@@ -12,7 +12,7 @@ import yaml
 
 from generator.backends import placed as placed_tasks
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
-from generator.backends.roles import _acts, _round, graspable
+from generator.backends.roles import DRAWER_OUT_M, _acts, _round, drawer_joint, graspable
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
@@ -56,14 +56,23 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     place = next((c for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "placed"), None)
     inside = {o["name"]: o["starts_in"] for o in proposal["objects"] if o.get("starts_in")}
     receivers = {c.get("target") for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "inside"}
-    spots = ({} if place is None else placed_tasks.take_out_layout(place, place["object"], rng)
+    drawers = {c["target"]: c["joint"] for c in (proposal["success"], *(proposal.get("also") or ()))
+               if c["type"] == "inside" and c.get("joint")}
+    by_name = {o["name"]: o for o in proposal["objects"]}
+    for box in (o for o in proposal["objects"] if o["name"] in inside.values()):  # taken out of a drawer
+        if drawer_joint(assets[box["asset"]]):
+            drawers[box["name"]] = drawer_joint(assets[box["asset"]])
+    spots = ({} if place is None else placed_tasks.take_out_drawer_layout(
+        place, place["object"], assets[by_name[place["target"]]["asset"]], DRAWER_OUT_M, rng)
+             if place["object"] in inside and place.get("target") in drawers else
+             placed_tasks.take_out_layout(place, place["object"], rng)
              if place["object"] in inside else placed_tasks.placed_layout(place, place["object"], rng))
     for o in proposal["objects"]:
         a = assets[o["asset"]]
         # articulated objects anywhere at the back, movable ones where the solver measurably works (module
         # constant); overlaps and support are the critic's job
         (x0, x1), (y0, y1) = ARTICULATED_REGION_M if o["role"] == "articulated" else movable
-        x, y = spots.get(o["name"]) or (rng.uniform(x0, x1), rng.uniform(y0, y1))
+        x, y = (spots.get(o["name"]) or (rng.uniform(x0, x1), rng.uniform(y0, y1)))[:2]
         entry: dict[str, Any] = {"name": o["name"], "asset": o["asset"], "pos_m": [round(x, 3), round(y, 3), 0.0]}
         if o.get("color"):
             entry["color"] = o["color"]
@@ -81,16 +90,22 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 entry["quat_wxyz"] = [round(float(np.cos(half)), 7), 0.0, 0.0, round(float(np.sin(half)), 7)]
             entry["fixed"] = layout.get("fixed", True)
             entry["joint_state"] = {a["joints"][0]["name"]: float(layout["start"])}
+            if o["name"] in drawers and act != "open":  # the drawer it goes in (or comes out of) slid out (as far
+                j = a["joints"][0]  # as its shutting was measured from when a step shuts it), the chest's others shut
+                out = float(layout["start"]) if acts.get(o["name"]) == "close" else DRAWER_OUT_M
+                entry["joint_state"] = {j["name"]: float(j["closed_qpos"]), drawers[o["name"]]: out}
             entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
         elif o["role"] == "articulated":
             j = a["joints"][0]
             entry["fixed"] = True
             entry["joint_state"] = {j["name"]: float(j["closed_qpos"])}
+            if o["name"] in drawers:  # something is taken out of this drawer: slid out
+                entry["joint_state"][drawers[o["name"]]] = DRAWER_OUT_M
             entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
         else:  # what the solver issue asks of every task: +-8 cm, any yaw if round, else +-45 deg
             entry["randomize"] = {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}
-            if o["name"] in inside:  # on the floor of its container, moving with it at reset
-                entry["pos_m"][2] = CONTAINER_FLOOR_M
+            if o["name"] in inside:  # on the floor of its container (or drawer), moving with it at reset
+                entry["pos_m"][2] = spots[o["name"]][2] if len(spots.get(o["name"], ())) > 2 else CONTAINER_FLOOR_M
                 entry["randomize"]["xy_m"] = [0.0, 0.0]
             if proposal["success"].get("target") == "goal" and goal is None:
                 # a push: the goal mark PUSH_M across the table, towards its middle

@@ -14,6 +14,7 @@ import numpy as np
 
 from gendex_envs.spec import RobotSpec
 from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
+from generator.backends.roles import drawer_joint, drawer_spot, drawer_words
 from generator.backends.wording import camel, step, word
 from generator.phrasing import names_for, painted, phrase, qualifiers
 
@@ -26,6 +27,10 @@ TAKE_OUT_ROOM_M = 0.03
 """A taken-out object lies at least this far beyond touching its container (out of it, not leaning on its rim)."""
 TAKE_OUT_BAND_M = 0.12
 """Width of a take-out's ``next_to`` band."""
+DRAWER_TAKE_OUT_BAND_M = 0.3
+"""... and out of a chest's drawer: the solver sets it down beside the slid-out drawer, 0.45-0.47 m from the chest's
+middle (:func:`gendex.solve.set_down.set_down_point`); the object still in the drawer is in this band too, which the
+scene's ``inside`` negated rules out (:func:`generator.steps.scene.out_of_drawer`)."""
 REGION_WORDS = {"left": "left side", "right": "right side", "near": "near side", "far": "far side",
                 "centre": "middle", "near_left": "near left corner", "near_right": "near right corner",
                 "far_left": "far left corner", "far_right": "far right corner"}
@@ -66,19 +71,23 @@ def take_out_task(a: dict, b: dict, colors: tuple[str | None, ...], words: Calla
     (``next_to`` with :data:`TAKE_OUT_ROOM_M` and :data:`TAKE_OUT_BAND_M`)."""
     n, t = a["category"], b["category"] if b["category"] != a["category"] else b["id"]
     name = camel("take", *painted(a, colors, 0), "out", "of", *painted(b, colors, 1))
+    drawer = drawer_joint(b)  # out of a chest's drawer: set down beside the drawer, further from the chest's middle
+    where = f"the {drawer_words(b)}drawer of the {word(t)}" if drawer else f"the {word(t)}"
     return {
         "name": name,
-        "description": phrase("take_out", a, words(name), other=b, **qualifiers(a, b, colors)),
+        "description": phrase("take_out_drawer" if drawer else "take_out", a, words(name), other=b,
+                              amount=drawer_words(b) if drawer else "", **qualifiers(a, b, colors)),
         "objects": [{"name": n, "asset": a["id"], "role": "graspable", "starts_in": t}
                     | ({"color": colors[0]} if colors and colors[0] else {}),
-                    {"name": t, "asset": b["id"], "role": "container"}
+                    {"name": t, "asset": b["id"], "role": "articulated" if drawer else "container"}
                     | ({"color": colors[1]} if len(colors) > 1 and colors[1] else {})],
-        "steps": [step("reach", n, "arm", f"Bring the open hand to the {word(n)} in the {word(t)}."),
+        "steps": [step("reach", n, "arm", f"Bring the open hand to the {word(n)} in {where}."),
                   step("grasp", n, "hand", f"Close the fingers around the {word(n)}."),
-                  step("carry", t, "arm", f"Lift the {word(n)} out of the {word(t)} and carry it beside it."),
+                  step("carry", t, "arm", f"Lift the {word(n)} out of {where} and carry it beside it."),
                   step("release", n, "hand", f"Set the {word(n)} down on the table and let go of it.")],
-        "success": placed_condition(n, a, "next_to", b, (t,), room=TAKE_OUT_ROOM_M, band=TAKE_OUT_BAND_M),
-        "success_text": f"The {word(n)} is out of the {word(t)}, on the table next to it.",
+        "success": placed_condition(n, a, "next_to", b, (t,), room=TAKE_OUT_ROOM_M,
+                                    band=DRAWER_TAKE_OUT_BAND_M if drawer else TAKE_OUT_BAND_M),
+        "success_text": f"The {word(n)} is out of {where}, on the table next to it.",
     }
 
 
@@ -88,6 +97,22 @@ def take_out_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str
     side = float(np.sign(rng.uniform(-1, 1)) or 1.0)
     x, y = float(rng.uniform(0.0, 0.15)), side * float(rng.uniform(0.1, 0.2))
     return {cond["target"]: [x, y], held: [x, y]}
+
+
+DRAWER_CHEST_X_M = 0.6
+"""Nominal x of a chest something is taken out of (where its drawers were measured: the "close" layouts), ..."""
+DRAWER_CHEST_SIDE_M = 0.15
+"""... this far to one side of the table's middle: the object is set down beside its drawer towards the middle."""
+
+
+def take_out_drawer_layout(cond: dict, held: str, chest: dict, out: float, rng: np.random.Generator
+                           ) -> dict[str, list[float]]:
+    """Nominal (x, y) of a chest an object is taken out of (its drawer slid ``out``), and (x, y, z) of the object on
+    the floor of the drawer's bin, in the middle of the part out of the chest."""
+    side = float(np.sign(rng.uniform(-1, 1)) or 1.0)
+    x, y = DRAWER_CHEST_X_M + float(rng.uniform(-0.02, 0.02)), side * DRAWER_CHEST_SIDE_M
+    sx, sy, sz = drawer_spot(chest, out)
+    return {cond["target"]: [x, y], held: [round(x + sx, 3), round(y + sy, 3), round(sz, 3)]}
 
 
 def command(rng: np.random.Generator, a: dict, relation: str, b: dict | None, c: dict | None,
@@ -184,4 +209,5 @@ def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, 
 
 __all__ = ["BAND_M", "HAND_ROOM_M", "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS",
            "TAKE_OUT_BAND_M", "TAKE_OUT_ROOM_M", "command", "placed_condition", "placed_layout", "placed_options",
-           "placed_task", "take_out_layout", "take_out_task"]
+           "placed_task", "take_out_drawer_layout", "take_out_layout",
+           "take_out_task"]

@@ -99,12 +99,46 @@ def sticks_out(g: dict, c: dict) -> bool:
     return g["size_m"][2] * hand_fit_scale(g["size_m"][:2]) >= c["size_m"][2] + STICK_OUT_M
 
 
+RECEIVING_DRAWERS = {"drawer_chest_1": "drawer_0_slide", "drawer_chest_2": "drawer_1_slide",
+                     "drawer_chest_3": "drawer_2_slide"}
+"""The drawer of each chest the offline author puts things in and takes them out of: the lowest (solver, 6 attempts
+each, drawer 28 cm out: 6/6 and 5/6 into chest 1's one drawer, 6/6 into chest 2's and chest 3's bottom ones; their
+top drawers, 40 and 52 cm up, 1-5/6 and 2/6: a carry that high slips)."""
+DRAWER_OUT_M = 0.28
+"""How far a drawer something is put into or taken out of starts slid out (of its 0.3 m): 28 cm of its bin clear of
+the chest, room for the hand round the object."""
+
+
+def drawer_joint(a: dict) -> str | None:
+    """The joint of the drawer of ``a`` the offline author puts things in (:data:`RECEIVING_DRAWERS`: one whose link
+    holds things, ``holds_m``), else None."""
+    name = RECEIVING_DRAWERS.get(a["id"])
+    return name if any(j["name"] == name and j.get("holds_m") for j in a.get("joints") or []) else None
+
+
+def drawer_words(a: dict) -> str:
+    """What a request calls the drawer of :func:`drawer_joint`: ``bottom `` of a chest of several, else nothing."""
+    return "bottom " if len(a.get("joints") or []) > 1 else ""
+
+
+def drawer_spot(a: dict, out: float) -> tuple[float, float, float]:
+    """(x, y, z) in ``a``'s asset frame, at scale 1, of the middle of the floor of the part of its
+    :func:`drawer_joint` drawer's bin that is out of the chest when the drawer is slid ``out`` (m)."""
+    j = next(j for j in a["joints"] if j["name"] == drawer_joint(a))
+    (x0, y0, z0), (x1, y1, _) = j["holds_m"]
+    ox, oy, oz = j["link_origin_m"]
+    return ox - out + (x0 + min(x1, out)) / 2, oy + (y0 + y1) / 2, oz + z0
+
+
 def receptacle(a: dict) -> bool:
-    """A box or bin whose lid opens (catalog tag ``container``, a lid joint) that the offline author puts things in:
-    one with a measured layout that starts its lid open (:data:`~generator.backends.layouts.ARTICULATED_LAYOUTS`'s
+    """A box or bin whose lid opens (catalog tag ``container``, a lid joint), or a chest of drawers
+    (:func:`drawer_joint`), that the offline author puts things in: a box or bin with a measured layout that starts
+    its lid open (:data:`~generator.backends.layouts.ARTICULATED_LAYOUTS`'s
     ``close`` entry: the same layout the press that shuts it afterwards was measured on)."""
     from generator.backends.layouts import ARTICULATED_LAYOUTS
 
     joints = a.get("joints") or []
+    if drawer_joint(a) is not None:
+        return True
     return ("container" in a["tags"] and bool(joints) and joints[0]["handle_link"].startswith("lid")
             and bool((ARTICULATED_LAYOUTS.get(("close", a["id"])) or {}).get("measured")))

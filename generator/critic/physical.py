@@ -85,6 +85,7 @@ import numpy as np
 
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
 from gendex_envs.conditions import CONDITION_DEFAULTS
+from gendex_envs.placement import in_drawer
 from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec
 from generator.critic.directives import Directive
 from generator.critic.layout import Room, choose_move, front_zone
@@ -404,6 +405,8 @@ def _support(p: Placed, placed: dict[str, Placed]) -> tuple[bool, float]:
     for other in placed.values():
         if other is p:
             continue
+        if other.record.articulated and in_drawer(p.spec, other.spec, other.record):
+            return True, bottom  # in a slid-out drawer, whose bin the chest's closed box leaves out
         if not (other.lo[0] <= c[0] <= other.hi[0] and other.lo[1] <= c[1] <= other.hi[1]):
             continue
         if other.lo[2] - SUPPORT_TOL_M <= bottom <= other.hi[2] + SUPPORT_TOL_M:

@@ -40,10 +40,11 @@ MAX_STEPS = 4 * MAX_PARTS
 """Steps of a proposal: up to 4 for a part (reach, grasp, carry, release)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
                 "min_dz_m", "max_dz_m", "fraction", "max_error", "relation", "other", "region", "min_gap_m",
-                "max_gap_m", "max_offset_m")
+                "max_gap_m", "max_offset_m", "joint")
 """Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut; ``fraction``
 and ``max_error`` with ``joint_at``: the joint set part way; ``relation``, ``other``, ``region`` and the gaps with
-``placed``: where the object is set down, seen from the robot)."""
+``placed``: where the object is set down, seen from the robot; ``joint`` with ``inside``: the drawer of a chest it
+lies in)."""
 
 
 def skill_list() -> str:
@@ -87,11 +88,12 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
     names = [o.name for o in objects]
     if len(set(names)) != len(names):
         raise ProposalError(f"object names must be unique: {names}")
-    holders = {o.name for o in objects if o.role == "container"}
+    holders = {o.name for o in objects if o.role == "container"
+               or any(j.get("holds_m") for j in assets[o.asset].get("joints") or ())}
     for i, o in enumerate(objects):
         if o.starts_in is not None and (o.starts_in not in holders or o.role != "graspable"):
-            raise ProposalError(f"objects[{i}]: starts_in {o.starts_in!r} must name a container of the proposal "
-                                f"({sorted(holders) or 'none'}), for a graspable object")
+            raise ProposalError(f"objects[{i}]: starts_in {o.starts_in!r} must name a container or a chest of "
+                                f"drawers of the proposal ({sorted(holders) or 'none'}), for a graspable object")
     steps = []
     for i, s in enumerate(raw["steps"] or []):
         if not isinstance(s, dict):
@@ -145,6 +147,15 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
                                     f"relation {rel!r}; objects: {names}")
     if succ["type"] in ("joint_open", "joint_at") and not assets[objects[names.index(succ["object"])].asset]["joints"]:
         raise ProposalError(f"{where}: {succ['type']} needs an articulated object, {succ['object']!r} is rigid")
+    if succ.get("joint") is not None:
+        if succ["type"] != "inside":
+            raise ProposalError(f"{where}.joint {succ['joint']!r}: a proposal's condition names a joint only for "
+                                f"'inside' (the drawer the object lies in), not for {succ['type']!r}")
+        target = assets[objects[names.index(succ["target"])].asset]
+        holding = [j["name"] for j in target.get("joints") or () if j.get("holds_m")]
+        if succ["joint"] not in holding:
+            raise ProposalError(f"{where}.joint {succ['joint']!r} is not a drawer of {succ['target']!r} that holds "
+                                f"things; allowed: {holding or 'none (it has no drawer)'}")
     if succ["type"] == "joint_at" and not (isinstance(succ.get("fraction"), (int, float))
                                            and 0.0 <= succ["fraction"] <= 1.0):
         raise ProposalError(f"{where}: joint_at needs a fraction in [0, 1] of the way from closed to open, got "

@@ -112,6 +112,30 @@ def let_go(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=success)
 
 
+def out_of_drawer(spec: TaskSpec) -> TaskSpec:
+    """Give every object the success sets down next to a chest it starts in the slid-out drawer of (*take the can
+    out of the drawer*) an ``inside`` negated on that drawer: beside the chest is a band of distances from its
+    middle that the slid-out drawer lies in too, and doing nothing would meet it."""
+    from gendex_envs.assets.catalog import get_asset
+    from gendex_envs.placement import starts_in
+
+    records = {o.name: get_asset(o.asset) for o in spec.objects}
+    by_name = {o.name: o for o in spec.objects}
+    conds, extra = spec.success.conditions, []
+    for c in conds:
+        if c.type != "placed" or c.negate or c.target is None or not records[c.target].articulated \
+                or starts_in(by_name[c.object], spec.objects, records) != c.target:
+            continue
+        chest = by_name[c.target]
+        joint = max((j for j in records[c.target].joints if j.holds_m is not None),
+                    key=lambda j: chest.joint_state.get(j.name, j.closed_qpos))
+        extra.append(ConditionSpec(type="inside", object=c.object, target=c.target, joint=joint.name, negate=True))
+    if not extra:
+        return spec
+    log.info("success of %s: %s must be out of the drawer", spec.name, ", ".join(c.object for c in extra))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + tuple(extra)))
+
+
 def hold_joint_at(spec: TaskSpec) -> TaskSpec:
     """Give a success with a ``joint_at`` condition (a joint set part way) :data:`SETTLED_STEPS` to hold: a door
     swung through the band, or a lever pushed past it, is not where it was asked to be."""
@@ -146,7 +170,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return hold_joint_at(let_go(hold_lifted(spec)))
+    return hold_joint_at(let_go(out_of_drawer(hold_lifted(spec))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

@@ -233,13 +233,15 @@ def test_groups_the_catalog_cannot_make_are_refused_saying_why(text, refused):
         read(text)
 
 
-def test_a_box_or_bin_with_a_lid_is_something_to_put_in_a_drawer_or_an_appliance_not_yet():
+def test_a_box_or_bin_with_a_lid_and_a_drawer_are_something_to_put_in_an_appliance_not_yet():
     r = read("put the lemon in the box and shut the lid")
     assert [(x.skill, [m.asset for m in x.objects]) for x in (r, *r.then)] == [
         ("put_in", ["lemon", "box_with_lid_large"]), ("close", ["box_with_lid_large"])]
     r = read("first open the trash can, then drop the banana into it")
     assert [x.skill for x in (r, *r.then)] == ["open", "put_in"] and r.then[0].objects[1].asset.startswith("trash")
-    for text in ("put the apple in the drawer", "put the can in the microwave"):
+    r = read("put the apple in the drawer")
+    assert (r.skill, r.objects[1].part, r.objects[1].asset.startswith("drawer_chest")) == ("put_in", "drawer", True)
+    for text in ("put the can in the microwave", "put the orange in the oven"):
         with pytest.raises(InstructionError, match="cannot be its receptacle object"):
             read(text)
 

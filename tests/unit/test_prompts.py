@@ -70,3 +70,16 @@ def test_the_guided_prompt_describes_parts_in_turn_towers_and_take_outs():
     assert '"starts_in": "<the container\'s name>"' in text and '"also" list' in text
     assert 'then "put the lemon in the large bowl"' in text and "take_out" in text
     assert "tower" in text and "a lifted object only in the last part" in text
+
+
+def test_the_prompts_describe_a_drawer_as_a_receptacle_with_its_joint():
+    """*Put the can in the bottom drawer*: an ``inside`` condition naming the drawer's joint, in the form
+    ``parse_proposal`` accepts (tests/unit/test_drawers.py); both proposal prompts say so."""
+    guided = render("propose_guided", instruction="put the can in the drawer", asset_guidance="-",
+                    existing_tasks="- (none)", skills="-", condition_types="inside", control_joints="arm, hand",
+                    task_skills="-", reading="-")
+    assert "drawer's joint" in " ".join(guided.split())
+    assert "min_gap_m, max_gap_m, joint}" in guided and "lowest drawer" in guided
+    free = render("propose", asset_guidance="-", existing_tasks="- (none)", skills="-", condition_types="inside",
+                  control_joints="arm, hand")
+    assert '"joint": "drawer_1_slide"' in " ".join(free.split())
