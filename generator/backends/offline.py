@@ -41,6 +41,7 @@ from generator.backends.base import ModelRequest, ModelResponse
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
+    EMPTIED_DRAWERS,
     STICK_OUT_M,
     _acts,
     _joint_at,
@@ -450,13 +451,13 @@ class OfflineBackend:
             g = pick(0, graspable, "object to take out")
             box = pick(1, lambda x: (container(x) and fits_in(g, x)) or drawer_joint(x) is not None,
                        "container or drawer it fits in")
-            if drawer_joint(box):
+            if drawer_joint(box) and box["id"] not in EMPTIED_DRAWERS:
                 raise InstructionError(
                     f"the offline author does not take things out of a drawer yet: the solver's grasps of an object "
                     f"lying in a drawer's bin, between its walls, failed (an apple and a can in the {box['id']} "
                     f"and its like: 0 of 12 attempts); it puts things into one ('put the {g['category']} in the "
                     f"drawer') and takes them out of a bowl or a pot")
-            if not sticks_out(g, box):
+            if not drawer_joint(box) and not sticks_out(g, box):
                 able = sorted(a["id"] for a in assets.values()
                               if graspable(a) and fits_in(a, box) and sticks_out(a, box))
                 raise InstructionError(

@@ -168,3 +168,29 @@ def test_a_take_out_of_a_drawer_is_not_met_by_the_object_lying_in_it():
                                                         joint="drawer_0_slide", negate=True)
     raw["objects"][0]["pos_m"] = [0.2, -0.2, 0.0]  # on the table: nothing to add
     assert len(out_of_drawer(parse_task_spec(raw)).success.conditions) == 1
+
+
+def test_a_drawer_the_author_may_empty_starts_the_object_in_it_and_its_success_is_out_of_it(monkeypatch):
+    """What the author writes for a chest it takes things out of (none is measured good enough yet, so the set is
+    patched here): the can on the floor of the slid-out drawer, in it at every reset wherever the chest is drawn,
+    and the success (beside the chest, not in the drawer) false there."""
+    import generator.backends.offline as offline
+    from gendex_envs.holds import in_holds
+    from gendex_envs.success import conditions_hold
+    from gendex_envs.task_env import TaskEnv
+
+    monkeypatch.setattr(offline, "EMPTIED_DRAWERS", frozenset(RECEIVING_DRAWERS))
+    b = OfflineBackend(seed=2)
+    p = parse_proposal(_guided(b, "take the can out of the bottom drawer of the three-drawer chest"))
+    assert p.objects[0].starts_in == "drawer_chest" and "bottom drawer" in p.description
+    spec = _scene(b, p)
+    assert [(c.type, c.negate) for c in spec.success.conditions] == [("placed", False), ("inside", True),
+                                                                     ("released", False)]
+    env = TaskEnv(task_spec=spec, obs_mode="none", render_backend="none")
+    try:
+        for seed in range(3):
+            env.reset(seed=seed)
+            assert bool(in_holds(env, "drawer_chest", "drawer_2_slide", env.obj_pose("can").p)[0]), seed
+            assert not bool(conditions_hold(env, spec.success.conditions)[0]), seed
+    finally:
+        env.close()
