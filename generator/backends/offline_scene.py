@@ -47,6 +47,17 @@ def _movable_region(proposal: dict, assets: dict[str, dict], acts: dict[str, str
 
 
 
+def _spots(place: dict, inside: dict[str, str], chest: dict | None, rng: np.random.Generator) -> dict[str, list]:
+    """Nominal places of a place's objects: taken out of a ``chest``'s drawer, out of a container, or set by
+    another object (:mod:`generator.backends.placed`)."""
+    held = place["object"]
+    if held in inside and chest is not None:
+        return placed_tasks.take_out_drawer_layout(place, held, chest, DRAWER_OUT_M, rng)
+    if held in inside:
+        return placed_tasks.take_out_layout(place, held, rng)
+    return placed_tasks.placed_layout(place, held, rng)
+
+
 def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator) -> str:
     """A scene answer (a fenced YAML spec) for ``proposal``, drawn with ``rng``."""
     objects = []
@@ -62,11 +73,8 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     for box in (o for o in proposal["objects"] if o["name"] in inside.values()):  # taken out of a drawer
         if drawer_joint(assets[box["asset"]]):
             drawers[box["name"]] = drawer_joint(assets[box["asset"]])
-    spots = ({} if place is None else placed_tasks.take_out_drawer_layout(
-        place, place["object"], assets[by_name[place["target"]]["asset"]], DRAWER_OUT_M, rng)
-             if place["object"] in inside and place.get("target") in drawers else
-             placed_tasks.take_out_layout(place, place["object"], rng)
-             if place["object"] in inside else placed_tasks.placed_layout(place, place["object"], rng))
+    spots = {} if place is None else _spots(place, inside, assets[by_name[place["target"]]["asset"]]
+                                            if place.get("target") in drawers else None, rng)
     for o in proposal["objects"]:
         a = assets[o["asset"]]
         # articulated objects anywhere at the back, movable ones where the solver measurably works (module

@@ -207,7 +207,7 @@ def placed_layout(cond: dict, held: str, rng: np.random.Generator) -> dict[str, 
     return {cond["target"]: [0.1, y_ref], held: [0.1, y_ref + cond["max_gap_m"] + 0.18]}
 
 
-__all__ = ["BAND_M", "HAND_ROOM_M", "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS",
-           "TAKE_OUT_BAND_M", "TAKE_OUT_ROOM_M", "command", "placed_condition", "placed_layout", "placed_options",
-           "placed_task", "take_out_drawer_layout", "take_out_layout",
-           "take_out_task"]
+__all__ = ["BAND_M", "DRAWER_CHEST_SIDE_M", "DRAWER_CHEST_X_M", "DRAWER_TAKE_OUT_BAND_M", "HAND_ROOM_M",
+           "REGIONS_IN_TURN", "REGION_WORDS", "RELATIONS_IN_TURN", "SIDE_WORDS", "TAKE_OUT_BAND_M", "TAKE_OUT_ROOM_M",
+           "command", "placed_condition", "placed_layout", "placed_options", "placed_task", "take_out_drawer_layout",
+           "take_out_layout", "take_out_task"]
