@@ -101,9 +101,10 @@ def sticks_out(g: dict, c: dict) -> bool:
 
 RECEIVING_DRAWERS = {"drawer_chest_1": "drawer_0_slide", "drawer_chest_2": "drawer_1_slide",
                      "drawer_chest_3": "drawer_2_slide"}
-"""The drawer of each chest the offline author puts things in and takes them out of: the lowest (solver, 6 attempts
-each, drawer 28 cm out: 6/6 and 5/6 into chest 1's one drawer, 6/6 into chest 2's and chest 3's bottom ones; their
-top drawers, 40 and 52 cm up, 1-5/6 and 2/6: a carry that high slips)."""
+"""The drawer of each chest the offline author puts things in (and, for :data:`EMPTIED_DRAWERS`, takes them out of):
+the lowest (solver, 4-6 attempts each, drawer 28 cm out: a can 4/4, an apple 6/6, a lemon 5/6 into chest 1's one
+drawer, 6/6 into chest 2's and chest 3's bottom ones; their top drawers, 40 and 52 cm up, 1-5/6 and 2/6: a carry
+that high slips)."""
 EMPTIED_DRAWERS: frozenset[str] = frozenset()
 """The chests whose :data:`RECEIVING_DRAWERS` drawer the offline author takes things out of: none yet (an apple out of
 the two-drawer chest's, a can out of the three-drawer chest's: 0 of 12 gate attempts; the grasp trials fail between
