@@ -151,6 +151,11 @@ def is_container(a: dict) -> bool:
     return "container" in a["tags"] and not a.get("joints") and a["category"] not in ("cup", "wine_glass", "jar")
 
 
+def drawers(a: dict) -> tuple[str, ...]:
+    """The joints of ``a`` whose link holds things (catalog ``holds_m``: a chest's drawers)."""
+    return tuple(j["name"] for j in a.get("joints") or () if j.get("holds_m"))
+
+
 def is_surface(a: dict) -> bool:
     """Something flat to set an object on: a plate, or an asset tagged ``surface`` (tray, cutting board)."""
     return a["category"] == "plate" or ("surface" in a["tags"] and not a.get("joints"))
@@ -172,8 +177,8 @@ def part_kinds(a: dict) -> tuple[str, ...]:
 ROLE_TESTS = {
     "graspable": is_graspable, "container": is_container, "surface": is_surface, "block": is_block,
     "receptacle": lambda a: is_container(a) or ("container" in a["tags"] and "lid" in part_kinds(a))
-    or any(j.get("holds_m") for j in a.get("joints") or ()),
-    "holder": lambda a: is_container(a) or any(j.get("holds_m") for j in a.get("joints") or ()),
+    or bool(drawers(a)),
+    "holder": lambda a: is_container(a) or bool(drawers(a)),
     "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
@@ -587,4 +592,4 @@ def _closest(phrase: str, able: Sequence[dict]) -> dict:
 
 
 __all__ = ["KINDS", "SKILL_ROLES", "SYNONYMS", "TASK_SKILLS", "InstructionError", "Mention", "Reading", "TaskSkill",
-           "read_instruction", "skill_vocabulary"]
+           "drawers", "read_instruction", "skill_vocabulary"]

@@ -117,8 +117,10 @@ the chest, room for the hand round the object."""
 def drawer_joint(a: dict) -> str | None:
     """The joint of the drawer of ``a`` the offline author puts things in (:data:`RECEIVING_DRAWERS`: one whose link
     holds things, ``holds_m``), else None."""
+    from generator.instruction import drawers
+
     name = RECEIVING_DRAWERS.get(a["id"])
-    return name if any(j["name"] == name and j.get("holds_m") for j in a.get("joints") or []) else None
+    return name if name in drawers(a) else None
 
 
 def drawer_words(a: dict) -> str:

@@ -24,7 +24,7 @@ from gendex_envs.spec import (
 from generator.backends.base import Backend
 from generator.catalog_view import asset_dicts, guidance
 from generator.errors import ProposalError, RetriesExhaustedError
-from generator.instruction import Reading, skill_vocabulary
+from generator.instruction import Reading, drawers, skill_vocabulary
 from generator.novelty import Novelty, proposal_signature
 from generator.records import PROPOSAL_CONDITION_TYPES, ROLES, Proposal, ProposedObject, ProposedStep
 from generator.steps.common import ask, parse_json_block
@@ -89,7 +89,7 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
     if len(set(names)) != len(names):
         raise ProposalError(f"object names must be unique: {names}")
     holders = {o.name for o in objects if o.role == "container"
-               or any(j.get("holds_m") for j in assets[o.asset].get("joints") or ())}
+               or drawers(assets[o.asset])}
     for i, o in enumerate(objects):
         if o.starts_in is not None and (o.starts_in not in holders or o.role != "graspable"):
             raise ProposalError(f"objects[{i}]: starts_in {o.starts_in!r} must name a container or a chest of "
@@ -152,7 +152,7 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
             raise ProposalError(f"{where}.joint {succ['joint']!r}: a proposal's condition names a joint only for "
                                 f"'inside' (the drawer the object lies in), not for {succ['type']!r}")
         target = assets[objects[names.index(succ["target"])].asset]
-        holding = [j["name"] for j in target.get("joints") or () if j.get("holds_m")]
+        holding = list(drawers(target))
         if succ["joint"] not in holding:
             raise ProposalError(f"{where}.joint {succ['joint']!r} is not a drawer of {succ['target']!r} that holds "
                                 f"things; allowed: {holding or 'none (it has no drawer)'}")
