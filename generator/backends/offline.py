@@ -163,7 +163,7 @@ class OfflineBackend:
         o = [a for a in assets if openable(a)]
         out = [("lift", self._lift_task(a)) for a in g]
         out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
-        out += [("put_in", self._put_task(a, b)) for a in g for b in assets if drawer_joint(b)]  # a chest's drawer
+        out += [("put_in", self._put_task(a, b)) for a in g for b in assets if drawer_joint(b) and fits_in(a, b)]
         out += [("place_on", self._plate_task(a, b)) for a in g for b in p]
         out += [("open_" + _part(a), self._open_task(a)) for a in o]
         usable = {a["id"]: a for a in g}

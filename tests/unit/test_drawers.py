@@ -194,3 +194,11 @@ def test_a_drawer_the_author_may_empty_starts_the_object_in_it_and_its_success_i
             assert not bool(conditions_hold(env, spec.success.conditions)[0]), seed
     finally:
         env.close()
+
+
+def test_an_object_taller_than_a_drawer_s_walls_is_not_put_in_it():
+    """The cracker box (21 cm) slipped on the carry over the chest (1 of 4 in a batch's gate): refused, naming what
+    it can go in instead."""
+    with pytest.raises(InstructionError, match="'drawer' .* cannot be the container it fits in.*trash_can_tall"):
+        _guided(OfflineBackend(seed=1), "put the cracker box in the drawer")
+    parse_proposal(_guided(OfflineBackend(seed=1), "put the sugar box in the drawer"))  # 17.5 cm: in chest 1's
