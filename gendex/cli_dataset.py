@@ -28,6 +28,7 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
     """Collect every task of a dataset manifest, then check the result against the manifest's checksums. Before it
     collects, one attempt tells whether this code collects as the code that built the manifest did."""
     from gendex.data.datasets import build, load_manifest, manifest_path, record_checksums, save_manifest, verify
+    from gendex.data.numerics import NUMERICS
     from gendex.data.provenance import BuiltWith, canary, check_code, current_commit
     from gendex_envs.errors import GenDexError
 
@@ -40,7 +41,7 @@ def dataset_build(name: str = typer.Argument(..., help="A manifest in datasets/ 
         sums = build(m, target, backend=backend_of(workers, ray, ray_address),
                      progress=lambda task, ok, n: typer.echo(f"  {task}: {ok} episodes after {n} attempts", err=True))
         if record:
-            built = BuiltWith(canary=code.canary or canary(m), commit=current_commit())
+            built = BuiltWith(canary=code.canary or canary(m), commit=current_commit(), numerics=NUMERICS)
             save_manifest(record_checksums(m, sums, built), manifest_path(name))
             typer.echo(f"built {target}: {len(sums)} files; checksums and the code that built them recorded in "
                        f"{manifest_path(name)}")

@@ -50,11 +50,14 @@ class FanOutError(RuntimeError):
 
 @dataclass(frozen=True)
 class Backend:
-    """Where jobs run: ``kind``, with ``workers`` workers; ``address``: a Ray cluster to join (None: start one)."""
+    """Where jobs run: ``kind``, with ``workers`` workers; ``address``: a Ray cluster to join (None: start one);
+    ``env``: environment variables the worker processes start with (libraries that read a switch when they load,
+    e.g. :data:`gendex.data.numerics.PINNED_ENV`)."""
 
     kind: BackendKind = "local"
     workers: int = 1
     address: str | None = None
+    env: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -65,6 +68,9 @@ class Backend:
             raise FanOutError(f"a Ray address ({self.address!r}) needs the ray backend, not {self.kind!r}")
         if self.kind == "local" and self.workers != 1:
             raise FanOutError(f"the local backend runs one worker in this process, not {self.workers}")
+        if self.kind == "local" and self.env:
+            raise FanOutError("the local backend runs in this process, whose environment is already set; worker "
+                              f"environment {dict(self.env)} needs the process or ray backend")
 
     @classmethod
     def from_options(cls, workers: int = 1, ray: bool = False, ray_address: str | None = None) -> Backend:
@@ -86,10 +92,28 @@ class Backend:
 _WORKER: Callable | None = None
 
 
+class _Unbuilt:
+    """Stands for a worker whose ``make_worker()`` raised: each job raises that error, so it reaches the caller
+    (a pool's initializer that raises would instead be restarted for ever)."""
+
+    def __init__(self, error: BaseException):
+        self.error = error
+
+    def __call__(self, job):
+        raise self.error
+
+
+def _build_worker(make_worker: Callable[[], Callable]) -> Callable:
+    _one_thread()
+    try:
+        return make_worker()
+    except Exception as exc:  # any error: it is raised again, in the caller, by the first job
+        return _Unbuilt(exc)
+
+
 def _process_init(make_worker: Callable[[], Callable]) -> None:
     global _WORKER
-    _one_thread()
-    _WORKER = make_worker()
+    _WORKER = _build_worker(make_worker)
 
 
 def _process_call(job):
@@ -105,6 +129,21 @@ def _one_thread() -> None:
 
     torch.set_num_threads(1)
     threadpool_limits(1)
+
+
+@contextlib.contextmanager
+def _environ(env: tuple[tuple[str, str], ...]) -> Iterator[None]:
+    """``env`` set in ``os.environ`` for the block (processes started in it inherit it), then restored."""
+    saved = {k: os.environ.get(k) for k, _ in env}
+    os.environ.update(dict(env))
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
 
 
 # ---------------------------------------------------------------------------------------------- ray backend
@@ -138,8 +177,7 @@ def _actor_class():
         """One worker object in its own process; Ray rebuilds it (and re-runs its unfinished jobs) if it dies."""
 
         def __init__(self, make_worker):
-            _one_thread()
-            self.worker = make_worker()
+            self.worker = _build_worker(make_worker)
 
         def run(self, job):
             return self.worker(job)
@@ -155,7 +193,8 @@ def _ray_map(make_worker: Callable, jobs: Iterable, backend: Backend, ahead: int
     of the line is slow); results are yielded strictly in job order, at most ``ahead`` jobs past the last one."""
     ray = _ray()
     started = ray_init(backend.address, backend.workers)
-    actors = [_actor_class().remote(make_worker) for _ in range(backend.workers)]
+    options = {"runtime_env": {"env_vars": dict(backend.env)}} if backend.env else {}
+    actors = [_actor_class().options(**options).remote(make_worker) for _ in range(backend.workers)]
     in_flight: deque = deque()
     running: dict = {}  # ref -> actor index, for jobs not yet seen finished
     load = [0] * len(actors)
@@ -223,7 +262,8 @@ def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Ba
     elif backend.kind == "process":
         import multiprocessing
 
-        pool = multiprocessing.get_context("spawn").Pool(backend.workers, _process_init, (make_worker,))
+        with _environ(backend.env):  # spawned workers copy this process's environment when they start
+            pool = multiprocessing.get_context("spawn").Pool(backend.workers, _process_init, (make_worker,))
         try:  # in order, at most ``ahead`` submitted past the last result taken (jobs are pulled lazily)
             pending: deque = deque()
             it = iter(jobs)

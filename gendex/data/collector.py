@@ -182,9 +182,12 @@ def attempt_once(cfg: CollectConfig, make_solver: Callable[[], Solver], seed: in
 
 def _make_attempter(cfg: CollectConfig, make_solver: Callable[[], Solver], task_root: str) -> _Attempter:
     """A worker process's attempter (:func:`gendex.fanout.ordered_map`): registers a task registered at run time
-    in the parent (e.g. a scratch root) first."""
+    in the parent (e.g. a scratch root) first. A worker started with pinned numerics checks that they took."""
     import gendex_envs  # noqa: F401
+    from gendex.data import numerics
     from gendex_envs.registry import register_tasks
+
+    numerics.check()
 
     if cfg.task_id not in gym.registry:
         register_tasks([Path(task_root)])

@@ -48,6 +48,7 @@ from typing import Protocol
 import dacite
 import yaml
 
+from gendex.data import numerics
 from gendex.data.episode import EpisodeError
 from gendex.data.provenance import BuiltWith
 from gendex.fanout import Backend, session
@@ -220,13 +221,14 @@ def build(manifest: DatasetManifest, out: Path, *, workers: int = 1,
           progress: Callable[[str, int, int], None] | None = None, backend: Backend | None = None) -> dict[str, str]:
     """Collect every task of ``manifest`` into ``out`` (resumable), write its card and the build record; returns
     the built dataset's checksums. ``progress(task, successes, attempts)`` after each attempt. ``backend``
-    (:class:`gendex.fanout.Backend`, default ``workers`` local processes) runs the attempts; a Ray instance is
-    started once for the whole build."""
+    (:class:`gendex.fanout.Backend`, default ``workers`` local processes) runs the attempts, in worker processes
+    with pinned numerics (:mod:`gendex.data.numerics`: the same bytes on any x86-64 CPU); a Ray instance is started
+    once for the whole build."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     record = {"manifest": manifest.name, "description": manifest.description, "gendex_version":
               manifest.gendex_version, "solver": manifest.solver, "tasks": []}
-    backend = backend or Backend.from_options(workers)
+    backend = numerics.pinned_backend(backend or Backend.from_options(workers))
     with session(backend):
         for t in manifest.tasks:
             _build_task(manifest, t, out, backend, progress, record)

@@ -12,6 +12,7 @@ early sign.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import logging
 import subprocess
@@ -19,6 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from gendex.data.numerics import NUMERICS
 
 log = logging.getLogger(__name__)
 
@@ -37,6 +40,9 @@ class BuiltWith:
     """The git commit of the checkout that built it, when known (informational)."""
     stale: bool = False
     """Marked by ``gendex dataset stale``: the checksums come from older code; a build now gives other files."""
+    numerics: str = ""
+    """The pinned numerics the build ran with (:data:`gendex.data.numerics.NUMERICS`); empty: the CPU's own kernels
+    (builds before pinning, which only a CPU of the same kind reproduces)."""
 
 
 def _digest_arrays(h, name: str, value) -> None:
@@ -50,7 +56,35 @@ def _digest_arrays(h, name: str, value) -> None:
 
 def canary(manifest) -> str:
     """The canary of ``manifest`` under the code at hand: its first task's first attempt (seed ``task.seed``),
-    collected exactly as a build collects it."""
+    collected exactly as a build collects it: in a worker process with pinned numerics."""
+    from gendex.data.numerics import pinned_backend
+    from gendex.fanout import ordered_map
+    from gendex_envs.registry import resolve_task
+
+    root = str(resolve_task(manifest.tasks[0].task).tasks_root)
+    results = ordered_map(functools.partial(_canary_worker, manifest, root), [0], pinned_backend(None))
+    try:
+        return next(results)
+    finally:
+        results.close()
+
+
+def _canary_worker(manifest, task_root: str):
+    """A worker (:func:`gendex.fanout.ordered_map`) computing ``manifest``'s canary in its own process (its first
+    task registered from ``task_root`` when the parent registered it at run time)."""
+    import gymnasium as gym
+
+    import gendex_envs  # noqa: F401
+    from gendex.data import numerics
+    from gendex_envs.registry import register_tasks, resolve_task
+
+    numerics.check()
+    if resolve_task(manifest.tasks[0].task).env_id not in gym.registry:
+        register_tasks([Path(task_root)])
+    return lambda _job: _canary_here(manifest)
+
+
+def _canary_here(manifest) -> str:
     from gendex.data.collector import CollectConfig, attempt_once
     from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
     from gendex_envs.registry import resolve_task
@@ -113,7 +147,9 @@ def check_code(manifest, current: str | None = None) -> CodeCheck:
     if built.canary == current:
         return CodeCheck(name, "same", current, f"{name}: this code collects as the code that built it "
                                                 f"(commit {built.commit or 'unknown'})")
+    why = "" if built.numerics == NUMERICS else (
+        f" (it was built with {built.numerics or 'its CPU' + chr(39) + 's own'} numerics, this code pins {NUMERICS})")
     return CodeCheck(name, "differs", current,
-                     f"{name} was built by other code (commit {built.commit or 'unknown'}): this code collects its "
-                     f"first attempt differently, so a build will not match its checksums; {refresh}, or "
+                     f"{name} was built by other code (commit {built.commit or 'unknown'}){why}: this code collects "
+                     f"its first attempt differently, so a build will not match its checksums; {refresh}, or "
                      f"`gendex dataset stale {name}` marks it as built by older code")

@@ -36,6 +36,10 @@ def _make(die_once_at=None, marker=None):
     return Squarer(die_once_at, marker)
 
 
+def _make_env_reader():
+    return lambda name: (name, os.environ.get(name), os.getpid())
+
+
 @pytest.fixture(scope="module")
 def ray_cluster():
     ray = pytest.importorskip("ray", reason="the ray extra is installed by scripts/setup.sh")
@@ -58,6 +62,8 @@ def test_backends_are_validated_with_named_reasons():
     assert Backend.from_options(2) == Backend("process", 2)
     assert Backend.from_options(2, ray=True) == Backend("ray", 2)
     assert Backend.from_options(1, ray_address="auto") == Backend("ray", 1, "auto")
+    with pytest.raises(FanOutError, match="needs the process or ray backend"):
+        Backend("local", env=(("GENDEX_FANOUT_TEST", "1"),))
 
 
 def test_local_and_process_backends_return_jobs_in_order():
@@ -94,3 +100,16 @@ def test_ray_backend_survives_a_worker_killed_mid_job(ray_cluster, tmp_path):
     dead = int(marker.read_text())
     assert got[6][2] != dead  # job 6 was re-run by another process
     assert len({r[2] for r in got}) >= 2
+
+
+def test_worker_processes_start_with_the_backends_environment(ray_cluster):
+    """A library that reads a switch when it loads (numpy, torch) sees it only if the worker process starts with
+    it: the process and ray backends start theirs with ``env``, and this process's environment is left as it was."""
+    env = (("GENDEX_FANOUT_TEST", "pinned"),)
+    assert "GENDEX_FANOUT_TEST" not in os.environ
+    for backend in (Backend("process", 2, env=env), Backend("ray", 2, env=env)):
+        got = list(ordered_map(_make_env_reader, ["GENDEX_FANOUT_TEST"] * 4, backend))
+        assert {r[1] for r in got} == {"pinned"} and os.getpid() not in {r[2] for r in got}, backend
+    assert "GENDEX_FANOUT_TEST" not in os.environ
+    plain = list(ordered_map(_make_env_reader, ["GENDEX_FANOUT_TEST"] * 2, Backend("process", 2)))
+    assert {r[1] for r in plain} == {None}
