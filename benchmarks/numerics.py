@@ -32,7 +32,6 @@ from gendex.fanout import Backend, ordered_map
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
 from gendex_envs.registry import resolve_task
 
-DEFAULT_TASKS = ("GenDex/PutAppleBowl-v1", "GenDex/PickUpBottle-v1", "GenDex/OpenCabinet-v1")
 SINGLE = {  # one switch at a time, as its library would see another CPU
     "torch plain kernels": ("ATEN_CPU_CAPABILITY",),
     "numpy baseline loops": ("NPY_DISABLE_CPU_FEATURES",),
@@ -61,9 +60,18 @@ def attempts(task: str, seeds: list[int], env: dict[str, str]) -> tuple[list[str
     return [_digest(r) for r in results], [r.seconds for r in results]
 
 
+def manifest_tasks() -> list[str]:
+    """The first task of each committed dataset manifest that records checksums (what a build must reproduce)."""
+    from gendex.data.datasets import load_manifest
+    from gendex_envs.library import library_dir
+
+    manifests = [load_manifest(p.stem) for p in sorted(library_dir("datasets").glob("*.yaml"))]
+    return sorted({m.tasks[0].task for m in manifests if m.checksums})
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--tasks", nargs="+", default=list(DEFAULT_TASKS))
+    ap.add_argument("--tasks", nargs="+", help="env ids (default: the first task of each recorded dataset manifest)")
     ap.add_argument("--attempts", type=int, default=6)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
@@ -72,7 +80,7 @@ def main() -> None:
                 if line.startswith("model name")), platform.machine())
     print(f"machine: {cpu}, {os.cpu_count()} CPUs; pinned numerics {numerics.NUMERICS}")
     pinned = {k: v for k, v in numerics.PINNED_ENV.items() if k != numerics.MARKER}
-    for task in args.tasks:
+    for task in args.tasks or manifest_tasks():
         seeds = list(range(args.seed, args.seed + args.attempts))
         native, t_native = attempts(task, seeds, {})
         print(f"\n{task}, seeds {seeds[0]}..{seeds[-1]}: attempts that differ from native")
