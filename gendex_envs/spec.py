@@ -61,7 +61,8 @@ RobotUid = Literal["ur10e_shadow"]
 Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
-Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient"]
+Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient",
+                "press"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
@@ -81,6 +82,7 @@ SKILL_MEANINGS: dict[str, str] = {
     "push": "push or slide the target across its support without grasping it",
     "turn": "turn the target about its own axis (a knob, a valve, a lid)",
     "reorient": "rotate the target inside the hand (in-hand manipulation)",
+    "press": "press a button or switch past its detent to its other rest position, without grasping it",
 }
 """What each skill of :data:`SKILLS` does; the stage's ``target`` is the object it acts on."""
 assert set(SKILL_MEANINGS) == set(SKILLS)

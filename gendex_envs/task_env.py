@@ -51,6 +51,7 @@ from gendex_envs import guard
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
+from gendex_envs.detents import Detents
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
 from gendex_envs.heap import freeze_long_lived
@@ -281,6 +282,7 @@ class TaskEnv(BaseEnv):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
             self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}
         self.success_tracker = SuccessTracker(self.task_spec.success, self.num_envs, self.device)
+        self.detents = Detents(self)
         self.goal_site = None
         if self.task_spec.goal is not None:
             gb = self.scene.create_actor_builder()
@@ -402,6 +404,9 @@ class TaskEnv(BaseEnv):
         elif tail.shape[-1] != 0:
             raise TaskSpecError(f"state has {tail.shape[-1]} values after the simulation state; expected 0 or "
                                 f"{target.shape[-1]} controller targets")
+
+    def _before_control_step(self):
+        self.detents.update()  # each button's or switch's spring pulls towards its nearest rest position
 
     def _after_simulation_step(self):
         self.agent.contacts.invalidate()

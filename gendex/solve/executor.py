@@ -80,10 +80,10 @@ DRAWER_CLEAR_M = 0.15
 it, and fingers left in the bin caught its front wall on the way to its handle and pulled it out (2 of 8)."""
 ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "pull", "close": "shut"}
 """Skill -> primitive for an articulated target that a stage grasps (hooks by its handle)."""
-PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press"}
+PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press", "press": "press"}
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
-               "open": 50, "close": 50, "turn": 40}
+               "open": 50, "close": 50, "turn": 40, "press": 30}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""

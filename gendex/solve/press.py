@@ -51,6 +51,8 @@ from gendex_envs.physx import px_bodies
 
 log = logging.getLogger(__name__)
 
+MOVES_JOINT = ("open", "close", "turn", "press")
+"""Stage skills that move an articulated target's joint."""
 PALM_CONTACT = np.array([0.0, -0.0135, 0.045])
 """Palm frame point that touches the surface in a palm press: the skin at the palm's centre (the sphere cover of
 the open hand: palm skin at y = -13.3 mm, the palm spans z = 0 to 0.09)."""
@@ -198,6 +200,8 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
             base = axis - np.dot(axis, m) * m
             if np.linalg.norm(base) < 1e-6:  # a slide pushed along its axis: start from the vertical
                 base = np.array([0.0, 0.0, 1.0]) - m[2] * m
+            if np.linalg.norm(base) < 1e-6:  # pushed straight down (a button): start from the link's x
+                base = np.array([1.0, 0.0, 0.0]) - m[0] * m
             base /= np.linalg.norm(base)
             if not joint.prismatic:  # positive angles turn the fingers towards the hinge
                 hinge = rot_t @ (joint.point - joint.link[:3, 3])
@@ -284,8 +288,8 @@ class PressPrimitives(HandlePrimitives):
     def _sign(self, stage) -> float:
         """+1 when ``stage`` (or, for a reach, the stage that moves the joint after it) opens the joint, else -1."""
         spec = self.motion.env.task_spec
-        if stage.skill not in ("open", "close", "turn"):
-            stage = next((s for s in spec.stages if s.target == stage.target and s.skill in ("open", "close", "turn")),
+        if stage.skill not in MOVES_JOINT:
+            stage = next((s for s in spec.stages if s.target == stage.target and s.skill in MOVES_JOINT),
                          stage)
         if stage.skill in ("open", "close"):
             return 1.0 if stage.skill == "open" else -1.0

@@ -38,6 +38,8 @@ DARK: RGBA = (0.12, 0.12, 0.14, 1.0)
 PLASTIC: RGBA = (0.25, 0.45, 0.65, 1.0)
 SILVER: RGBA = (0.68, 0.70, 0.73, 1.0)
 RED: RGBA = (0.80, 0.15, 0.12, 1.0)
+YELLOW: RGBA = (0.95, 0.78, 0.10, 1.0)
+GREEN: RGBA = (0.15, 0.62, 0.25, 1.0)
 
 BAR_R = 0.011
 """Default handle-bar radius (Ø 2.2 cm)."""
@@ -164,6 +166,9 @@ class Joint:
     velocity: float = 3.0
     holds: tuple[Vec3, Vec3] | None = None
     """The space the child link holds things in (a drawer's bin), (low, high) corners in the child link frame."""
+    detents: tuple[float, ...] | None = None
+    """Rest positions (fractions from closed to open) a spring of stiffness ``spring`` pulls towards (nearest)."""
+    spring: float | None = None
 
 
 @dataclass(frozen=True)
@@ -228,7 +233,8 @@ class Model:
         r6 = lambda xs: tuple(round(float(x), 6) + 0.0 for x in xs)  # noqa: E731
         joints = tuple(JointEntry(j.name, j.type, r6(j.limits), round(j.closed, 6), round(j.open, 6), j.child,
                                   r6(j.handle_point), None if j.holds is None else (r6(j.holds[0]), r6(j.holds[1])),
-                                  None if j.holds is None else r6(j.origin)) for j in self.joints)
+                                  None if j.holds is None else r6(j.origin), j.detents, j.spring)
+                       for j in self.joints)
         return AssetEntry(id=self.id, category=self.category, kind="articulated", source=SOURCE, licence=LICENCE,
                           tags=("articulated",) + self.tags, bbox_min_m=r6(lo), bbox_max_m=r6(hi),
                           mass_kg=round(self.mass, 6), friction=self.friction,
@@ -526,6 +532,44 @@ def knob(id: str, style: Literal["stove", "dial"]) -> Model:
                  friction=0.9, params={"style": style, "knob_height": zc})
 
 
+def push_button(id: str, style: Literal["estop", "arcade"]) -> Model:
+    """A push button on a housing that stands on the table; its cap slides straight down when pressed.
+
+    ``estop``: a red mushroom cap on a yellow box; pushed past half its 12 mm travel it latches down (detents at both
+    ends). ``arcade``: a wide green cap on a round housing; it springs back up when let go (one detent, up)."""
+    if style == "estop":
+        housing, top = [box((-0.05, -0.05, 0.0), (0.05, 0.05, 0.07), YELLOW)], 0.07
+        cap = [cyl((0.0, 0.0, 0.01), 0.012, 0.02, "z", DARK), cyl((0.0, 0.0, 0.028), 0.032, 0.016, "z", RED)]
+        travel, detents, spring, cap_top = 0.012, (0.0, 1.0), 800.0, 0.036
+    else:
+        housing, top = [cyl((0.0, 0.0, 0.025), 0.05, 0.05, "z", DARK)], 0.05
+        cap = [cyl((0.0, 0.0, 0.011), 0.036, 0.022, "z", GREEN)]
+        travel, detents, spring, cap_top = 0.01, (0.0,), 600.0, 0.022
+    joint = Joint("button_slide", "prismatic", "body", "button", (0.0, 0.0, top), (0.0, 0.0, -1.0), (0.0, travel), 0.0,
+                  travel, (0.0, 0.0, cap_top), damping=3.0, friction=0.0, effort=50.0, velocity=0.5,
+                  detents=detents, spring=spring)
+    return Model(id, "button", ("control", "button", "press"),
+                 (Link("body", 1.5, tuple(housing)), Link("button", 0.02, tuple(cap))), (joint,), friction=0.9,
+                 params={"style": style, "travel": travel, "housing_height": top,
+                         "color": "red" if style == "estop" else "green"})
+
+
+def lever_switch(id: str, length: float = 0.1, pivot: float = 0.1) -> Model:
+    """A lever switch on the front of a grey box: the lever (``length`` m) sticks out towards -x from a pivot
+    ``pivot`` m up and swings about y, tip up for off, tip down for on (0.35 rad each way of level). It snaps to
+    whichever side it was pushed past level (detents at both ends)."""
+    d, w, h = 0.08, 0.1, pivot + 0.05
+    base = [box((-d / 2, -w / 2, 0.0), (d / 2, w / 2, h), SILVER)]
+    lever = [cyl((0.0, 0.0, 0.0), 0.01, 0.03, "y", DARK), box((-length, -0.011, -0.006), (0.0, 0.011, 0.006), DARK),
+             box((-length, -0.016, -0.009), (-length + 0.025, 0.016, 0.009), RED)]
+    joint = Joint("lever_hinge", "revolute", "body", "lever", (-d / 2 - 0.01, 0.0, pivot), (0.0, -1.0, 0.0),
+                  (-0.35, 0.35), -0.35, 0.35, (-length + 0.0125, 0.0, 0.009), damping=0.01, friction=0.0, effort=5.0,
+                  velocity=3.0, detents=(0.0, 1.0), spring=1.5)
+    return Model(id, "switch", ("control", "switch", "press"),
+                 (Link("body", 1.2, tuple(base)), Link("lever", 0.05, tuple(lever), (0.0, 0.0, 0.0))), (joint,),
+                 friction=0.9, params={"lever_length": length, "pivot_height": pivot, "color": "grey"})
+
+
 VARIANTS: dict[str, Callable[[], Model]] = {
     "cabinet_left_hinge": lambda: cabinet("cabinet_left_hinge", "left"),
     "cabinet_right_hinge": lambda: cabinet("cabinet_right_hinge", "right", 0.36, 0.38, 0.56, "knob_bar"),
@@ -552,6 +596,10 @@ VARIANTS: dict[str, Callable[[], Model]] = {
     "valve_lever_short": lambda: valve("valve_lever_short", 0.09, 0.10),
     "knob_stove": lambda: knob("knob_stove", "stove"),
     "knob_dial": lambda: knob("knob_dial", "dial"),
+    "button_estop": lambda: push_button("button_estop", "estop"),
+    "button_arcade": lambda: push_button("button_arcade", "arcade"),
+    "switch_lever": lambda: lever_switch("switch_lever"),
+    "switch_lever_tall": lambda: lever_switch("switch_lever_tall", 0.12, 0.15),
 }
 """Every shipped variant, by asset id."""
 

@@ -54,6 +54,12 @@ class JointEntry:
     link_origin_m: tuple[float, float, float] | None = None
     """Where a joint with ``holds_m`` puts its link's frame in the asset frame at qpos 0 (m, scale 1; a drawer slides
     it along -x by its qpos): what an object set in the drawer is placed by before the scene is built."""
+    detents: tuple[float, ...] | None = None
+    """Rest positions a spring pulls the joint towards, as fractions of the way from closed (0) to open (1): the
+    nearest one pulls (:mod:`gendex_envs.detents`). ``(0.0,)``: a momentary button that springs back; ``(0.0, 1.0)``:
+    a switch or a latching button that snaps to whichever side it was pushed past the middle. None: no spring."""
+    spring: float | None = None
+    """Stiffness of the detent spring at scale 1 (N/m for a prismatic joint, N·m/rad for a revolute one)."""
 
 
 @dataclass(frozen=True)

@@ -162,7 +162,7 @@ def test_allowed_value_constants() -> None:
     assert CONDITION_TYPES == ("lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
                                "hand_at", "fingertips_near", "hand_open", "placed", "joint_at")
     assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
-                      "reorient")
+                      "reorient", "press")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
