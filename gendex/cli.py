@@ -158,7 +158,9 @@ def gate(task_ids: list[str] = typer.Argument(..., help="Tasks to measure, e.g. 
 @app.command("tasks-doc")
 def tasks_doc(out: Path = typer.Option(Path("docs/tasks.md"), "--out", help="The gallery Markdown file."),
               all_versions: bool = typer.Option(False, "--all-versions", help="A row per version, not per task."),
-              size: int = typer.Option(192, "--size", min=64, help="Thumbnail size (px).")) -> None:
+              size: int = typer.Option(192, "--size", min=64, help="Thumbnail size (px)."),
+              rerender: bool = typer.Option(False, "--rerender", help="Draw every picture again (default: keep a "
+                                                                      "version's picture already there).")) -> None:
     """Write the task gallery (picture, instruction, skills, objects, stages, measured success) to docs/tasks.md,
     with a thumbnail of every task beside it."""
     from gendex_envs.errors import GenDexError
@@ -166,7 +168,7 @@ def tasks_doc(out: Path = typer.Option(Path("docs/tasks.md"), "--out", help="The
     from generator.task_gallery import write_task_gallery
 
     try:
-        path = write_task_gallery(registered_tasks(), out, all_versions=all_versions, size=size)
+        path = write_task_gallery(registered_tasks(), out, all_versions=all_versions, size=size, rerender=rerender)
     except GenDexError as exc:
         _die(exc)
     typer.echo(f"wrote {path}")

@@ -47,16 +47,19 @@ def _row(env_id: str, version: TaskVersion, picture: str) -> str:
 
 
 def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures: Path | None = None,
-                       all_versions: bool = False, size: int = THUMB_PX) -> Path:
+                       all_versions: bool = False, size: int = THUMB_PX, rerender: bool = False) -> Path:
     """Write the gallery Markdown to ``out`` and a thumbnail per task into ``pictures`` (default: a folder named
-    after ``out`` beside it); returns ``out``."""
+    after ``out`` beside it); returns ``out``. A version's folder never changes once published, so a picture already
+    there of that version and size is kept; ``rerender`` draws every one again (after a change to the renderer or to
+    an asset)."""
     chosen = dict(versions) if all_versions else latest_versions(versions)
     pictures = pictures or out.with_suffix("")
     pictures.mkdir(parents=True, exist_ok=True)
     rows = []
     for env_id, version in tqdm(sorted(chosen.items()), desc="task pictures", unit="task"):
         png = pictures / f"{version.name}-v{version.version}.png"
-        Image.fromarray(thumbnail(version, size)).save(png)
+        if rerender or not png.is_file() or Image.open(png).size != (size, size):
+            Image.fromarray(thumbnail(version, size)).save(png)
         rows.append(_row(env_id, version, png.relative_to(out.parent).as_posix()))
     head = ["# Task library", "",
             f"{len(rows)} tasks ({'every version' if all_versions else 'the latest version of each'}), written by "

@@ -34,3 +34,21 @@ def test_gallery_has_a_row_and_a_real_picture_per_task_and_shows_gate_results(tm
     assert f"](tasks/{pic.name})" in text
     img = Image.open(pic)
     assert img.size == (96, 96) and len(set(img.getdata())) > 50  # a rendered scene, not a blank frame
+
+
+def test_a_published_versions_picture_is_kept_unless_asked_to_draw_it_again(tmp_path):
+    """A version's folder never changes once published: tasks-doc keeps its picture (a library of hundreds would
+    otherwise be drawn again for one new task), and --rerender draws it again."""
+    src = next(v for v in registered_tasks().values() if v.name == "LiftApple")
+    versions = {src.env_id: src}
+    out = tmp_path / "docs" / "tasks.md"
+    pic = tmp_path / "docs" / "tasks" / f"LiftApple-v{src.version}.png"
+    pic.parent.mkdir(parents=True)
+    Image.new("RGB", (96, 96), (255, 0, 0)).save(pic)
+    write_task_gallery(versions, out, size=96)
+    assert set(Image.open(pic).getdata()) == {(255, 0, 0)}  # kept
+    write_task_gallery(versions, out, size=128)
+    assert Image.open(pic).size == (128, 128)  # another size: drawn again
+    Image.new("RGB", (128, 128), (255, 0, 0)).save(pic)
+    write_task_gallery(versions, out, size=128, rerender=True)
+    assert len(set(Image.open(pic).getdata())) > 50
