@@ -62,6 +62,16 @@ straight (the finger pads lie at z = 0.174 to 0.185; the tips end 2 cm further).
 SHELF_HAND = HOOK_OPEN | {"FFJ2": 1.57, "MFJ2": 1.57, "RFJ2": 1.57, "LFJ2": 1.2, "LFJ1": 1.57, "LFJ0": 1.57}
 """A shelf: the fingers bent square at their knuckles, straight beyond (the little finger curled out of the way),
 the thumb in the palm plane."""
+POKE_HAND = HOOK_OPEN | {f + j: v for f in ("MF", "RF", "LF") for j, v in (("J3", 1.55), ("J2", 1.55), ("J1", 1.4),
+                                                                          ("J0", 1.4))} | {
+    "THJ4": 1.2, "THJ3": 0.2, "THJ2": 0.2, "THJ1": 0.8, "THJ0": 0.8}
+"""A poke: the index finger straight, the other fingers curled into the palm, the thumb folded across it (their
+lowest points 9 cm behind the index tip)."""
+POKE_TILTS_DEG = (0, 25, 40)
+"""How far a poking finger may lean off the push direction (the wrist then sits nearer the robot: a finger straight
+down over a button 1.2 m from the arm's base leaves the wrist out of reach)."""
+POKE_CONTACT = np.array([0.033, 0.0, 0.195])
+"""Palm frame point that touches in a poke: the end of the straight index finger (its tip site at z = 0.191)."""
 SHELF_CONTACT = np.array([0.011, -0.085, 0.091])
 """Palm frame point that touches the surface in a shelf lift: the top of the bent middle finger 1.6 cm from its
 tip (its axis at z = 0.099, radius 7-8 mm; the fingers end at y = -0.101)."""
@@ -169,10 +179,12 @@ def press_direction(joint: JointFrame, point_local: np.ndarray) -> np.ndarray:
 
 
 def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, sign: float,
-                shelf_first: bool = False) -> list[PressPose]:
+                shelf_first: bool = False, poke_first: bool = False) -> list[PressPose]:
     """Press poses of the moving link (its convex ``shape`` in the link frame) that push the point ``point_local``
     (moved by each of :data:`SHIFTS_M`) towards opening (``sign`` +1) or closing (-1), in order of preference: palm
-    presses before fingertip presses before shelf lifts (``shelf_first``: shelf lifts before fingertip presses);
+    presses before fingertip presses before shelf lifts (``shelf_first``: shelf lifts before fingertip presses;
+    ``poke_first``: index-finger pokes before all of them, a button's or switch's press, where the open hand would
+    push whatever lies under its 20 cm);
     then by contact point; fingers as :data:`FINGER_ANGLES_DEG` orders them; the palm following as :data:`FOLLOWS`
     does."""
     rot_t = joint.link[:3, :3].T
@@ -223,12 +235,40 @@ def press_poses(joint: JointFrame, shape: ObjectShape, point_local: np.ndarray, 
                     for follow in FOLLOWS:
                         out.append(PressPose(off, back.copy(), site=site, fingers=words, back=how, shift_m=shift,
                                              follow=follow, q_ref=joint.q, contact=contact.copy()))
+    if poke_first:
+        out = poke_poses(joint, contacts) + out
     if not joint.prismatic:
         shelves = shelf_poses(joint, contacts)
         if shelf_first:
             palm = [p for p in out if p.site == "palm"]
             return palm + shelves + [p for p in out if p.site != "palm"]
         out += shelves
+    return out
+
+
+def poke_poses(joint: JointFrame, contacts: list[tuple[np.ndarray, np.ndarray, tuple[float, float]]]
+               ) -> list[PressPose]:
+    """Index-finger pokes at each contact: the straight finger along the push, the palm facing each of eight ways
+    about it; the finger backs off along itself."""
+    out = []
+    for surface, m, shift in contacts:
+        base = np.array([1.0, 0.0, 0.0]) - m[0] * m
+        if np.linalg.norm(base) < 1e-6:
+            base = np.array([0.0, 1.0, 0.0]) - m[1] * m
+        base /= np.linalg.norm(base)
+        for tilt in POKE_TILTS_DEG:
+            for deg in FINGER_ANGLES_DEG:
+                h = axis_rotation(m, np.radians(deg)) @ base
+                t = np.radians(tilt)
+                f = np.cos(t) * m - np.sin(t) * h  # the finger leans away from where the palm faces
+                n = h - np.dot(h, f) * f
+                rot = palm_rotation(f, n / np.linalg.norm(n))
+                off = np.eye(4)
+                off[:3, :3] = rot
+                off[:3, 3] = surface - CONTACT_GAP_M * m - rot @ POKE_CONTACT
+                out.append(PressPose(off, -f, site="poke", fingers=f"palm facing {deg:+d} deg, leaning {tilt} deg",
+                                     back="along the finger", shift_m=shift, q_ref=joint.q,
+                                     contact=POKE_CONTACT.copy(), hand=dict(POKE_HAND)))
     return out
 
 
@@ -391,7 +431,9 @@ class PressPrimitives(HandlePrimitives):
         # a lever turned back to off: the fingertips slid off it short of shut (stalled at 0.15-0.17 rad in 8 of 8
         # dev seeds of a faucet and a valve), the bent fingers' shelf carried it home (13 of 13)
         back = sign < 0 and any(s.skill == "turn" and s.target == name for s in u.task_spec.stages)
-        for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign, shelf_first=back):
+        poke = any(s.skill == "press" and s.target == name for s in u.task_spec.stages)
+        for pose in press_poses(joint, self._shape(name), handle_local(u, name), sign, shelf_first=back,
+                                poke_first=poke):
             touch = pose.palm_at(joint, joint.q)
             if pose.site not in covers:
                 covers[pose.site] = self.hand_cover(pose.hand)

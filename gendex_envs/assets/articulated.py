@@ -535,15 +535,16 @@ def knob(id: str, style: Literal["stove", "dial"]) -> Model:
 def push_button(id: str, style: Literal["estop", "arcade"]) -> Model:
     """A push button on a housing that stands on the table; its cap slides straight down when pressed.
 
-    ``estop``: a red mushroom cap on a yellow box; pushed past half its 12 mm travel it latches down (detents at both
-    ends). ``arcade``: a wide green cap on a round housing; it springs back up when let go (one detent, up)."""
+    ``estop``: a red mushroom cap (Ø 5 cm) on a yellow box; pushed past half its 12 mm travel it latches down (detents
+    at both ends). ``arcade``: a green cap (Ø 4 cm) on a round housing; it springs back up when let go (one detent,
+    up)."""
     if style == "estop":
         housing, top = [box((-0.05, -0.05, 0.0), (0.05, 0.05, 0.07), YELLOW)], 0.07
-        cap = [cyl((0.0, 0.0, 0.01), 0.012, 0.02, "z", DARK), cyl((0.0, 0.0, 0.028), 0.032, 0.016, "z", RED)]
+        cap = [cyl((0.0, 0.0, 0.01), 0.012, 0.02, "z", DARK), cyl((0.0, 0.0, 0.028), 0.025, 0.016, "z", RED)]
         travel, detents, spring, cap_top = 0.012, (0.0, 1.0), 800.0, 0.036
     else:
         housing, top = [cyl((0.0, 0.0, 0.025), 0.05, 0.05, "z", DARK)], 0.05
-        cap = [cyl((0.0, 0.0, 0.011), 0.036, 0.022, "z", GREEN)]
+        cap = [cyl((0.0, 0.0, 0.011), 0.02, 0.022, "z", GREEN)]
         travel, detents, spring, cap_top = 0.01, (0.0,), 600.0, 0.022
     joint = Joint("button_slide", "prismatic", "body", "button", (0.0, 0.0, top), (0.0, 0.0, -1.0), (0.0, travel), 0.0,
                   travel, (0.0, 0.0, cap_top), damping=3.0, friction=0.0, effort=50.0, velocity=0.5,
