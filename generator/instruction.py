@@ -165,8 +165,15 @@ def is_block(a: dict) -> bool:
     return "block" in a["tags"] and not a.get("joints")
 
 
+PRESSED = ("button", "switch")
+"""Categories of articulated objects whose one part is pressed past a detent (the ``press`` skill)."""
+
+
 def part_kinds(a: dict) -> tuple[str, ...]:
-    """The kinds of movable part an articulated asset has (``door``, ``drawer``, ``lid``, ``lever``, ``knob``)."""
+    """The kinds of movable part an articulated asset has (``door``, ``drawer``, ``lid``, ``lever``, ``knob``; a
+    button's or a switch's one part is ``button`` or ``switch``)."""
+    if a.get("category") in PRESSED:
+        return tuple(a["category"] for _ in a.get("joints") or [])
     kinds = []
     for j in a.get("joints") or []:
         link = j.get("handle_link") or j["name"]
@@ -182,6 +189,7 @@ ROLE_TESTS = {
     "pushable": lambda a: not a.get("joints") and max(a["size_m"][:2]) <= 0.25,
     "openable": lambda a: any(k in ("door", "drawer", "lid") for k in part_kinds(a)),
     "turnable": lambda a: any(k in ("lever", "knob") for k in part_kinds(a)),
+    "pressable": lambda a: any(k in PRESSED for k in part_kinds(a)),
     "ball": lambda a: "ball" in a["tags"] and not a.get("joints"),
     "landmark": lambda a: not a.get("joints"),
 }
@@ -191,7 +199,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "lift": ("graspable",), "put_in": ("graspable", "receptacle"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
-    "take_out": ("graspable", "holder"),
+    "take_out": ("graspable", "holder"), "press": ("pressable",),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -227,9 +235,11 @@ def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
         for phrase in (cat.replace("_", " "), cat.replace("_", "")):
             add(phrase, "name", same)
             add(phrase + ("es" if phrase.endswith(("s", "x", "ch")) else "s"), "name", same)
+    categories = {b["category"] for b in assets}
     for phrase, target in SYNONYMS.items():
         match = [b for b in assets if target in (b["category"], b["id"])]
-        add(phrase, "synonym", match)
+        # a word for one model ('emergency stop' -> button_estop) names it as its id does, not any of its kind
+        add(phrase, "synonym" if target in categories else "id", match)
     return out
 
 
@@ -315,7 +325,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     skill, verb_end = found
     in_hand = find(words, "in the hand") >= 0 or find(words, "in hand") >= 0 or find(words, "in its hand") >= 0
     names = _names(assets)
-    spans = _spans(words, names)
+    # a name inside the verb is the verb: 'switch on the tap' (the verb), 'turn on the switch' (the object)
+    spans = [sp for sp in _spans(words, names) if sp[0] >= verb_end or sp[2] not in _VERB_WORDS]
     # a colour that is also a name ('orange') right before another name is its colour: 'the orange block'
     spans = [sp for k, sp in enumerate(spans) if not (sp[2] in COLOR_WORDS and k + 1 < len(spans)
                                                       and spans[k + 1][0] == sp[1])]
@@ -413,6 +424,10 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if loose:
         notes.append(loose)
     off = is_off(words)
+    if skill in ("push", "turn", "lift", "open") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
+            _by_id(assets, mentions[0].asset)):
+        skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'
+        _refuse_unbuilt(text, words, skill)
     if skill == "close" and mentions and mentions[0].asset and ROLE_TESTS["turnable"](
             _by_id(assets, mentions[0].asset)) and not ROLE_TESTS["openable"](_by_id(assets, mentions[0].asset)):
         skill, roles, direction = "turn", SKILL_ROLES["turn"], "off"  # 'close the valve', 'shut the tap'
@@ -421,13 +436,22 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         direction = "off" if off else "on"
     _refuse_unbuilt(text, words, skill, [m for m in mentions if m.qualifier and m.how in ("id", "name", "synonym")
                                          and not any(f"'{m.qualifier}' in" in n for n in notes)])
-    resolved = _assign(skill, roles, mentions, assets, text)
+    resolved = [_own_color(m, assets) for m in _assign(skill, roles, mentions, assets, text)]
     for m in resolved:
         if m.color is not None and _by_id(assets, m.asset).get("joints"):
             raise InstructionError(f"'{m.phrase}': painting an articulated object ({m.asset}) is not built yet; ask "
                                    f"for it without a colour")
     return Reading(text, skill, tuple(resolved), tuple(notes), direction=direction, relation=relation,
                    region=region, amount=amount)
+
+
+def _own_color(m: Mention, assets: Sequence[dict]) -> Mention:
+    """``m`` with its colour dropped when it names the model of its options that has that colour as its own look
+    (an articulated model's ``color``: 'the red button' is the emergency stop, not a button painted red)."""
+    if m.color is None:
+        return m
+    own = [i for i in m.options or (m.asset,) if _by_id(assets, i).get("color") == m.color]
+    return dataclasses.replace(m, asset=own[0], options=tuple(own), color=None) if own else m
 
 
 def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,

@@ -169,6 +169,18 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "swing the {d}'s lever round to turn it on",
         "turn the {d} on by pushing its handle all the way to one side",
     ),
+    "press_button": (
+        "press the {d} all the way down",
+        "push the {d} in until it clicks",
+        "press down on the {d} with the open hand",
+        "give the {d} a firm press",
+    ),
+    "press_switch": (
+        "flip the {d} on",
+        "push the {d}'s lever down to switch it on",
+        "switch the {d} on by pressing its lever down",
+        "press the {d}'s lever down until it clicks on",
+    ),
     "open_door_part": (
         "open the {d}'s door {a} and hold it there",
         "pull the {d} door open {a}, no further",
@@ -418,7 +430,7 @@ def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | No
 
 def direction(skill: str) -> str | None:
     """``"open"`` for a skill that opens or turns something on, ``"close"`` for one that closes, else None."""
-    if skill.startswith("open_") or skill in ("turn", "turn_part"):
+    if skill.startswith(("open_", "press_")) or skill in ("turn", "turn_part"):
         return "open"
     if skill.startswith("close_") or skill == "turn_off":
         return "close"

@@ -41,6 +41,8 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
               "a door, drawer or lid (cabinet, microwave, drawer chest, trash can)", "close the cabinet door"),
     TaskSkill("turn", ("turn on", "switch on", "turn", "twist", "swing", "turn off", "switch off", "switch"),
               "a faucet or valve lever, on or off", "turn on the faucet"),
+    TaskSkill("press", ("press", "push down", "hit", "click", "depress", "flip", "toggle", "punch", "smash"),
+              "a button pressed all the way down, or a lever switch flipped on", "press the emergency stop button"),
     TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
     TaskSkill("take_out", ("take out", "get out", "lift out", "pull out", "fish out", "remove"),
@@ -69,7 +71,11 @@ SYNONYMS: dict[str, str] = {
     "teacup": "cup", "soft brick": "foam_brick", "puzzle cube": "rubiks_cube", "drawer unit": "drawer_chest",
     "storage box": "box_with_lid", "notebook computer": "laptop", "stove knob": "knob_stove",
     "chopping board": "cutting_board", "serving tray": "tray", "ball valve": "valve", "shutoff valve": "valve",
-    "stopcock": "valve",
+    "stopcock": "valve", "emergency stop": "button_estop", "emergency stop button": "button_estop",
+    "estop": "button_estop", "stop button": "button_estop", "kill switch": "button_estop",
+    "arcade button": "button_arcade", "push button": "button", "pushbutton": "button", "buzzer": "button_arcade",
+    "game button": "button_arcade", "light switch": "switch", "toggle switch": "switch", "lever switch": "switch",
+    "breaker": "switch", "power switch": "switch", "tall switch": "switch_lever_tall",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 

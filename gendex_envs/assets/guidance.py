@@ -21,6 +21,8 @@ def asset_summary(record: AssetRecord) -> dict:
     if record.articulated:
         out["fixed_base"] = e.fixed_base
         out["joints"] = [asdict(j) for j in e.joints]
+        if "color" in e.params:  # the colour people call it by ('the red button')
+            out["color"] = e.params["color"]
     return out
 
 

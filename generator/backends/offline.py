@@ -82,7 +82,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "several", "composed")
+              "press", "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -196,7 +196,7 @@ class OfflineBackend:
         # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
-                  if i in by_id and not lay["grasp"] and lay["measured"] and skill not in ("turn", "turn_off")
+                  if i in by_id and not lay["grasp"] and lay["measured"] and skill not in ("turn", "turn_off", "press")
                   and lay.get("composed", True)]
         seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in g for b in c if fits_in(a, b)]
                    + [("place_on", a, b) for a in g for b in p])
@@ -357,6 +357,12 @@ class OfflineBackend:
             steps.append(_step("turn", n, "both", f"Push the {part} round until it is fully turned."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.8}
             text = f"The {part} is turned to at least 80 % of its range."
+        elif skill == "press":  # past the detent: a latching button or a switch then stays there
+            what = "button all the way down" if a["category"] == "button" else "switch's lever down past its click"
+            steps.append(_step("press", n, "both", f"Press the {what} with the open hand."))
+            success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
+            text = (f"The {_w(n)} is pressed in to at least 90 % of its travel." if a["category"] == "button"
+                    else f"The {_w(n)} is on: its lever is pressed down to at least 90 % of its swing.")
         elif skill == "turn_off":  # a turn whose success is the joint shut: the stage pushes the lever back
             steps.append(_step("turn", n, "both", f"Push the {part} back until the {_w(n)} is off."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
@@ -367,7 +373,8 @@ class OfflineBackend:
             text = f"The {part} is open to at least half of its opening."
         name = _camel("turn", a["id"], "off") if skill == "turn_off" else _camel(skill, a["id"])
         return {
-            "name": name, "description": phrase(_kind(skill, a), a, self._words(name)),
+            "name": name, "description": phrase(f"press_{a['category']}" if skill == "press" else _kind(skill, a),
+                                                a, self._words(name)),
             "objects": [{"name": n, "asset": a["id"], "role": "articulated"}],
             "steps": steps, "success": success, "success_text": text,
         }
@@ -475,7 +482,7 @@ class OfflineBackend:
                 raise InstructionError(f"the offline author opens only doors and drawers part way (a lid let go part "
                                        f"way falls); '{mentions[0]['phrase']}' ({a['id']}) opens by its {_part(a)}")
             proposal = self._open_task(a, None if amount is None else joint_fraction(amount, a))
-        elif skill in ("open", "close", "turn"):
+        elif skill in ("open", "close", "turn", "press"):
             act = "turn_off" if skill == "turn" and reading.get("direction") == "off" else skill
             if amount is not None and act != "turn":
                 raise InstructionError(f"the offline author opens only doors and drawers part way (by their handle: "

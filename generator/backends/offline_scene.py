@@ -102,7 +102,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 j = a["joints"][0]  # as its shutting was measured from when a step shuts it), the chest's others shut
                 out = float(layout["start"]) if acts.get(o["name"]) == "close" else DRAWER_OUT_M
                 entry["joint_state"] = {j["name"]: float(j["closed_qpos"]), drawers[o["name"]]: out}
-            entry["randomize"] = {"xy_m": [0.05, 0.05], "yaw_deg": 15.0}
+            entry["randomize"] = dict(layout.get("randomize") or {"xy_m": [0.05, 0.05], "yaw_deg": 15.0})
         elif o["role"] == "articulated":
             j = a["joints"][0]
             entry["fixed"] = True

@@ -13,7 +13,8 @@ from generator.phrasing import COMMANDS, NAMES, PURPOSES, SITUATIONS, domain, na
 ASSETS = {a["id"]: a for a in asset_dicts()}
 READ_AS = {"open_door": "open", "open_drawer": "open", "open_lid": "open", "close_door": "close",
            "close_drawer": "close", "close_lid": "close", "turn_off": "turn", "open_door_part": "open",
-           "open_drawer_part": "open", "turn_part": "turn", "put_in_drawer": "put_in", "take_out_drawer": "take_out"}
+           "open_drawer_part": "open", "turn_part": "turn", "put_in_drawer": "put_in", "take_out_drawer": "take_out",
+           "press_button": "press", "press_switch": "press"}
 CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks of that skill
     "lift": ("apple", None), "put_in": ("lemon", "pot"), "place_on": ("pear", "plate"),
     "stack": ("block_medium", "block_large"), "push": ("block_large", None),
@@ -24,6 +25,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "open_door_part": ("cabinet_left_hinge", None), "open_drawer_part": ("drawer_chest_2", None),
     "turn_part": ("valve_lever_short", None), "take_out": ("can", "bowl"),
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
+    "press_button": ("button_estop", None), "press_switch": ("switch_lever", None),
 }
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees"), "put_in_drawer": ("bottom ", None),
