@@ -424,7 +424,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if loose:
         notes.append(loose)
     off = is_off(words)
-    if skill in ("push", "turn", "lift", "open") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
+    if skill in ("push", "turn") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'
         _refuse_unbuilt(text, words, skill)
