@@ -32,11 +32,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-
-def _success(info: dict) -> bool:
-    value = info.get("success", False)
-    return bool(np.asarray(value.cpu() if hasattr(value, "cpu") else value).reshape(-1)[0])
+from blind_replay import _success  # the same success reading as the blind replay
 
 
 def baseline(env, seed: int, policy: str) -> bool:

@@ -427,7 +427,6 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if skill in ("push", "turn") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'
-        _refuse_unbuilt(text, words, skill)
     if skill == "close" and mentions and mentions[0].asset and ROLE_TESTS["turnable"](
             _by_id(assets, mentions[0].asset)) and not ROLE_TESTS["openable"](_by_id(assets, mentions[0].asset)):
         skill, roles, direction = "turn", SKILL_ROLES["turn"], "off"  # 'close the valve', 'shut the tap'

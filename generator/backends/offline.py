@@ -359,7 +359,7 @@ class OfflineBackend:
             text = f"The {part} is turned to at least 80 % of its range."
         elif skill == "press":  # past the detent: a latching button or a switch then stays there
             what = "button all the way down" if a["category"] == "button" else "switch's lever down past its click"
-            steps.append(_step("press", n, "both", f"Press the {what} with the open hand."))
+            steps.append(_step("press", n, "both", f"Press the {what}."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
             text = (f"The {_w(n)} is pressed in to at least 90 % of its travel." if a["category"] == "button"
                     else f"The {_w(n)} is on: its lever is pressed down to at least 90 % of its swing.")
