@@ -18,7 +18,8 @@ Run by :class:`~gendex.solve.executor.StageExecutor` for stages whose target is 
   else a planned arm motion, the held object attached to the palm in the collision model; an object that is no
   longer with the hand at the end has slipped.
 - ``place`` — centre the held object over the target and lower it until it rests there.
-- ``push`` — slide an object across the table with the flat hand, closed loop on its measured pose.
+- ``push`` — slide an object across the table with the flat hand, closed loop on its measured pose
+  (:mod:`gendex.solve.push`).
 - ``release`` — open the hand back to the grasp's pre-shape and back off.
 
 Every :class:`~gendex_envs.errors.ExecutionError` raised here names its cause (``no_ik``, ``slipped``, ...).
@@ -39,13 +40,10 @@ from gendex.solve.edge_drag import EdgeVariant
 from gendex.solve.edge_geometry import find_ring
 from gendex.solve.edge_trial import EdgeTrials, reach_edge
 from gendex.solve.grasp import (
-    PALM_THICKNESS_M,
     RELEASE_HAND,
     GraspPlan,
     GraspSynthesizer,
     object_heading,
-    palm_rotation,
-    pose_of,
 )
 from gendex.solve.grasp_trial import (
     MIN_LIFT_M,
@@ -58,7 +56,7 @@ from gendex.solve.grasp_trial import (
     fits_on,
     rose_with_hand,
 )
-from gendex.solve.hand import TIP_ALONG_M, HandModel
+from gendex.solve.hand import HandModel
 from gendex.solve.set_down import POINT, POINT_CARRY_M
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex.solve.stage_grip import missed_only_conditions, with_middle_finger
@@ -99,26 +97,6 @@ PLACE_RESTING_M = 0.008
 """A place lowers the held object's lowest point to this far *below* the surface under it, and stops as soon as the
 palm has gone :data:`PLACE_RESTING_M` further down than the object: an object held tilted (a pinch lets it swing
 about the pinch line) is pressed flat on its support before the hand lets go."""
-PUSH_HAND = {"THJ4": 0.0, "THJ3": 0.0, "THJ2": 0.0, "THJ1": 0.0, "THJ0": 0.0} | {
-    f + j: 0.0 for f in ("FF", "MF", "RF", "LF") for j in ("J3", "J2", "J1", "J0")}
-"""A flat hand: fingers straight and together, thumb along the palm."""
-PUSH_ALONG_M = 0.07
-"""The object meets the pushing palm this far along it from the palm origin (towards the fingers)."""
-PUSH_GAP_M = 0.005
-PUSH_TIP_CLEARANCE_M = 0.012
-"""Fingertips-down pushing: the tips' ends this far above the table."""
-PUSH_APPROACH_M = 0.05
-PUSH_MIN_HEIGHT_M = 0.03
-PUSH_MAX_HEIGHT_M = 0.09
-"""Palm origin heights above the table tried, lowest first."""
-PUSH_M_PER_STEP = 0.008
-PUSH_INTO_M = 0.015
-PUSH_LEAD_M = 0.012
-"""How far the palm's target may run into the object's back face (the PD lag turns it into the pushing force), and
-how far short of the goal (along the first push direction) pushing stops."""
-PUSH_MAX_STEPS = 150
-PUSH_STOP_FRACTION = 0.5
-"""Pushing stops once the object's centre is within this fraction of the task's tolerance of the goal."""
 CARRY_YAWS_RAD = (0.0, 0.4, -0.4, 0.8, -0.8)
 CARRY_RAISES_M = (0.0, 0.05, 0.1)
 """Turns of the hand (and the held object) about the vertical, tried in turn along a level carry's straight line
@@ -299,7 +277,7 @@ class RigidPrimitives:
                            if self.config.max_trials else EdgeVariant())
                 self.plan = yield from reach_edge(m, self.hand, name, self._shapes[name], variant, self.config.motion)
                 return
-            yield from self._bring_hand(name, plan, q_pre)
+            yield from self.bring_hand(name, plan, q_pre)
             moved = float(np.linalg.norm(self._pose_now(name)[:3] - before[:3]))
             if moved <= MOVED_M or attempt == self.config.replans:
                 break
@@ -307,12 +285,14 @@ class RigidPrimitives:
         self.plan = plan
         yield from approach(m, plan, self.config.motion)
 
-    def _bring_hand(self, name: str, plan: GraspPlan, q_pre: np.ndarray) -> Iterator[np.ndarray]:
+    def bring_hand(self, name: str, plan: GraspPlan, q_pre: np.ndarray, synth: GraspSynthesizer | None = None
+                   ) -> Iterator[np.ndarray]:
         """Planned arm motion to the pre-grasp pose that keeps the opened hand off every object, the target
         included: to a staging pose (:data:`STAGING_M` back along the approach and/or up) planned with the hand's
         spheres in the collision model, then straight to the pre-grasp pose along a path checked against the
-        objects' geometry. When no staging pose works, the arm alone is planned to the pre-grasp pose."""
-        m, synth = self.m, self._synth
+        objects' geometry. When no staging pose works, the arm alone is planned to the pre-grasp pose. ``synth``:
+        the synthesizer that made ``plan`` (default: the last grasp's)."""
+        m, synth = self.m, synth or self._synth
         hand_q = m.with_hand(m.target(), plan.open_hand)
         cover = self.hand.spheres(plan.open_hand)
         up = np.array([0.0, 0.0, 1.0])
@@ -543,92 +523,10 @@ class RigidPrimitives:
 
     # ------------------------------------------------------------------ pushing
     def push(self, name: str, goal_xy: np.ndarray, tolerance_m: float) -> Iterator[np.ndarray]:
-        """Slide ``name`` across the table until its centre is within ``tolerance_m`` of ``goal_xy``, without
-        grasping it: the flat hand (fingers straight and together, thumb along the palm; fingers down like a broom, or
-        sideways) is brought behind the object by the staged approach; then, every step, the palm turns to face the
-        goal from the object's *measured* centre and advances :data:`PUSH_M_PER_STEP` while it is no more than
-        :data:`PUSH_INTO_M` into the object's back face."""
-        m = self.m
-        plan, q_pre, lateral = self._push_plan(name, goal_xy)
-        self.plan = plan
-        yield from self._bring_hand(name, plan, q_pre)
-        cmd = m.ik.fk(m.target()).p  # the commanded palm position (kept here: IK residuals must not accumulate)
-        height = float(cmd[2])
-        for _ in range(PUSH_MAX_STEPS):
-            shape = self.shape(name)
-            center = shape.footprint().center
-            rest = goal_xy - center
-            if float(np.linalg.norm(rest)) <= PUSH_STOP_FRACTION * tolerance_m or float(rest @ plan.approach[:2]) < \
-                    PUSH_LEAD_M:
-                break  # there, or about to pass it (the palm's lag and the object's slide carry it the rest)
-            d = np.append(rest / np.linalg.norm(rest), 0.0)
-            side = np.array([-d[1], d[0], 0.0])
-            lo, _ = shape.extent_along(d)
-            behind = float(center @ d[:2] - lo) + PALM_THICKNESS_M  # palm origin to the object's centre, along d
-            rel = np.append(center, height) - (cmd - lateral)  # object centre seen from the palm's push point
-            ahead = float(rel @ d) - behind  # > 0: the palm is short of the object's back face
-            # forward while the palm is at most PUSH_INTO_M into the back face; steering is by re-aiming alone (the
-            # palm turns to face the goal from where the object is): a sideways palm correction only dragged the
-            # object along by friction (measured: 11/12 with one at 30 % gain, 12/12 without)
-            step = min(PUSH_M_PER_STEP, max(0.0, ahead + PUSH_INTO_M)) * d
-            fingers = plan.palm.to_transformation_matrix()[:3, 2]
-            if abs(fingers[2]) < 0.5:  # fingers sideways: they turn with the push direction
-                fingers = np.sign(fingers @ np.array([-plan.approach[1], plan.approach[0], 0.0])) * side
-            cmd = cmd + step
-            turned = pose_of(palm_rotation(fingers, d), cmd)  # the palm keeps facing the push direction
-            q = m.ik.solve(turned, m.target(), restarts=0)
-            if q is None:
-                raise ExecutionError(f"no IK for the palm pushing {name!r} at {np.round(cmd, 3)}", cause="no_ik")
-            t = m.target()
-            t[m.arm] = q[m.arm]
-            yield m.emit(t)
-        else:
-            left = float(np.linalg.norm(goal_xy - self.shape(name).footprint().center))
-            raise ExecutionError(f"{name!r} still {left:.3f} m from where it is pushed to after {PUSH_MAX_STEPS} "
-                                 "steps", cause="target_not_reached")
-        self.plan = None
-        yield from m.cartesian(np.array([0.0, 0.0, 0.05]) - 0.04 * plan.approach, 0.01)
+        """Slide ``name`` across the table to ``goal_xy`` with the flat hand (:func:`gendex.solve.push.push`)."""
+        from gendex.solve.push import push
 
-    def _push_plan(self, name: str, goal_xy: np.ndarray) -> tuple[GraspPlan, np.ndarray, np.ndarray]:
-        """The first flat-hand pose behind ``name`` whose approach along the push line keeps the hand off everything
-        and whose pre-push pose the arm reaches without collision; the arm's joint vector there; and the palm's
-        horizontal offset from the push line. Poses tried: fingers pointing down (tips just above the table, the
-        fingers a broom behind the object), then fingers to either side at rising heights."""
-        env, m = self.env, self.m
-        shape = self.shape(name)
-        fp = shape.footprint()
-        rest = goal_xy - fp.center
-        if float(np.linalg.norm(rest)) < 1e-6:
-            raise ExecutionError(f"{name!r} is already where it is pushed to", cause="unsupported")
-        d = np.append(rest / np.linalg.norm(rest), 0.0)
-        lo, _ = shape.extent_along(d)
-        behind = float(fp.center @ d[:2] - lo) + PALM_THICKNESS_M + PUSH_GAP_M
-        line = np.append(fp.center, env.table_height) - behind * d
-        others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
-        synth = GraspSynthesizer(self.hand, shape, env.table_height, 0.0, others)
-        self._synth = synth
-        m.avoid_objects(exclude=(name,))
-        tips = float(np.max(self.hand.pads(PUSH_HAND, TIP_ALONG_M)[:, 2]))
-        down = np.array([0.0, 0.0, -1.0])
-        poses = [(down, np.zeros(3), tips + PUSH_TIP_CLEARANCE_M, "fingers down")]
-        for h in np.arange(PUSH_MIN_HEIGHT_M, PUSH_MAX_HEIGHT_M + 1e-9, 0.01):
-            for side in (1.0, -1.0):
-                f = side * np.array([-d[1], d[0], 0.0])
-                poses.append((f, -PUSH_ALONG_M * f, h, f"fingers sideways, palm {100 * h:.0f} cm up"))
-        for f, lateral, h, note in poses:
-            p = line + lateral + np.array([0.0, 0.0, h])
-            plan = GraspPlan("push", pose_of(palm_rotation(f, d), p), approach=d, approach_m=PUSH_APPROACH_M,
-                             open_hand=dict(PUSH_HAND), closing=(), note=note)
-            if not synth.path_clear(PUSH_HAND, plan.palm, -PUSH_APPROACH_M * d, np.zeros(3)):
-                continue
-            q_pre = m.ik.solve(plan.pregrasp, m.with_hand(m.target(), plan.open_hand), restarts=20,
-                               valid=m.collision.is_free)
-            if q_pre is not None:
-                log.info("pushing %r with %s", name, note)
-                return plan, q_pre, lateral
-            log.debug("push pose %s: no collision-free IK", note)
-        raise ExecutionError(f"no flat-hand pose behind {name!r} that clears the table and the objects and that the "
-                             "arm reaches", cause="no_ik")
+        yield from push(self, name, goal_xy, tolerance_m)
 
     def release(self) -> Iterator[np.ndarray]:
         """Let go: the fingers go back to the grasp's own pre-shape (the least motion that frees the object, no
