@@ -12,7 +12,8 @@ from typing import Any, Literal, get_args
 from gendex_envs.typed_yaml import MAX_POSITION_M, quote
 
 ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
-                        "hand_at", "fingertips_near", "hand_open", "placed", "joint_at"]
+                        "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
+                        "at_rest"]
 Part = Literal["handle"]
 Relation = Literal["left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_region"]
 Region = Literal["left", "right", "near", "far", "centre", "near_left", "near_right", "far_left", "far_right"]
@@ -96,11 +97,22 @@ class ConditionSpec:
     """joint_at: where the joint must be, as a fraction of the way from closed (0; off) to open (1; on), in [0, 1]."""
     max_error: float | None = None
     """joint_at: how far from ``fraction`` the joint may be, in the same units (in (0, 0.5]; default 0.1)."""
+    max_tilt_deg: float | None = None
+    """upright: how far the object's up axis (the one that pointed up at reset) may lean from world up (degrees, in
+    (0, 180); default 15)."""
+    min_tilt_deg: float | None = None
+    """flipped: how far the object's up axis must have turned from world up (degrees, in (0, 180]; default 150: upside
+    down, give or take 30)."""
+    max_speed_m_s: float | None = None
+    """at_rest: the fastest the object's origin may move (m/s, > 0; default 0.02)."""
+    max_spin_rad_s: float | None = None
+    """at_rest: the fastest the object may spin (rad/s, > 0; default 0.3)."""
 
 
 CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_force_n": 0.3, "max_force_n": 0.3,
                                       "ring_radius_m": 0.0, "above_m": 0.0, "min_gap_m": 0.05, "max_gap_m": 0.3,
-                                      "max_offset_m": 0.1, "max_error": 0.1}
+                                      "max_offset_m": 0.1, "max_error": 0.1, "max_tilt_deg": 15.0,
+                                      "min_tilt_deg": 150.0, "max_speed_m_s": 0.02, "max_spin_rad_s": 0.3}
 """Values of optional condition fields left out."""
 
 CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
@@ -125,13 +137,19 @@ CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
                "in a region of the table, seen from the robot"),
     "joint_at": (("object", "fraction"), ("joint", "max_error"),
                  "the joint is within max_error of fraction of the way from closed to open"),
+    "upright": (("object",), ("max_tilt_deg",), "the object stands as it stood at reset, its up axis within "
+                "max_tilt_deg of world up"),
+    "flipped": (("object",), ("min_tilt_deg",), "the object is turned over: its up axis at reset now points at least "
+                "min_tilt_deg away from world up"),
+    "at_rest": (("object",), ("max_speed_m_s", "max_spin_rad_s"), "the object is still: it moves at most "
+                "max_speed_m_s and spins at most max_spin_rad_s"),
 }
 """Condition type -> (required fields, optional fields, meaning). ``type`` and ``negate`` apply to every type."""
 assert set(CONDITION_FIELDS) == set(CONDITION_TYPES)
 
 
 _POSITIVE = {"min_height_m", "max_dist_m", "min_force_n", "max_palm_force_n", "max_force_n", "max_xy_m",
-             "min_spread_m", "max_offset_m"}
+             "min_spread_m", "max_offset_m", "max_speed_m_s", "max_spin_rad_s"}
 
 
 def condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
@@ -170,6 +188,10 @@ def condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:
         bad("max_dz_m", f"> min_dz_m ({c.min_dz_m})")
     if c.type == "placed":
         p += _placed_problems(c, at)
+    if c.max_tilt_deg is not None and not 0 < c.max_tilt_deg < 180:
+        bad("max_tilt_deg", "in (0, 180) degrees")
+    if c.min_tilt_deg is not None and not 0 < c.min_tilt_deg <= 180:
+        bad("min_tilt_deg", "in (0, 180] degrees")
     if c.fraction is not None and not 0 <= c.fraction <= 1:
         bad("fraction", "a fraction in [0, 1] (0: closed or off, 1: open or on)")
     if c.max_error is not None and not 0 < c.max_error <= 0.5:

@@ -68,3 +68,13 @@ def z_twist(q_wxyz: torch.Tensor, q0_wxyz: torch.Tensor) -> torch.Tensor:
     dz = w1 * z0 + x1 * y0 - y1 * x0 + z1 * w0
     angle = 2.0 * torch.atan2(dz, dw)
     return torch.remainder(angle + math.pi, 2.0 * math.pi) - math.pi
+
+
+def tilt(q_wxyz: torch.Tensor, q0_wxyz: torch.Tensor) -> torch.Tensor:
+    """[N] angle (rad, in [0, pi]) between world up and the object axis that pointed up at ``q0``, now at ``q``: 0
+    for an object standing as it stood at ``q0`` (turned about the vertical or not), pi for one turned upside down."""
+    up = torch.zeros_like(q_wxyz[:, 1:])
+    up[:, 2] = 1.0
+    conj = q0_wxyz * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q0_wxyz.dtype, device=q0_wxyz.device)
+    axis = quat_rotate(q_wxyz, quat_rotate(conj, up))
+    return torch.acos(axis[:, 2].clamp(-1.0, 1.0))

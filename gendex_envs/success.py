@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import torch
 
 from gendex_envs.errors import TaskSpecError
-from gendex_envs.geometry import box_rest_point, xy_distance, z_twist
+from gendex_envs.geometry import box_rest_point, tilt, xy_distance, z_twist
 from gendex_envs.holds import in_holds
 from gendex_envs.reward_checks import check_evaluate
 from gendex_envs.spec import CONDITION_DEFAULTS, GOAL_TARGET, ConditionSpec, StageSpec, SuccessSpec, TaskSpec
@@ -150,6 +150,17 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
         twist = z_twist(env.obj_pose(c.object).q, env.init_obj_quat(c.object))
         goal = math.radians(c.min_deg)
         return twist >= goal if goal > 0 else twist <= goal
+    if t in ("upright", "flipped"):
+        angle = tilt(env.obj_pose(c.object).q, env.init_obj_quat(c.object))
+        if t == "upright":
+            return angle <= math.radians(_param(c, "max_tilt_deg"))
+        return angle >= math.radians(_param(c, "min_tilt_deg"))
+    if t == "at_rest":
+        obj = env.obj(c.object)
+        lin, ang = ((obj.root_linear_velocity, obj.root_angular_velocity) if c.object in env.articulations
+                    else (obj.linear_velocity, obj.angular_velocity))
+        return ((torch.linalg.norm(lin, dim=-1) <= _param(c, "max_speed_m_s"))
+                & (torch.linalg.norm(ang, dim=-1) <= _param(c, "max_spin_rad_s")))
     if t == "over":
         p, q = rest_point(env, c.object), env.obj_pose(c.target).p
         dz = p[:, 2] - q[:, 2]

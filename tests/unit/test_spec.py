@@ -160,7 +160,8 @@ def test_allowed_value_constants() -> None:
     assert CONTROL_JOINT_MODES == ("arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire")
     assert STAGE_METHODS == ("motion_planning", "RL")
     assert CONDITION_TYPES == ("lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
-                               "hand_at", "fingertips_near", "hand_open", "placed", "joint_at")
+                               "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
+                               "at_rest")
     assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
                       "reorient", "press")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
