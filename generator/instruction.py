@@ -192,6 +192,7 @@ ROLE_TESTS = {
     "pressable": lambda a: any(k in PRESSED for k in part_kinds(a)),
     "ball": lambda a: "ball" in a["tags"] and not a.get("joints"),
     "landmark": lambda a: not a.get("joints"),
+    "handover": lambda a: "handover" in a["tags"],
 }
 """What an object must be to play each role."""
 
@@ -199,7 +200,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "lift": ("graspable",), "put_in": ("graspable", "receptacle"), "place_on": ("graspable", "surface"),
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
-    "take_out": ("graspable", "holder"), "press": ("pressable",),
+    "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -275,6 +276,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
             i = find(words, v)
             if i >= 0:
                 hits.append((i, -len(v.split()), s.name, i + len(v.split())))
+    if words[:1] == ["hand"]:  # 'hand the bottle to me'; 'hand' elsewhere is the robot's ('with the open hand')
+        hits.append((0, -1, "hand_over", 1))
     if not hits:
         return None
     hits.sort()
@@ -298,7 +301,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
         return "take_out", end  # take the apple out of the bowl; not 'pull the drawer out of the chest' (an open)
     if "take_out" in names and " lid " in rest:
         return "open", end  # remove the lid
-    if names[0] in ("lift", "push", "turn") and (" open " in rest or " lid off " in rest):
+    opened = re.search(r" open (?!hand |palm |fingers )", rest)  # not 'with the open hand'
+    if names[0] in ("lift", "push", "turn") and (opened or " lid off " in rest):
         return "open", end  # lift the lid open, swing the door open, take the lid off
     if "turn" in names and "reorient" in names:
         return "turn", end
@@ -424,6 +428,11 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if loose:
         notes.append(loose)
     off = is_off(words)
+    zone = [m for m in mentions if m.asset and ROLE_TESTS["handover"](_by_id(assets, m.asset))]
+    if zone and skill in ("put_in", "place_on", "place_at", "lift", "push", "hand_over"):
+        # 'set the bottle on the hand-over mat': a hand-over; the mat is the task's own, not an object to assign
+        skill, roles, relation, region = "hand_over", SKILL_ROLES["hand_over"], None, None
+        mentions = [m for m in mentions if m not in zone]
     if skill in ("push", "turn") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'

@@ -169,6 +169,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "swing the {d}'s lever round to turn it on",
         "turn the {d} on by pushing its handle all the way to one side",
     ),
+    "hand_over": (
+        "hand the {o} over to the person across the {s}",
+        "pass the {o} over and leave it on the hand-over mat",
+        "give me the {o} and let go of it on the hand-over mat",
+        "hand over the {o}, leaving it still on the yellow mat",
+        "bring me the {o} and set it down on the hand-over mat",
+    ),
     "press_button": (
         "press the {d} all the way down",
         "push the {d} in until it clicks",

@@ -64,9 +64,10 @@ def _header(title: str) -> str:
 def _parts(spec: dict) -> list[dict]:
     """The task's success conditions, one per part, without the ``grasped`` that the scene step adds beside a
     ``lifted`` (:func:`generator.steps.scene.hold_lifted`) nor the ``released`` it adds beside a set-down
-    (:func:`generator.steps.scene.let_go`): the lift's terms already reward the contact, and letting go is rewarded
-    by the success itself."""
-    return [c for c in spec["success"]["conditions"] if c["type"] not in ("grasped", "released")]
+    (:func:`generator.steps.scene.let_go`), nor the ``at_rest`` and ``upright`` it adds to a hand-over
+    (:func:`generator.steps.scene.hand_over_settles`): the lift's terms already reward the contact, and letting go
+    and settling are rewarded by the success itself."""
+    return [c for c in spec["success"]["conditions"] if c["type"] not in ("grasped", "released", "at_rest", "upright")]
 
 
 def _success_condition(spec: dict, obj: str | None = None) -> dict:

@@ -31,10 +31,12 @@ from generator.instruction import part_kinds
 from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
-               "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out", "press")
+               "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out", "press",
+               "hand_over")
 """The task skills: the solver issue's thirteen in its order, then the task language's places (``place_at``: set
 down beside, between or in a region), taking an object out of a container (``take_out``), then the dexterous
-skills' (``press``: a button or switch pushed past its detent)."""
+skills' (``press``: a button or switch pushed past its detent; ``hand_over``: an object left still on the hand-over
+mat)."""
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
@@ -66,6 +68,8 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
                     part: str | None = None, negate: bool = False, taken_out: bool = False) -> str | None:
     """The task skill a success condition of type ``kind`` asks for (None for conditions that name none);
     ``taken_out``: a ``placed`` object starts in its target (a take-out)."""
+    if kind in ("near", "over", "inside", "placed") and target_category == "handover_mat" and not negate:
+        return "hand_over"
     if kind == "placed":
         return "take_out" if taken_out else "place_at"
     if kind == "lifted":

@@ -51,6 +51,10 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
               "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",
               "put the apple to the left of the bowl"),
+    TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
+                            "give me", "bring me", "deliver"),
+              "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
+              "hand me the bottle"),
 )}
 """The task skills a request may ask for, in the order verbs are tried (earlier skills win ties)."""
 
@@ -76,6 +80,9 @@ SYNONYMS: dict[str, str] = {
     "arcade button": "button_arcade", "push button": "button", "pushbutton": "button", "buzzer": "button_arcade",
     "game button": "button_arcade", "light switch": "switch", "toggle switch": "switch", "lever switch": "switch",
     "breaker": "switch", "power switch": "switch", "tall switch": "switch_lever_tall",
+    "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
+    "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",
+    "handover spot": "handover_mat", "mat": "handover_mat", "yellow mat": "handover_mat",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 
@@ -96,7 +103,8 @@ STOP_WORDS = frozenset(
 FILLER_WORDS = frozenset(
     "into inside onto top hand goal mark table shut closed open side around across upright away back "
     "there here target spot marked place position edge middle centre center surface counter worktop "
-    "tabletop air way width tower floor"
+    "tabletop air way width tower floor person someone somebody human people user operator colleague partner "
+    "friend guest customer"
     .split())
 """Words after the verb that name no object (places on the table among them)."""
 

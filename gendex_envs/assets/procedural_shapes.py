@@ -46,6 +46,8 @@ TOOL = ("graspable", "tool")
 UTENSIL = ("graspable", "utensil", "tableware")
 BLOCK = ("graspable", "block", "toy")
 SURFACE = ("surface", "kitchenware")
+HANDOVER = ("handover", "marker")
+"""A hand-over zone: where the robot leaves things for a person to take (the ``hand_over`` task skill)."""
 
 GENERATORS: dict[str, Callable[[], ProceduralShape]] = {}
 
@@ -329,7 +331,7 @@ def _box(asset_id, size, mass, friction, rgba, tags, bevel=0.0, category=None):
     return make
 
 
-def _surface(asset_id, size, mass, friction, rgba, rim=None, bevel=0.3):
+def _surface(asset_id, size, mass, friction, rgba, rim=None, bevel=0.3, tags=SURFACE):
     """Something flat to set things on: a board (one bevelled slab, ``size`` x, y, thickness in cm) or, with ``rim``
     (height, wall thickness), a tray: a base and four walls, each its own convex part."""
     def make():
@@ -344,13 +346,16 @@ def _surface(asset_id, size, mass, friction, rgba, rim=None, bevel=0.3):
                 parts.convex(box_pts((w, y, h), (sx * (x - w) / 2, 0, h / 2)), faceted=True)
             for sy in (-1, 1):
                 parts.convex(box_pts((x - 2 * w, w, h), (0, sy * (y - w) / 2, h / 2)), faceted=True)
-        return _done(parts, id=asset_id, category=asset_id, tags=SURFACE, mass_kg=mass, friction=friction,
+        return _done(parts, id=asset_id, category=asset_id, tags=tags, mass_kg=mass, friction=friction,
                      rgba=rgba, source=SOURCE_PRIMITIVES, params={"top_z_m": t / 100})
     return make
 
 
 _register("cutting_board", _surface("cutting_board", (30, 20, 1.8), 0.8, 0.8, (0.72, 0.55, 0.35, 1.0)))
 _register("tray", _surface("tray", (34, 26, 0.6), 0.5, 0.6, (0.3, 0.35, 0.4, 1.0), rim=(2.5, 0.8)))
+# the hand-over zone: a thin bright mat at the person's side of the table (a marker, never a support to stack on)
+_register("handover_mat", _surface("handover_mat", (22, 22, 0.6), 0.2, 1.0, (0.95, 0.75, 0.1, 1.0), bevel=0.2,
+                                   tags=HANDOVER))
 _register("cracker_box", _box("cracker_box", (16, 6, 21), 0.411, 0.6, (0.85, 0.2, 0.15, 1.0), BOX))
 _register("sugar_box", _box("sugar_box", (9, 4, 17.5), 0.514, 0.6, (0.95, 0.9, 0.55, 1.0), BOX))
 _register("pudding_box", _box("pudding_box", (8.9, 3.5, 11), 0.187, 0.6, (0.55, 0.35, 0.2, 1.0), BOX))

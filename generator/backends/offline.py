@@ -53,6 +53,8 @@ from generator.backends.roles import (
     drawer_words,
     fits_in,
     graspable,
+    handed,
+    handover_zone,
     openable,
     receptacle,
     sticks_out,
@@ -82,7 +84,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "several", "composed")
+              "press", "hand_over", "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -94,6 +96,10 @@ COMPOSED_WEIGHT = 2.0
 """How much likelier a composed task is drawn than the tasks of any one skill."""
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
+HANDOVER_XY_M = 0.08
+"""A handed-over object lies on the mat when its middle is this close to the mat's (the mat is 22 cm square)."""
+HANDOVER_DZ_M = (-0.01, 0.05)
+"""... and this high above the mat's base: standing on it, or lying on it on its side (a can: 3.3 cm up)."""
 
 
 class OfflineBackend:
@@ -171,6 +177,8 @@ class OfflineBackend:
                 if t in usable and b in usable and usable[b]["category"] == "block"]
         out += [("push", self._push_task(a)) for a in g if a["id"] in PUSHED]
         by_id = {a["id"]: a for a in assets}
+        zone = next((a for a in assets if handover_zone(a)), None)
+        out += [("hand_over", self._handover_task(a, zone)) for a in assets if zone is not None and handed(a)]
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
@@ -327,6 +335,22 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} rests on top of the {_w(t)}.",
         }
 
+    def _handover_task(self, a: dict, zone: dict, colors: tuple[str | None, ...] = ()) -> dict:
+        """Hand ``a`` over: carry it to the hand-over mat ``zone`` and let go of it there. The scene step adds that it
+        must come to rest, standing as it stood (:func:`generator.steps.scene.hand_over_settles`)."""
+        n, t = a["category"], "mat"
+        name = _camel("hand", "over", *painted(a, colors, 0))
+        return {
+            "name": name, "description": phrase("hand_over", a, self._words(name), **qualifiers(a, None, colors)),
+            "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
+                        {"name": t, "asset": zone["id"], "role": "support"}],
+            "steps": [*self._carry_steps(n, t, "over")[:3],
+                      _step("release", n, "hand", f"Let go of the {_w(n)} on the {_w(t)} and leave it there.")],
+            "success": {"type": "over", "object": n, "target": t, "max_xy_m": HANDOVER_XY_M,
+                        "min_dz_m": HANDOVER_DZ_M[0], "max_dz_m": HANDOVER_DZ_M[1]},
+            "success_text": f"The {_w(n)} has been let go on the hand-over mat and rests there.",
+        }
+
     def _push_task(self, a: dict) -> dict:
         n = a["category"]
         name = _camel("push", a["id"], "to", "goal")
@@ -472,6 +496,12 @@ class OfflineBackend:
                     f"above its rim, where the fingers close ('{mentions[0]['phrase']}' ({g['id']}) in the "
                     f"{box['id']} does not); from the {box['id']} it takes out: {', '.join(able) or 'nothing'}")
             proposal = placed_tasks.take_out_task(g, box, colors, self._words)
+        elif skill == "hand_over":
+            zone = next((x for x in assets.values() if handover_zone(x)), None)
+            if zone is None:
+                raise InstructionError("the offline author needs the hand-over mat (handover_mat) in the catalog to "
+                                       "hand something over")
+            proposal = self._handover_task(pick(0, handed, "object to hand over"), zone, colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -494,7 +524,7 @@ class OfflineBackend:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
                 "(see GenDex/RotateTennisBall-v0 and `gendex train`). It writes: lift, put_in, place_on, stack, "
-                "push, open, close, turn.")
+                "push, open, close, turn, press, take_out, place_at, hand_over.")
         name, k = proposal["name"], 2
         while proposal["name"] in existing:
             proposal["name"] = f"{name}{k}"

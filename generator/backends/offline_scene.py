@@ -27,6 +27,11 @@ MOVABLE_REGION_M = ((-0.02, 0.18), (-0.26, 0.26))
 where the solver was measured to work: benchmarks/grasp.py's region (x -0.02..0.22, y -0.22..0.22, 34 objects
 held >= 90 %) and the reference tasks' v1 layouts (y to +-0.24, 50/50). Sampling the whole table front (x -0.35..0.7,
 y -0.55..0.55, as before) put a plate 1.26 m from the base: 0/10 carries found an arm pose above it."""
+HANDOVER_REGION_M = ((0.36, 0.44), (-0.22, 0.22))
+"""Where the hand-over mat lies: on the far side of the table, where a person across it reaches (its middle 0.18 m
+or more beyond the movable objects' region; hand-written trials with the mat at (0.4, -0.2): 18 of 20 handed over)."""
+HANDOVER_RANDOMIZE = {"xy_m": [0.03, 0.05], "yaw_deg": 0.0}
+"""How far the mat moves at reset."""
 ARTICULATED_REGION_M = ((0.52, 0.68), (-0.2, 0.2))
 """The same for articulated objects (their front faces the robot): OpenCabinet, OpenDrawer and CloseDrawer succeed
 48-50/50 at (0.55-0.6, 0-0.1) +-5 cm; a batch sampled over x 0.3..0.75, y +-0.45 lost 3/10 drawer openings to
@@ -103,6 +108,11 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 out = float(layout["start"]) if acts.get(o["name"]) == "close" else DRAWER_OUT_M
                 entry["joint_state"] = {j["name"]: float(j["closed_qpos"]), drawers[o["name"]]: out}
             entry["randomize"] = dict(layout.get("randomize") or {"xy_m": [0.05, 0.05], "yaw_deg": 15.0})
+        elif "handover" in a["tags"]:  # the hand-over mat: fixed, on the person's side of the table
+            (x0, x1), (y0, y1) = HANDOVER_REGION_M
+            entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
+            entry["fixed"] = True
+            entry["randomize"] = dict(HANDOVER_RANDOMIZE)
         elif o["role"] == "articulated":
             j = a["joints"][0]
             entry["fixed"] = True
@@ -157,4 +167,4 @@ def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generato
             "randomize": {"xy_m": [0.08, 0.08], "yaw_deg": 180.0 if _round(a) else 45.0}}
 
 
-__all__ = ["ARTICULATED_REGION_M", "DISTRACTOR_P", "MOVABLE_REGION_M", "PUSH_M", "scene_spec"]
+__all__ = ["ARTICULATED_REGION_M", "DISTRACTOR_P", "HANDOVER_REGION_M", "MOVABLE_REGION_M", "PUSH_M", "scene_spec"]

@@ -45,6 +45,21 @@ def _measured() -> frozenset[str]:
     return measured_graspable(MIN_GRASP_RATE)
 
 
+def handed(a: dict) -> bool:
+    """Objects the offline author hands over: the graspable ones, and the small vessels a person takes by hand (a
+    mug, a cup, a jar), held by the solver as :func:`graspable` asks."""
+    s = a["size_m"]
+    measured = _measured()
+    vessel = ("graspable" in a["tags"] and "container" in a["tags"] and max(s) <= 0.16 and a["mass_kg"] <= 0.6
+              and not a.get("joints") and (not measured or a["id"] in measured))
+    return graspable(a) or vessel
+
+
+def handover_zone(a: dict) -> bool:
+    """The hand-over mat: where the robot leaves what it hands to a person."""
+    return "handover" in a["tags"] and not a.get("joints")
+
+
 def _round(a: dict) -> bool:
     """Round seen from above (a ball, a can, a bowl): any yaw is the same object."""
     s = a["size_m"]

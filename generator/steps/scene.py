@@ -136,6 +136,31 @@ def out_of_drawer(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + tuple(extra)))
 
 
+ROLLS = ("ball", "fruit")
+"""Catalog tags of objects that may rest any way up (a ball, an apple): a hand-over asks no ``upright`` of them."""
+
+
+def hand_over_settles(spec: TaskSpec) -> TaskSpec:
+    """Give every object the success sets on a hand-over zone (an asset tagged ``handover``) an ``at_rest``
+    condition, and an ``upright`` one unless it rolls (:data:`ROLLS`): a hand-over leaves the object still, standing
+    as it stood, for a person to take; one set down toppling or rolling is not handed over."""
+    by_name = {o.name: o for o in spec.objects}
+    conds = spec.success.conditions
+    handed = [c.object for c in conds if c.type in (*SET_DOWN_CONDITIONS, "placed") and not c.negate
+              and c.target in by_name and "handover" in asset_dict(by_name[c.target].asset)["tags"]]
+    have = {(c.type, c.object) for c in conds if not c.negate}
+    extra = []
+    for o in dict.fromkeys(handed):
+        if ("at_rest", o) not in have:
+            extra.append(ConditionSpec(type="at_rest", object=o))
+        if ("upright", o) not in have and not set(ROLLS) & set(asset_dict(by_name[o].asset)["tags"]):
+            extra.append(ConditionSpec(type="upright", object=o))
+    if not extra:
+        return spec
+    log.info("success of %s: %s must come to rest (and stand as it stood)", spec.name, ", ".join(dict.fromkeys(handed)))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + tuple(extra)))
+
+
 def hold_joint_at(spec: TaskSpec) -> TaskSpec:
     """Give a success with a ``joint_at`` condition (a joint set part way) :data:`SETTLED_STEPS` to hold: a door
     swung through the band, or a lever pushed past it, is not where it was asked to be."""
@@ -170,7 +195,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return hold_joint_at(let_go(out_of_drawer(hold_lifted(spec))))
+    return hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:
