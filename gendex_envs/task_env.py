@@ -261,6 +261,7 @@ class TaskEnv(BaseEnv):
 
         self.objects.clear()
         self.articulations.clear()
+        self.__dict__.pop("_handle_frames", None)  # links of the scene a reconfiguration replaced
         self._art_init_qpos: dict[str, torch.Tensor] = {}
         self._init_pose: dict[str, tuple[torch.Tensor, torch.Tensor]] = {}
         self._layout: list[Item] = []
@@ -533,7 +534,8 @@ class TaskEnv(BaseEnv):
         return self._cached(("handle_pos", name, joint), compute)
 
     def _handle_frame(self, name: str, joint: str | None) -> tuple[Link, torch.Tensor]:
-        """(handle link, grip point in its frame, scaled): fixed for the env's life, so memoised."""
+        """(handle link, grip point in its frame, scaled): fixed for the scene's life, so memoised (a reconfiguration
+        builds new links and drops the memo)."""
         key = (name, joint)
         cache = self.__dict__.setdefault("_handle_frames", {})
         if key not in cache:

@@ -99,6 +99,27 @@ def test_cabinet_handle_and_joint_api(make_env):
     assert torch.linalg.norm(moved - handle).item() > 0.2, "opening the door must swing the handle"
 
 
+def test_the_handle_is_read_from_the_scene_a_reconfiguration_built(make_env):
+    """Under reconfiguration every reset builds new links: the handle is where the new door's handle is (a memo of
+    the first scene's link kept the first episode's handle, and the twist primitive turned about it)."""
+    from gendex_envs.registry import HISTORY_FREE
+
+    env = make_env("GenDex/OpenCabinet-v0", gym_api=False, **HISTORY_FREE)
+    u = env.unwrapped
+    seen = []
+    for seed in (0, 1, 2):
+        env.reset(seed=seed)
+        link = u.handle_link("cabinet")
+        local = torch.tensor(u.joint_record("cabinet").handle_point_m) * u.task_spec.object("cabinet").scale
+        pose = link.pose
+        from gendex_envs.geometry import transform_points
+
+        want = transform_points(pose.p, pose.q, local.to(pose.p))
+        assert torch.allclose(u.handle_pos("cabinet"), want, atol=1e-5), seed
+        seen.append(want[0])
+    assert torch.linalg.norm(seen[0] - seen[1]) > 1e-3  # the reset moved the cabinet: the check can fail
+
+
 @pytest.mark.parametrize("env_id", REFERENCE_TASKS)
 def test_robot_starts_clear_of_the_scene(make_env, env_id):
     """At reset the robot touches nothing: no link penetrates the table or an object."""
