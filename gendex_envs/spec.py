@@ -62,7 +62,7 @@ Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
 Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient",
-                "press"]
+                "press", "twist"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
@@ -83,9 +83,12 @@ SKILL_MEANINGS: dict[str, str] = {
     "turn": "turn the target about its own axis (a knob, a valve, a lid)",
     "reorient": "rotate the target inside the hand (in-hand manipulation)",
     "press": "press a button or switch past its detent to its other rest position, without grasping it",
+    "twist": "unscrew (or screw on) the target's cap about its own axis, regrasping it between turns of the hand",
 }
 """What each skill of :data:`SKILLS` does; the stage's ``target`` is the object it acts on."""
 assert set(SKILL_MEANINGS) == set(SKILLS)
+JOINT_SKILLS: tuple[str, ...] = ("open", "close", "turn", "press", "twist")
+"""Stage skills that move an articulated target's joint (its success: the joint's fraction)."""
 
 SCALE_RANGE: tuple[float, float] = (0.3, 2.0)
 QUAT_NORM_TOL = 1e-3

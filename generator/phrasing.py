@@ -169,6 +169,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "swing the {d}'s lever round to turn it on",
         "turn the {d} on by pushing its handle all the way to one side",
     ),
+    "twist": (
+        "unscrew the {d}'s cap",
+        "twist the cap off the {d}",
+        "unscrew the lid of the {d}, a turn at a time",
+        "open the {d} by unscrewing its cap",
+        "loosen the {d}'s cap until it comes free",
+    ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",
         "pass the {o} over and leave it on the hand-over mat",

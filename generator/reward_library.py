@@ -13,6 +13,7 @@ import math
 import textwrap
 from typing import Any
 
+from gendex_envs.spec import JOINT_SKILLS
 from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
 
 _HEADER_TEMPLATE = '''"""{title}
@@ -97,9 +98,9 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     fail = _FAIL_RIGID.format(rigid=tuple(rigid)) if rigid else _FAIL_NONE
     title = f"{spec['name']}, stage {stage_name}: {stage['instruction']}"
     src = _header(title)
-    if kind == "push" or (cond.get("target") == "goal" and kind not in ("open", "close", "turn", "press")):
+    if kind == "push" or (cond.get("target") == "goal" and kind not in JOINT_SKILLS):
         return src + _PUSH.format(fail=fail, obj=obj)
-    if kind in ("open", "close", "turn", "press"):
+    if kind in JOINT_SKILLS:
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
         progress = ('(1.0 - info["open_fraction"]) / (1.0 - OPEN_FRACTION)' if kind == "close" or cond.get("negate")

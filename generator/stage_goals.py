@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from gendex_envs.spec import JOINT_SKILLS
+
 LIFT_M = 0.1
 """Lift height when the task states none (a ``lifted`` success condition states it)."""
 OPEN_FRACTION = 0.8
@@ -50,13 +52,13 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
     if skill == "release":  # the task's conditions on the released object (all of them if none names it)
         mine = [c for c in task_conditions if c.get("object") == target] or task_conditions
         return [*(dict(c) for c in mine), {"type": "grasped", "object": target, "negate": True}]
-    if skill in ("open", "close", "turn", "press"):
+    if skill in JOINT_SKILLS:
         at = [dict(c) for c in task_conditions if c.get("type") == "joint_at" and c.get("object") == target]
         if at:  # set part way (open halfway, turn to an angle): the stage ends where the task does
             return at
         frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
         cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
-        shuts = skill == "close" or (skill in ("turn", "press") and _shuts(task_conditions, target))
+        shuts = skill == "close" or (skill != "open" and _shuts(task_conditions, target))
         return [cond | {"negate": True}] if shuts else [cond]
     if skill == "place":  # the task's conditions with this target: the held object set on it
         return [dict(c) for c in task_conditions if c.get("target") == target] or None

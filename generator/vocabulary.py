@@ -51,6 +51,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("place_at", (), "a graspable object set down left or right of, in front of, behind, next to or between "
               "other objects, or in a region of the table (far left, near side, middle), as the robot sees it",
               "put the apple to the left of the bowl"),
+    TaskSkill("twist", ("unscrew", "twist off", "twist open", "screw off", "untwist", "loosen", "screw", "tighten"),
+              "a jar lid or bottle cap unscrewed a full turn, regrasped between turns of the hand (jar, wide-mouth "
+              "bottle, canister)", "unscrew the jar lid"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
@@ -83,6 +86,9 @@ SYNONYMS: dict[str, str] = {
     "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
     "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",
     "handover spot": "handover_mat", "mat": "handover_mat", "yellow mat": "handover_mat",
+    "jam jar": "jar", "glass jar": "jar", "mason jar": "jar", "kitchen canister": "canister",
+    "tin canister": "canister",
+    "wide mouth bottle": "screw_bottle", "water bottle": "screw_bottle", "sports bottle": "screw_bottle",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 
@@ -91,7 +97,7 @@ KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block"
                          "thing": "graspable", "object": "graspable", "item": "graspable"}
 """Words naming a kind of object (a catalog tag): 'a fruit' is any fruit; which one is a recorded choice."""
 
-PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab")
+PARTS = ("door", "drawer", "lid", "lever", "handle", "knob", "rack", "tab", "cap")
 """Words naming the part of an articulated object a skill acts on (recorded, never an object on their own)."""
 ORDINALS = {"top": "top", "upper": "top", "bottom": "bottom", "lower": "bottom", "first": "top", "second": "second"}
 

@@ -61,6 +61,7 @@ from gendex.solve.set_down import (
     placed_condition,
     set_down_point,
 )
+from gendex.solve.twist import TWIST_PRIMITIVES, TwistPrimitives
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.success import SET_DOWN_CONDITIONS
@@ -83,7 +84,7 @@ ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "
 PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press", "press": "press"}
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
-               "open": 50, "close": 50, "turn": 40, "press": 30}
+               "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
@@ -143,6 +144,7 @@ class StageExecutor:
         self.logs: list[StageLog] = []
         self._handles = HandlePrimitives(self.motion, hand_cover=self._hand_cover)
         self._presses = PressPrimitives(self.motion, self._hand_cover)
+        self._twists = TwistPrimitives(self.rigid)
         limit = [n for n in (time_limit(env), getattr(u, "horizon", None)) if n is not None]
         self.motion.set_budget(min(limit) if limit else None, int(u.elapsed_steps[0]))
         self.stage_index = -1
@@ -193,6 +195,8 @@ class StageExecutor:
                                  cause="unsupported", stage=stage.name, skill=stage.skill)
         if stage.target not in self._env.articulations or stage.skill in TO_A_PLACE:
             table, kind = RIGID_PRIMITIVES, "a rigid"
+        elif any(s.skill == "twist" and s.target == stage.target for s in self._env.task_spec.stages):
+            table, kind = TWIST_PRIMITIVES, "a twisted articulated"
         elif self._grasped(stage.target):
             table, kind = ARTICULATED_PRIMITIVES, "a hooked articulated"
         else:
@@ -252,7 +256,9 @@ class StageExecutor:
             self.logs.append(StageLog(stage.name, prim, "scripted"))
             log.info("stage %r (%s, %s): primitive %r%s", stage.name, stage.skill, stage.method, prim,
                      " (no trained policy)" if stage.method == "RL" else "")
-            if prim in PRESS_PRIMITIVES.values():
+            if prim in TWIST_PRIMITIVES.values():
+                yield from self._twists.run(prim, stage)
+            elif prim in PRESS_PRIMITIVES.values():
                 yield from self._presses.run(prim, stage)
             elif prim in ARTICULATED_PRIMITIVES.values():
                 yield from self._handles.run(prim, stage)

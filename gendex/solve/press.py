@@ -48,11 +48,10 @@ from gendex.solve.grasp import axis_rotation, palm_rotation
 from gendex.solve.shape import ObjectShape, PosedShape
 from gendex_envs.errors import ExecutionError
 from gendex_envs.physx import px_bodies
+from gendex_envs.spec import JOINT_SKILLS
 
 log = logging.getLogger(__name__)
 
-MOVES_JOINT = ("open", "close", "turn", "press")
-"""Stage skills that move an articulated target's joint."""
 PALM_CONTACT = np.array([0.0, -0.0135, 0.045])
 """Palm frame point that touches the surface in a palm press: the skin at the palm's centre (the sphere cover of
 the open hand: palm skin at y = -13.3 mm, the palm spans z = 0 to 0.09)."""
@@ -328,8 +327,8 @@ class PressPrimitives(HandlePrimitives):
     def _sign(self, stage) -> float:
         """+1 when ``stage`` (or, for a reach, the stage that moves the joint after it) opens the joint, else -1."""
         spec = self.motion.env.task_spec
-        if stage.skill not in MOVES_JOINT:
-            stage = next((s for s in spec.stages if s.target == stage.target and s.skill in MOVES_JOINT),
+        if stage.skill not in JOINT_SKILLS:
+            stage = next((s for s in spec.stages if s.target == stage.target and s.skill in JOINT_SKILLS),
                          stage)
         if stage.skill in ("open", "close"):
             return 1.0 if stage.skill == "open" else -1.0

@@ -571,6 +571,40 @@ def lever_switch(id: str, length: float = 0.1, pivot: float = 0.1) -> Model:
                  friction=0.9, params={"lever_length": length, "pivot_height": pivot, "color": "grey"})
 
 
+SCREW_STYLES: dict[str, tuple[float, float, float, float, float, RGBA, str]] = {
+    # style: body radius, body height, neck radius (0: none), cap radius, cap height, cap colour, its name
+    "jar": (0.042, 0.10, 0.0, 0.045, 0.024, RED, "red"),
+    "jar_small": (0.036, 0.085, 0.0, 0.039, 0.02, YELLOW, "yellow"),
+    "bottle": (0.04, 0.15, 0.028, 0.031, 0.025, WHITE, "white"),
+    "bottle_tall": (0.038, 0.20, 0.027, 0.03, 0.025, RED, "red"),
+    "canister": (0.05, 0.13, 0.0, 0.053, 0.03, DARK, "black"),
+    "canister_small": (0.045, 0.10, 0.0, 0.048, 0.028, WHITE, "white"),
+}
+"""The screw-top containers (:func:`screw_cap`): a glass jar and a jam jar, a wide-mouth bottle and a tall one, a
+steel kitchen canister and a small one."""
+
+
+def screw_cap(id: str, style: str) -> Model:
+    """A container fixed to the table under a cap that screws about the vertical axis (:data:`SCREW_STYLES`):
+    counter-clockwise (seen from above) unscrews it, one full turn frees it (the joint's open end); thread friction
+    holds it wherever the hand leaves it. A bottle has a 1.5 cm neck under its cap; its category is ``bottle``."""
+    r_body, h_body, r_neck, r, h, rgba, color = SCREW_STYLES[style]
+    glass, green = (0.80, 0.88, 0.90, 1.0), GREEN
+    kind = style.split("_")[0]
+    body_rgba = {"jar": glass, "bottle": green, "canister": STEEL}[kind]
+    body = [cyl((0.0, 0.0, h_body / 2), r_body, h_body, "z", body_rgba)]
+    top = h_body
+    if r_neck:
+        body.append(cyl((0.0, 0.0, h_body + 0.0075), r_neck, 0.015, "z", body_rgba))
+        top = h_body + 0.015
+    joint = Joint("cap_screw", "revolute", "body", "cap", (0.0, 0.0, top), (0.0, 0.0, 1.0), (0.0, 2 * math.pi), 0.0,
+                  2 * math.pi, (0.0, 0.0, h), damping=0.05, friction=0.02, effort=2.0, velocity=4.0)
+    return Model(id, kind, ("container", "kitchen", "screw"),
+                 (Link("body", 0.8, tuple(body)), Link("cap", 0.05, (cyl((0.0, 0.0, h / 2), r, h, "z", rgba),))),
+                 (joint,), friction=1.0,
+                 params={"style": style, "cap_radius": r, "cap_height": h, "cap_top": top + h, "color": color})
+
+
 VARIANTS: dict[str, Callable[[], Model]] = {
     "cabinet_left_hinge": lambda: cabinet("cabinet_left_hinge", "left"),
     "cabinet_right_hinge": lambda: cabinet("cabinet_right_hinge", "right", 0.36, 0.38, 0.56, "knob_bar"),
@@ -597,6 +631,7 @@ VARIANTS: dict[str, Callable[[], Model]] = {
     "valve_lever_short": lambda: valve("valve_lever_short", 0.09, 0.10),
     "knob_stove": lambda: knob("knob_stove", "stove"),
     "knob_dial": lambda: knob("knob_dial", "dial"),
+    **{f"screw_{style}": (lambda style=style: screw_cap(f"screw_{style}", style)) for style in SCREW_STYLES},
     "button_estop": lambda: push_button("button_estop", "estop"),
     "button_arcade": lambda: push_button("button_arcade", "arcade"),
     "switch_lever": lambda: lever_switch("switch_lever"),

@@ -11,6 +11,9 @@ button was seldom finds it (a 9 x 10 cm palm over a 6.4 cm cap: at +-10 x +-12 c
 pressed the emergency stop 7 of 30 times; pressed with the palm, where the whole open hand presses what lies under
 it, and at +-15 x +-25 cm, pulled nearer the robot by the critic's reach check, the arcade button 7 of 30 too)."""
 
+TWIST_RANDOMIZE = {"xy_m": [0.1, 0.15], "yaw_deg": 30.0}
+"""How far a screw-top container moves at reset (hand-written trials unscrewed the three at x 0.02-0.25, y +-0.2)."""
+
 ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
     ("close", "cabinet_left_hinge"): {"pos_m": (0.62, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
                                       "measured": "CloseCabinet 50/50"},
@@ -72,6 +75,13 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
         "measured": "gate 10/10 (guided generation, seed 8303)", "randomize": PRESS_RANDOMIZE},
     ("press", "switch_lever_tall"): {"pos_m": (0.35, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
         "measured": "gate 10/10 (guided generation, seed 8304)", "randomize": PRESS_RANDOMIZE},
+    # screw-top containers, unscrewed a turn of the hand at a time (hand-written trials: 8/8 each at x 0.02-0.25)
+    ("twist", "screw_jar"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+        "measured": "gate 10/10 (guided generation, seed 8501)", "randomize": TWIST_RANDOMIZE},
+    ("twist", "screw_bottle"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+        "measured": "gate 10/10 (guided generation, seed 8502)", "randomize": TWIST_RANDOMIZE},
+    ("twist", "screw_canister"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+        "measured": "gate 10/10 (guided generation, seed 8503)", "randomize": TWIST_RANDOMIZE},
 }
 """Articulated objects the offline author closes, opens by pressing (lids), turns on or turns off (``turn_off``: the
 lever starts open, the task shuts it), with a layout the skill was

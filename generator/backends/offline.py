@@ -35,6 +35,7 @@ import zlib
 import numpy as np
 import yaml
 
+from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
@@ -84,7 +85,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "several", "composed")
+              "press", "hand_over", "twist", "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -204,7 +205,8 @@ class OfflineBackend:
         # composed: a door or lid the open hand shuts or opens (it leaves the hand free; a faucet or valve stands
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
-                  if i in by_id and not lay["grasp"] and lay["measured"] and skill not in ("turn", "turn_off", "press")
+                  if i in by_id and not lay["grasp"] and lay["measured"]
+                  and skill not in ("turn", "turn_off", "press", "twist")
                   and lay.get("composed", True)]
         seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in g for b in c if fits_in(a, b)]
                    + [("place_on", a, b) for a in g for b in p])
@@ -387,6 +389,10 @@ class OfflineBackend:
             success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
             text = (f"The {_w(n)} is pressed in to at least 90 % of its travel." if a["category"] == "button"
                     else f"The {_w(n)} is on: its lever is pressed down to at least 90 % of its swing.")
+        elif skill == "twist":  # a full turn counter-clockwise, a turn of the hand at a time
+            steps.append(_step("twist", n, "both", f"Unscrew the {_w(n)}'s cap, regrasping it between turns."))
+            success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
+            text = f"The {_w(n)}'s cap is unscrewed: turned at least 90 % of a full turn."
         elif skill == "turn_off":  # a turn whose success is the joint shut: the stage pushes the lever back
             steps.append(_step("turn", n, "both", f"Push the {part} back until the {_w(n)} is off."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
@@ -395,7 +401,8 @@ class OfflineBackend:
             steps.append(_step("open", n, "both", f"Lift the {part} along its arc until it is open."))
             success = {"type": "joint_open", "object": n, "min_fraction": 0.5}
             text = f"The {part} is open to at least half of its opening."
-        name = _camel("turn", a["id"], "off") if skill == "turn_off" else _camel(skill, a["id"])
+        name = (_camel("turn", a["id"], "off") if skill == "turn_off" else _camel("unscrew", n) if skill == "twist"
+                else _camel(skill, a["id"]))
         return {
             "name": name, "description": phrase(f"press_{a['category']}" if skill == "press" else _kind(skill, a),
                                                 a, self._words(name)),
@@ -512,7 +519,7 @@ class OfflineBackend:
                 raise InstructionError(f"the offline author opens only doors and drawers part way (a lid let go part "
                                        f"way falls); '{mentions[0]['phrase']}' ({a['id']}) opens by its {_part(a)}")
             proposal = self._open_task(a, None if amount is None else joint_fraction(amount, a))
-        elif skill in ("open", "close", "turn", "press"):
+        elif skill in JOINT_SKILLS:
             act = "turn_off" if skill == "turn" and reading.get("direction") == "off" else skill
             if amount is not None and act != "turn":
                 raise InstructionError(f"the offline author opens only doors and drawers part way (by their handle: "

@@ -16,6 +16,9 @@ from generator.backends.roles import DRAWER_OUT_M, _acts, _round, drawer_joint, 
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
+STAGE_HORIZONS = {"twist": 700}
+"""Stage horizons (control steps) of skills that take longer than a stage's usual 40 (a twist: 5-6 grasps a turn,
+about 90 steps each; hand-written trials 525-741 steps with the reach)."""
 PUSH_M = 0.22
 """How far a push task's goal mark lies from the object's nominal place (PushBlockToGoal: 22 cm, 50/50)."""
 COMPOSED_SIDE_M = 0.1
@@ -141,7 +144,8 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
         stages.append({"name": name + (f"_{i}" if repeated else ""),
                        "instruction": s["instruction"], "skill": s["skill"], "method": method,
                        "control_joint": "arm" if method == "motion_planning" else s["control_joint"],
-                       "horizon": 60 if method == "motion_planning" else 40, "target": s["target"]})
+                       "horizon": STAGE_HORIZONS.get(s["skill"], 60 if method == "motion_planning" else 40),
+                       "target": s["target"]})
     conds = [{k: v for k, v in c.items() if v is not None}
              for c in (proposal["success"], *(proposal.get("also") or ()))]
     spec = {"name": proposal["name"], "instruction": proposal["description"], "objects": objects,

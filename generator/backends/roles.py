@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import functools
 
+from gendex_envs.spec import JOINT_SKILLS
+
 _OPENABLE_LINKS = ("door", "lid", "drawer")
 
 
@@ -17,7 +19,7 @@ def _part(a: dict) -> str:
 def _kind(skill: str, a: dict) -> str:
     """The task skill of ``skill`` (open, close, turn, turn_off) on articulated ``a``: ``close_door``, ``open_lid``,
     ``turn``, ``turn_off``."""
-    return skill if skill in ("turn", "turn_off", "press") else f"{skill}_{_part(a)}"
+    return skill if skill in ("turn", "turn_off", "press", "twist") else f"{skill}_{_part(a)}"
 
 
 MIN_GRASP_RATE = 0.9
@@ -98,7 +100,7 @@ def _acts(proposal: dict) -> dict[str, str]:
     shut = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ()))
             if c["type"] == "joint_open" and c.get("negate")}
     return {s["target"]: "turn_off" if s["skill"] == "turn" and s["target"] in shut else s["skill"]
-            for s in proposal["steps"] if s["skill"] in ("open", "close", "turn", "press")}
+            for s in proposal["steps"] if s["skill"] in JOINT_SKILLS}
 
 
 def _joint_at(n: str, fraction: float) -> dict:

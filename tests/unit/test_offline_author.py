@@ -164,11 +164,11 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
 
     b = OfflineBackend(seed=3)
     options = [o for skill, o in b._task_options(list(asset_dicts())) if skill != "composed"]
-    picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn", "Press"))
+    picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn", "Press", "Unscrew"))
               and not o["name"].endswith(("Half", "Degrees"))
               or (o["name"].startswith("Open") and o["objects"][0]["asset"] in {i for _, i in ARTICULATED_LAYOUTS})]
     kinds = {o["name"][:4] for o in picked}
-    assert kinds == {"Stac", "Push", "Clos", "Turn", "Open", "Pres"}, kinds
+    assert kinds == {"Stac", "Push", "Clos", "Turn", "Open", "Pres", "Unsc"}, kinds
     laid_out = 0
     for i, raw in enumerate(picked):
         p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")

@@ -26,6 +26,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "turn_part": ("valve_lever_short", None), "take_out": ("can", "bowl"),
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
+    "twist": ("screw_jar", None),
 }
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees"), "put_in_drawer": ("bottom ", None),

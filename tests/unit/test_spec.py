@@ -163,7 +163,7 @@ def test_allowed_value_constants() -> None:
                                "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
                                "at_rest")
     assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
-                      "reorient", "press")
+                      "reorient", "press", "twist")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
