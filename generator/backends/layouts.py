@@ -11,8 +11,10 @@ button was seldom finds it (a 9 x 10 cm palm over a 6.4 cm cap: at +-10 x +-12 c
 pressed the emergency stop 7 of 30 times; pressed with the palm, where the whole open hand presses what lies under
 it, and at +-15 x +-25 cm, pulled nearer the robot by the critic's reach check, the arcade button 7 of 30 too)."""
 
-TWIST_RANDOMIZE = {"xy_m": [0.1, 0.15], "yaw_deg": 30.0}
-"""How far a screw-top container moves at reset (hand-written trials unscrewed the three at x 0.02-0.25, y +-0.2)."""
+TWIST_RANDOMIZE = {"xy_m": [0.15, 0.25], "yaw_deg": 30.0}
+"""How far a screw-top container moves at reset: so far that the hand come down blind where one episode's cap was
+seldom finds it (a palm on a 6-10 cm cap turns it from 5 cm off: at +-10 x +-15 cm a blind replay of one success
+unscrewed the bottle 27 and the canister 26 of 50 times, seeds 65000-65049)."""
 
 ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
     ("close", "cabinet_left_hinge"): {"pos_m": (0.62, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
