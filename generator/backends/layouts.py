@@ -77,7 +77,8 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
         "measured": "gate 10/10 (guided generation, seed 8303)", "randomize": PRESS_RANDOMIZE},
     ("press", "switch_lever_tall"): {"pos_m": (0.35, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
         "measured": "gate 10/10 (guided generation, seed 8304)", "randomize": PRESS_RANDOMIZE},
-    # screw-top containers, unscrewed a turn of the hand at a time (hand-written trials: 8/8 each at x 0.02-0.25)
+    # screw-top containers, unscrewed a turn of the hand at a time (hand-written trials: jar 8/8, bottle 13/13,
+    # canister 3/3, at x -0.03-0.27, y -0.25-0.25)
     ("twist", "screw_jar"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
         "measured": "gate 10/10 (guided generation, seed 8501)", "randomize": TWIST_RANDOMIZE},
     ("twist", "screw_bottle"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
