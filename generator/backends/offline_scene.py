@@ -12,7 +12,7 @@ import yaml
 
 from generator.backends import placed as placed_tasks
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
-from generator.backends.roles import DRAWER_OUT_M, _acts, _round, drawer_joint, graspable
+from generator.backends.roles import DRAWER_OUT_M, _acts, _round, drawer_joint, graspable, handover_zone
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
@@ -111,7 +111,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 out = float(layout["start"]) if acts.get(o["name"]) == "close" else DRAWER_OUT_M
                 entry["joint_state"] = {j["name"]: float(j["closed_qpos"]), drawers[o["name"]]: out}
             entry["randomize"] = dict(layout.get("randomize") or {"xy_m": [0.05, 0.05], "yaw_deg": 15.0})
-        elif "handover" in a["tags"]:  # the hand-over mat: fixed, on the person's side of the table
+        elif handover_zone(a):  # the hand-over mat: fixed, on the person's side of the table
             (x0, x1), (y0, y1) = HANDOVER_REGION_M
             entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
             entry["fixed"] = True

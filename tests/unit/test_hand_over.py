@@ -4,7 +4,6 @@ critic's check that the object starts clear of the hand-over mat, and the skill 
 from __future__ import annotations
 
 import dataclasses
-import json
 
 import numpy as np
 import pytest
@@ -117,4 +116,3 @@ def test_stats_count_a_set_down_on_the_mat_as_a_hand_over():
     assert condition_skill("over", target_category="plate") == "place_on"
     assert condition_skill("inside", target_category="handover_mat", negate=True) is None
     assert np.isclose(HANDOVER_XY_M, 0.08)
-    json.dumps(HANDOVER_DZ_M)
