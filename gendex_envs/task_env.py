@@ -407,7 +407,7 @@ class TaskEnv(BaseEnv):
                                 f"{target.shape[-1]} controller targets")
 
     def _before_control_step(self):
-        self.detents.update()  # each button's or switch's spring pulls towards its nearest rest position
+        self.detents.update()  # springs pull buttons and switches to their nearest rest; threads hold caps
 
     def _after_simulation_step(self):
         self.agent.contacts.invalidate()

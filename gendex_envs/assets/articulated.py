@@ -162,6 +162,8 @@ class Joint:
     """Grip centre in the child link frame at qpos 0."""
     damping: float = 0.2
     friction: float = 0.02
+    """Written to the URDF for other simulators; SAPIEN's URDF loader ignores it (``friction_limit`` is what GenDex
+    applies)."""
     effort: float = 50.0
     velocity: float = 3.0
     holds: tuple[Vec3, Vec3] | None = None
@@ -169,6 +171,8 @@ class Joint:
     detents: tuple[float, ...] | None = None
     """Rest positions (fractions from closed to open) a spring of stiffness ``spring`` pulls towards (nearest)."""
     spring: float | None = None
+    friction_limit: float | None = None
+    """Dry friction GenDex applies (:attr:`~gendex_envs.assets.manifest.JointEntry.friction_limit`)."""
 
 
 @dataclass(frozen=True)
@@ -233,7 +237,8 @@ class Model:
         r6 = lambda xs: tuple(round(float(x), 6) + 0.0 for x in xs)  # noqa: E731
         joints = tuple(JointEntry(j.name, j.type, r6(j.limits), round(j.closed, 6), round(j.open, 6), j.child,
                                   r6(j.handle_point), None if j.holds is None else (r6(j.holds[0]), r6(j.holds[1])),
-                                  None if j.holds is None else r6(j.origin), j.detents, j.spring)
+                                  None if j.holds is None else r6(j.origin), j.detents, j.spring,
+                                  j.friction_limit)
                        for j in self.joints)
         return AssetEntry(id=self.id, category=self.category, kind="articulated", source=SOURCE, licence=LICENCE,
                           tags=("articulated",) + self.tags, bbox_min_m=r6(lo), bbox_max_m=r6(hi),
@@ -571,6 +576,9 @@ def lever_switch(id: str, length: float = 0.1, pivot: float = 0.1) -> Model:
                  friction=0.9, params={"lever_length": length, "pivot_height": pivot, "color": "grey"})
 
 
+SCREW_RIM_FRICTION_N = 2.0
+"""The thread's dry friction as a force at the cap's rim (N; the torque is this times the cap's radius): what a grip
+must overcome to turn a cap, and what stops a cap a finger brushes from spinning on."""
 SCREW_STYLES: dict[str, tuple[float, float, float, float, float, RGBA, str]] = {
     # style: body radius, body height, neck radius (0: none), cap radius, cap height, cap colour, its name
     "jar": (0.042, 0.10, 0.0, 0.045, 0.024, RED, "red"),
@@ -598,7 +606,8 @@ def screw_cap(id: str, style: str) -> Model:
         body.append(cyl((0.0, 0.0, h_body + 0.0075), r_neck, 0.015, "z", body_rgba))
         top = h_body + 0.015
     joint = Joint("cap_screw", "revolute", "body", "cap", (0.0, 0.0, top), (0.0, 0.0, 1.0), (0.0, 2 * math.pi), 0.0,
-                  2 * math.pi, (0.0, 0.0, h), damping=0.05, friction=0.02, effort=2.0, velocity=4.0)
+                  2 * math.pi, (0.0, 0.0, h), damping=0.05, friction=0.02, effort=2.0, velocity=4.0,
+                  friction_limit=round(SCREW_RIM_FRICTION_N * r, 4))
     return Model(id, kind, ("container", "kitchen", "screw"),
                  (Link("body", 0.8, tuple(body)), Link("cap", 0.05, (cyl((0.0, 0.0, h / 2), r, h, "z", rgba),))),
                  (joint,), friction=1.0,

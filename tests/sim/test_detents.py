@@ -69,3 +69,38 @@ def test_the_pull_is_a_joint_drive_whose_target_is_the_nearest_rest(env):
     assert torch.allclose(targets["estop/button_slide"], torch.tensor([estop_on]))
     assert torch.allclose(targets["lever/lever_hinge"], torch.tensor([env.closed_qpos("lever")]))
     assert len(env.detents.items) == 3
+
+
+@pytest.fixture(scope="module")
+def jar():
+    raw = spec_to_dict(resolve_task("GenDex/UnscrewJar-v0").spec)
+    raw["objects"][0].pop("randomize")
+    e = TaskEnv(task_spec=parse_task_spec(raw), control_mode="pd_joint_delta_pos", render_backend="none")
+    e.reset(seed=0)
+    e.step(np.zeros(e.action_space.shape, dtype=np.float32))  # past the first step, where the thread's anchor is set
+    yield e
+    e.close()
+
+
+def _twist(env, torque_nm: float, steps: int = 10) -> float:
+    """Push the jar's cap counter-clockwise with ``torque_nm`` about its axis at every simulation step of ``steps``
+    control steps (the robot held still, out of reach) and return how far it turned (rad)."""
+    cap = env.handle_link("jar")._objs[0]
+    start = float(env.joint_qpos("jar")[0])
+    for _ in range(steps):
+        env.detents.update()
+        for _ in range(env.sim_freq // env.control_freq):
+            cap.add_force_torque(np.zeros(3), np.array([0.0, 0.0, torque_nm]))
+            env.scene.step()
+    return float(env.joint_qpos("jar")[0]) - start
+
+
+def test_a_screw_cap_holds_below_its_thread_friction_and_turns_above_it(jar):
+    from gendex_envs.assets.articulated import SCREW_RIM_FRICTION_N
+
+    limit = jar.asset_record("jar").joints[0].friction_limit
+    assert limit == pytest.approx(SCREW_RIM_FRICTION_N * jar.asset_record("jar").entry.params["cap_radius"], rel=1e-3)
+    assert abs(_twist(jar, 0.6 * limit)) < 0.01  # held by the thread (it gives FRICTION_SLIP at most)
+    turned = _twist(jar, 2.0 * limit)
+    assert turned > 0.3
+    assert abs(_twist(jar, 0.0)) < 0.01  # let go, it stays where it was turned to: it neither coasts nor springs back
