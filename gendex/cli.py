@@ -70,6 +70,7 @@ def list_tasks() -> None:
         origin = version.provenance()
         made = ("reworded from " + origin["reword"]["source"] if "reword" in origin
                 else "promoted from " + origin["promotion"]["source"] if "promotion" in origin
+                else "revised from " + origin["revision"]["source"] if "revision" in origin
                 else f"generated ({origin['generation']['backend']})" if "generation" in origin else "hand-written")
         gate = origin.get("solvability")
         solved = ("not measured by the solvability gate" if gate is None else

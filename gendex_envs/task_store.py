@@ -48,12 +48,12 @@ FORMAT = 1
 @lru_cache(maxsize=1)
 def inline_names() -> frozenset[str]:
     """Files (by path in the version folder) that always stay in the folder, besides every ``.py`` file: the spec,
-    ``tree.json`` and the records of this version alone (its gate measurement, rewording or promotion)."""
+    ``tree.json`` and the records of this version alone (its gate measurement, rewording, revision or promotion)."""
     from gendex_envs.task_version import TaskLayout
 
     layout = TaskLayout(".")
     return frozenset({layout.spec.name, TREE_NAME, *(layout.record(k).name for k in ("solvability", "reword",
-                                                                                         "promotion"))})
+                                                                                         "revision", "promotion"))})
 MAX_TREE_BYTES = 16 << 20
 MAX_TREE_FILES = 100_000
 MAX_OBJECT_BYTES = 1 << 32

@@ -58,8 +58,9 @@ VERSION_DIR = re.compile(r"\Av(0|[1-9][0-9]{0,8})\Z")
 """A version folder's name: ``v`` and the version in ASCII digits, no leading zero, the whole name (``$`` would match
 before a final newline, ``\\d`` any script's digits: ``v1\\n`` and ``v\u0661`` would both be version 1)."""
 RECORDS = ("generation", "proposal", "scene_candidates", "critique", "reward_attempts", "solvability", "promotion",
-           "reword", "run")
-"""JSON records a folder may hold (how it was generated, promoted, reworded or trained)."""
+           "reword", "revision", "run")
+"""JSON records a folder may hold (how it was generated, promoted, reworded, revised or trained). A ``revision`` is a
+change to a published task that a new version carries (its source, what changed and why)."""
 
 
 class TaskLayout:

@@ -4,9 +4,9 @@ A stage's success is data in the spec (``stages[k].success``, :mod:`gendex_envs.
 follow the reference tasks: a grasp holds the target with the thumb against two fingers (a hook on a handle: three
 fingers, no thumb), a lift holds it at the task's lift height, a release leaves the task's success met with the hand
 let go, an open, close or turn moves the joint past the task's fraction (a turn back below it when the task's
-condition is the joint shut: turning off; to the task's ``joint_at`` fraction when it has one), a push meets the
-task's condition on the pushed object. Skills without a template (reach, carry, place, reorient) declare nothing, so
-the stage succeeds with the task.
+condition is the joint shut: turning off; to the task's ``joint_at`` fraction when it has one; a twist's unscrewed
+cap ends in the hand), a push meets the task's condition on the pushed object. Skills without a template (reach,
+carry, place, reorient) declare nothing, so the stage succeeds with the task.
 """
 
 from __future__ import annotations
@@ -59,6 +59,8 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         frac = _task_value(task_conditions, "joint_open", target, "min_fraction", OPEN_FRACTION)
         cond: dict[str, Any] = {"type": "joint_open", "object": target, "min_fraction": frac}
         shuts = skill == "close" or (skill != "open" and _shuts(task_conditions, target))
+        if skill == "twist" and not shuts:  # unscrewed with the cap in the hand (generator.steps.scene)
+            return [cond, {"type": "grasped", "object": target, "part": "handle"}]
         return [cond | {"negate": True}] if shuts else [cond]
     if skill == "place":  # the task's conditions with this target: the held object set on it
         return [dict(c) for c in task_conditions if c.get("target") == target] or None

@@ -41,6 +41,11 @@ TWIST_PRIMITIVES = {"reach": "approach_twist", "twist": "twist"}
 """Skill -> primitive for an articulated target a ``twist`` stage turns."""
 TWIST_FAMILIES = ("top",)
 """Grasp families that turn a cap: the palm on it, the fingers round its rim."""
+NARROW_CAP_M = 0.035
+"""Caps narrower than this radius (a bottle's) are pinched first (thumb and fingers round the rim): a top grasp of
+one held it under a single finger pressing on its top, turning it without holding it (the bottle caps, seeds
+59769400-59769401)."""
+NARROW_FAMILIES = ("pinch", "top")
 TWIST_SLICE_RAD = math.radians(90)
 """How far the palm turns per grasp (the cap follows 55-65° of it: the grip winds up and closing turns it back a
 little; prototype on screw_jar, seeds 0-1: 90° slices 6 grasps a turn, 60° slices 9)."""
@@ -88,12 +93,14 @@ class TwistPrimitives:
         prefer = object_heading(cap.footprint().center, m.ik.base.p[:2])
         synth = GraspSynthesizer(rigid.hand, cap, env.table_height, prefer, others)
         m.avoid_objects()
-        for plan in synth.candidates():
-            if plan.kind not in TWIST_FAMILIES:
-                continue
+        radius = float(env.asset_record(name).entry.params.get("cap_radius", 1.0)) * env.task_spec.object(name).scale
+        families = NARROW_FAMILIES if radius < NARROW_CAP_M else TWIST_FAMILIES
+        candidates = list(synth.candidates())
+        for plan in (p for fam in families for p in candidates if p.kind == fam):
             q_pre = m.ik.solve(plan.pregrasp, m.with_hand(m.target(), plan.open_hand), restarts=20,
                                valid=m.collision.is_free)
-            if q_pre is None or m.ik.solve(plan.palm, q_pre, restarts=0) is None:
+            q_palm = None if q_pre is None else m.ik.solve(plan.palm, q_pre, restarts=0)
+            if q_palm is None or not self._turns(plan, q_palm, env.handle_pos(name)[0].cpu().numpy()):
                 continue
             log.info("twisting %r with a %s", name, plan)
             self.plan = plan
@@ -102,6 +109,19 @@ class TwistPrimitives:
             return
         raise ExecutionError(f"no grasp of {name!r}'s cap ({', '.join(TWIST_FAMILIES)}) that the arm reaches "
                              f"without collision (families {synth.families()})", cause="no_ik")
+
+    def _turns(self, plan: GraspPlan, q: np.ndarray, pivot: np.ndarray) -> bool:
+        """Whether the arm turns the palm of ``plan`` (at joint positions ``q``) a whole slice counter-clockwise
+        about ``pivot``, IK step by step as :meth:`~gendex.solve.motion.Motion.turn_about` will."""
+        ik, at = self.rigid.m.ik, sapien.Pose(np.asarray(pivot, dtype=np.float64))
+        n = int(np.ceil(TWIST_SLICE_RAD / TWIST_RAD_PER_STEP))
+        for k in range(1, n + 1):
+            half = TWIST_SLICE_RAD * k / n / 2
+            q = ik.solve(at * sapien.Pose(q=[np.cos(half), 0.0, 0.0, np.sin(half)]) * at.inv() * plan.palm, q,
+                         restarts=0)
+            if q is None:
+                return False
+        return True
 
     def _goal(self, stage) -> tuple[float, float]:
         """(sign, goal joint position): +1 towards open (unscrewing) past the task's fraction, or -1 towards shut."""

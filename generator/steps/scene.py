@@ -161,6 +161,25 @@ def hand_over_settles(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + tuple(extra)))
 
 
+def twist_holds_cap(spec: TaskSpec) -> TaskSpec:
+    """Give a success that a ``twist`` stage's cap be turned (``joint_open`` on the stage's target) a ``grasped``
+    condition on that cap: unscrewing ends with the cap in the hand (the plan step gives the stage the same,
+    :func:`generator.stage_goals.stage_goal`). A hand's forearm brushing past a screw-top turns its cap as well (a
+    blind replay of one success unscrewed 16-20 % of caps moved +-15 x 25 cm that way); it does not end holding it."""
+    twisted = {st.target for st in spec.stages if st.skill == "twist"}
+    conds = spec.success.conditions
+    held = {c.object for c in conds if c.type == "grasped" and not c.negate}
+    caps = [c.object for c in conds if c.type == "joint_open" and not c.negate and c.object in twisted
+            and c.object not in held]
+    if not caps:
+        return spec
+    log.info("success of %s: the twisted cap must end in the hand", spec.name)
+    extra = tuple(ConditionSpec(type="grasped", object=o, part="handle") for o in dict.fromkeys(caps))
+    success = dataclasses.replace(spec.success, conditions=conds + extra,
+                                  description=f"{spec.success.description.rstrip()} The cap ends in the hand.")
+    return dataclasses.replace(spec, success=success)
+
+
 def hold_joint_at(spec: TaskSpec) -> TaskSpec:
     """Give a success with a ``joint_at`` condition (a joint set part way) :data:`SETTLED_STEPS` to hold: a door
     swung through the band, or a lever pushed past it, is not where it was asked to be."""
@@ -195,7 +214,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))
+    return twist_holds_cap(hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec))))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

@@ -26,6 +26,9 @@ INSIDE = [{"type": "inside", "object": "apple", "target": "bowl"}]
     ("open", True, [{"type": "joint_open", "object": "apple", "min_fraction": 0.6}],
      [{"type": "joint_open", "object": "apple", "min_fraction": 0.6}]),
     ("close", True, [], [{"type": "joint_open", "object": "apple", "min_fraction": 0.8, "negate": True}]),
+    ("twist", True, [{"type": "joint_open", "object": "apple", "min_fraction": 0.9}],
+     [{"type": "joint_open", "object": "apple", "min_fraction": 0.9},
+      {"type": "grasped", "object": "apple", "part": "handle"}]),
     ("reach", False, INSIDE, None),
     ("reorient", False, INSIDE, None),
 ])

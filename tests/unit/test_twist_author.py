@@ -71,6 +71,10 @@ def test_an_unscrew_task_is_a_reach_and_a_long_twist_to_a_full_turn(text, asset)
     assert list(o.randomize.xy_m) == TWIST_RANDOMIZE["xy_m"] and o.joint_state == {"cap_screw": 0.0}
     twist = spec.stages[1]
     assert twist.skill == "twist" and twist.horizon == STAGE_HORIZONS["twist"]
+    # unscrewed means the cap ends in the hand: a forearm brushing past a cap turns it too
+    assert [(c.type, c.object, c.part) for c in spec.success.conditions] == [
+        ("joint_open", o.name, None), ("grasped", o.name, "handle")]
+    assert spec.success.description.endswith("The cap ends in the hand.")
     assert spec.max_episode_steps >= 2 * twist.horizon
     raw, roles = spec_to_dict(spec), roles_of(dataclasses.asdict(p))
     check_reward_source(compose_task_module(raw, roles))
