@@ -162,8 +162,7 @@ class Joint:
     """Grip centre in the child link frame at qpos 0."""
     damping: float = 0.2
     friction: float = 0.02
-    """Written to the URDF for other simulators; SAPIEN's URDF loader ignores it (``friction_limit`` is what GenDex
-    applies)."""
+    """URDF only (SAPIEN's loader ignores it; GenDex applies ``friction_limit``)."""
     effort: float = 50.0
     velocity: float = 3.0
     holds: tuple[Vec3, Vec3] | None = None
@@ -171,8 +170,7 @@ class Joint:
     detents: tuple[float, ...] | None = None
     """Rest positions (fractions from closed to open) a spring of stiffness ``spring`` pulls towards (nearest)."""
     spring: float | None = None
-    friction_limit: float | None = None
-    """Dry friction GenDex applies (:attr:`~gendex_envs.assets.manifest.JointEntry.friction_limit`)."""
+    friction_limit: float | None = None  # JointEntry.friction_limit: dry friction GenDex applies
 
 
 @dataclass(frozen=True)
@@ -577,8 +575,7 @@ def lever_switch(id: str, length: float = 0.1, pivot: float = 0.1) -> Model:
 
 
 SCREW_RIM_FRICTION_N = 2.0
-"""The thread's dry friction as a force at the cap's rim (N; the torque is this times the cap's radius): what a grip
-must overcome to turn a cap, and what stops a cap a finger brushes from spinning on."""
+"""The thread's dry friction at the cap's rim (N; times the cap's radius: the torque a grip must overcome)."""
 SCREW_STYLES: dict[str, tuple[float, float, float, float, float, RGBA, str]] = {
     # style: body radius, body height, neck radius (0: none), cap radius, cap height, cap colour, its name
     "jar": (0.042, 0.10, 0.0, 0.045, 0.024, RED, "red"),
