@@ -194,6 +194,8 @@ ROLE_TESTS = {
     "landmark": lambda a: not a.get("joints"),
     "handover": lambda a: "handover" in a["tags"],
     "screwable": lambda a: "cap" in part_kinds(a),
+    "insertable": lambda a: "peg" in a["tags"] and not a.get("joints"),
+    "socket": lambda a: "insert" in a["tags"] and not a.get("joints"),
 }
 """What an object must be to play each role."""
 
@@ -202,7 +204,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
-    "twist": ("screwable",),
+    "twist": ("screwable",), "insert": ("insertable", "socket"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -430,20 +432,10 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if loose:
         notes.append(loose)
     off = is_off(words)
-    zone = [m for m in mentions if m.asset and ROLE_TESTS["handover"](_by_id(assets, m.asset))]
-    if zone and skill in ("put_in", "place_on", "place_at", "lift", "push", "hand_over"):
-        # 'set the bottle on the hand-over mat': a hand-over; the mat is the task's own, not an object to assign
-        skill, roles, relation, region = "hand_over", SKILL_ROLES["hand_over"], None, None
-        mentions = [m for m in mentions if m not in zone]
-    screws = [m for m in (_screw_model(m, assets) for m in mentions) if m is not None]
-    tighten = skill == "close" or words[-1:] == ["on"] or any(w in ("screw", "tighten") for w in words)
-    capped = skill != "take_out" or any(w in ("lid", "cap", "top") for w in words)  # not 'take the apple out of'
-    if screws and capped and skill in ("open", "turn", "take_out", "press", "close", "twist"):
-        if tighten:
-            raise InstructionError(f'"{text}": screwing a cap on (tightening it) is not built yet; GenDex unscrews '
-                                   "caps and lids ('unscrew the jar lid')")
-        skill, roles = "twist", SKILL_ROLES["twist"]  # 'open the jar', 'turn the bottle cap', 'take the lid off'
-        mentions = screws[:1]
+    from generator.remaps import Read, object_skill  # the dexterous skills a verb means by its objects
+
+    r = object_skill(Read(skill, roles, relation, region, mentions), words, text, assets)
+    skill, roles, relation, region, mentions = r.skill, r.roles, r.relation, r.region, r.mentions
     if skill in ("push", "turn") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'
@@ -462,17 +454,6 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
                                    f"for it without a colour")
     return Reading(text, skill, tuple(resolved), tuple(notes), direction=direction, relation=relation,
                    region=region, amount=amount)
-
-
-def _screw_model(m: Mention, assets: Sequence[dict]) -> Mention | None:
-    """``m`` as the model with a screw cap it may name (*the jar*: the rigid jar's name, and the screw-top jar's
-    kind), None when it names none."""
-    if not m.asset:
-        return None
-    kind = _by_id(assets, m.asset)["category"]
-    ids = [*(m.options or (m.asset,)), *(a["id"] for a in assets if a["category"] == kind)]
-    screw = next((i for i in ids if ROLE_TESTS["screwable"](_by_id(assets, i))), None)
-    return None if screw is None else dataclasses.replace(m, asset=screw, options=(screw,))
 
 
 def _own_color(m: Mention, assets: Sequence[dict]) -> Mention:

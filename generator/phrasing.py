@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 NAMES: dict[str, tuple[str, ...]] = {
+    "peg_holder": ("peg holder", "holder", "pegboard"),
     "bowl": ("bowl", "serving bowl", "mixing bowl"),
     "pot": ("pot", "cooking pot", "saucepan"),
     "plate": ("plate", "dinner plate", "dish"),
@@ -64,9 +65,10 @@ MODEL_WORDS: dict[str, str] = {
     "oven_standard": "standard", "drawer_chest_1": "single-drawer", "drawer_chest_2": "two-drawer",
     "drawer_chest_3": "three-drawer", "trash_can_small": "small", "trash_can_tall": "tall",
     "box_with_lid_small": "small", "box_with_lid_large": "large", "laptop_13in": "13-inch", "laptop_15in": "15-inch",
+    "peg_round": "round", "peg_square": "square", "peg_thin": "thin",
 }
-"""Words that tell an articulated model from its siblings (read back by :mod:`generator.instruction` as that
-model): two tasks on sibling models must not read alike."""
+"""Words that tell a model from its siblings (articulated models, pegs), read back by :mod:`generator.instruction` as
+that model: two tasks on sibling models must not read alike."""
 
 SURFACES = ("table", "tabletop", "counter", "worktop")
 
@@ -175,6 +177,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "unscrew the lid of the {d}, a turn at a time",
         "open the {d} by unscrewing its cap",
         "loosen the {d}'s cap until it comes free",
+    ),
+    "insert": (
+        "insert the {o} into the {d}",
+        "fit the {o} into the hole of the {d}",
+        "slot the {o} down into the {d} and let go of it",
+        "put the {o} into the {d}'s hole, standing straight",
+        "push the {o} into the {d} until it sits on the bottom of the hole",
     ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",

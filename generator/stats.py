@@ -32,11 +32,12 @@ from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
                "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out", "press",
-               "hand_over", "twist")
+               "hand_over", "twist", "insert")
 """The task skills: the solver issue's thirteen in its order, then the task language's places (``place_at``: set
 down beside, between or in a region), taking an object out of a container (``take_out``), then the dexterous
 skills' (``press``: a button or switch pushed past its detent; ``hand_over``: an object left still on the hand-over
-mat; ``twist``: a cap unscrewed, regrasped between turns of the hand)."""
+mat; ``twist``: a cap unscrewed, regrasped between turns of the hand; ``insert``: a peg put into its holder's
+hole)."""
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
@@ -70,6 +71,8 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
     ``taken_out``: a ``placed`` object starts in its target (a take-out)."""
     if kind in ("near", "over", "inside", "placed") and target_category == "handover_mat" and not negate:
         return "hand_over"
+    if kind in ("over", "inside") and target_category == "peg_holder" and not negate:
+        return "insert"
     if kind == "placed":
         return "take_out" if taken_out else "place_at"
     if kind == "lifted":

@@ -54,6 +54,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("twist", ("unscrew", "twist off", "twist open", "screw off", "untwist", "loosen", "screw", "tighten"),
               "a jar lid or bottle cap unscrewed a full turn, regrasped between turns of the hand (jar, wide-mouth "
               "bottle, canister)", "unscrew the jar lid"),
+    TaskSkill("insert", ("insert", "plug", "slot", "fit", "peg"),
+              "a peg put into the hole of its holder (2.5-3 mm of clearance a side), upright, and let go: a round, "
+              "square or thin peg", "insert the square peg into the square hole"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
@@ -83,6 +86,11 @@ SYNONYMS: dict[str, str] = {
     "arcade button": "button_arcade", "push button": "button", "pushbutton": "button", "buzzer": "button_arcade",
     "game button": "button_arcade", "light switch": "switch", "toggle switch": "switch", "lever switch": "switch",
     "breaker": "switch", "power switch": "switch", "tall switch": "switch_lever_tall",
+    "peg holder": "peg_holder", "holder": "peg_holder", "peg hole": "peg_holder", "peg board": "peg_holder",
+    "pegboard": "peg_holder", "hole": "peg_holder", "round hole": "peg_holder_round",
+    "square hole": "peg_holder_square",
+    "thin hole": "peg_holder_thin", "small hole": "peg_holder_thin", "narrow hole": "peg_holder_thin",
+    "round peg": "peg_round", "square peg": "peg_square", "thin peg": "peg_thin", "dowel": "peg_thin",
     "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
     "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",
     "handover spot": "handover_mat", "mat": "handover_mat", "yellow mat": "handover_mat",

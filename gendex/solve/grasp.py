@@ -363,8 +363,11 @@ class GraspSynthesizer:
     """Grasp candidates of one object at its current pose (see the module docstring)."""
 
     def __init__(self, hand: HandModel, shape: PosedShape, table_z: float = 0.0, prefer_yaw_rad: float = 0.0,
-                 others: tuple[PosedShape, ...] = (), mass_kg: float = 0.0):
+                 others: tuple[PosedShape, ...] = (), mass_kg: float = 0.0, high_first: bool = False):
         self.hand = hand
+        self.high_first = high_first
+        """Pinch highest first: a peg goes into its hole bottom first, the fingers curled under a pinch at its middle
+        met the holder's top before the peg's end reached the hole (seed 57618305)."""
         self.shape = shape
         self.table_z = table_z
         self.prefer = prefer_yaw_rad
@@ -493,6 +496,8 @@ class GraspSynthesizer:
         com = self.shape.centroid()
         if h > TALL_M and fit is None:  # level with the centre of mass first: the weight pulls along the pads
             heights = [float(com[2])] + [z for z in heights if abs(z - float(com[2])) > 0.005]
+        if self.high_first:
+            heights = sorted(heights, reverse=True)
         s_com = 0.0
         if self._elongated():  # across it, at several places along it, its centroid first
             s_com = float((com[:2] - fp.center) @ fp.axis)

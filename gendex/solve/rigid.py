@@ -92,6 +92,11 @@ PLACE_CORRECTIONS = 3
 PLACE_TOLERANCE_M = 0.005
 """Before a place lowers the object, it is moved over the target's centre (at most this many corrections, until
 within the tolerance)."""
+INSERT_CORRECTIONS = 8
+INSERT_TOLERANCE_M = 0.0012
+INSERT_TILT_RAD = 0.02
+"""Into a holder (an asset tagged ``insert``: a hole a few mm wider than its peg) the object's *bottom* is centred
+over the hole to this tolerance, after the hand stands it up to within ``INSERT_TILT_RAD``."""
 PLACE_PRESS_M = 0.015
 PLACE_RESTING_M = 0.008
 """A place lowers the held object's lowest point to this far *below* the surface under it, and stops as soon as the
@@ -208,7 +213,9 @@ class RigidPrimitives:
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
         prefer = object_heading(shape.footprint().center, m.ik.base.p[:2])
-        synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others, px_bodies(env.obj(name))[0].mass)
+        into_hole = set_on is not None and "insert" in env.asset_record(set_on).tags  # a peg: held high
+        synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others, px_bodies(env.obj(name))[0].mass,
+                                 high_first=into_hole)
         self._synth = synth
         m.avoid_objects(exclude=(name,))
         q0 = m.target()
@@ -465,16 +472,29 @@ class RigidPrimitives:
         c, m, held = self.config, self.m, self.held
         if held is None:
             raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing", "slipped")
-        yield from self._stand_as_before(held)
+        insert = point is None and "insert" in self.env.asset_record(target).tags
+        yield from self._stand_as_before(held, INSERT_TILT_RAD if insert else None)
+        if insert:
+            yield from self._square_to(held, target)
         goal_xy = (np.asarray(point, dtype=np.float64) if point is not None
                    else np.asarray(at, dtype=np.float64) if at is not None else self.shape(target).footprint().center)
-        for _ in range(PLACE_CORRECTIONS):  # the carry ends within a few cm: centre the object over the target
+        last, move = np.inf, np.zeros(3)
+        for _ in range(INSERT_CORRECTIONS if insert else PLACE_CORRECTIONS):
+            # the carry ends within a few cm: centre the object (its bottom, into a hole) over the target
             lo, hi = m.world_aabb(held)
-            error = goal_xy - (lo[:2] + hi[:2]) / 2
-            if float(np.linalg.norm(error)) < PLACE_TOLERANCE_M:
+            now = self._pose_now(held)[:2] if insert else (lo[:2] + hi[:2]) / 2
+            error = goal_xy - now
+            off = float(np.linalg.norm(error))
+            log.debug("centring %r over %r: %.1f mm off", held, target, 1000 * off)
+            if off < (INSERT_TOLERANCE_M if insert else PLACE_TOLERANCE_M):
                 break
-            yield from m.cartesian(np.array([error[0], error[1], 0.0]), c.motion.lift_m_per_step, guard=True,
-                                   paced=True)
+            if insert and off > last:  # a peg pinched high swung rather than followed: back to the nearest
+                yield from m.cartesian(-move, c.motion.lift_m_per_step, guard=True, partial=True)
+                yield from m.hold(c.motion.settle_steps)
+                break
+            last, move = off, np.array([error[0], error[1], 0.0])
+            yield from m.cartesian(move, c.motion.lift_m_per_step, guard=True, paced=True,
+                                   partial=insert)  # a mm short of a hole: the next try, or the chamfer
             yield from m.hold(c.motion.settle_steps)
         lo, hi = m.world_aabb(held)
         xy = (lo[:2] + hi[:2]) / 2
@@ -501,9 +521,32 @@ class RigidPrimitives:
             yield from m.cartesian(np.array([0.0, 0.0, min(lag, PLACE_PRESS_M)]), c.motion.lift_m_per_step,
                                    guard=True)
 
-    def _stand_as_before(self, held: str) -> Iterator[np.ndarray]:
+    def _square_to(self, held: str, target: str) -> Iterator[np.ndarray]:
+        """Turn the hand about the vertical through the held object until its sides line up with a square hole's
+        (a square peg fits a hole 6 mm wider only within about 14° of it)."""
+        shapes = [self.env.asset_record(n).entry.params.get("shape") for n in (held, target)]
+        if shapes != ["square", "square"]:
+            return
+
+        def yaw(name: str) -> float:
+            x = sapien.Pose(q=self._pose_now(name)[3:]).to_transformation_matrix()[:3, 0]
+            return float(np.arctan2(x[1], x[0]))
+
+        for other_way in (False, True):  # the short way round; where the arm's reach ends, the long way (90° less)
+            error = (yaw(target) - yaw(held) + np.pi / 4) % (np.pi / 2) - np.pi / 4
+            if abs(error) <= INSERT_TILT_RAD:
+                return
+            turn = error - np.sign(error) * np.pi / 2 if other_way else error
+            lo, hi = self.m.world_aabb(held)
+            done = yield from self.m.turn_about((lo + hi) / 2, np.array([0.0, 0.0, turn]), UNTILT_RAD_PER_STEP,
+                                               guard=True)
+            if done >= 1.0:
+                return
+
+    def _stand_as_before(self, held: str, min_rad: float | None = None) -> Iterator[np.ndarray]:
         """Turn the hand about the held object's centre back to the object's tilt at reset (when: see
-        :data:`UNTILT_TOPPLE_RAD`): a bottle a side grasp lifted 24° askew falls when let go, on thumb or tray."""
+        :data:`UNTILT_TOPPLE_RAD`; ``min_rad``: any tilt over it): a bottle a side grasp lifted 24° askew falls when
+        let go, on thumb or tray; a peg must go into its hole straight."""
         q_now = self.env.obj(held).pose.q[0].cpu().numpy()
         q_init = self.env.init_obj_quat(held)[0].cpu().numpy()
         up_now = sapien.Pose(q=q_now).to_transformation_matrix()[:3, 2]
@@ -513,7 +556,7 @@ class RigidPrimitives:
         standing = self._shapes[held].posed(sapien.Pose(q=q_init).to_transformation_matrix())
         base = standing.footprint()
         topple = float(np.arctan2(base.width / 2, standing.centroid()[2] - base.bottom))
-        if topple > UNTILT_TOPPLE_RAD or not topple / 2 < angle <= UNTILT_MAX_RAD:
+        if topple > UNTILT_TOPPLE_RAD or not (topple / 2 if min_rad is None else min_rad) < angle <= UNTILT_MAX_RAD:
             return
         axis, (lo, hi) = np.cross(up_now, up_then), self.m.world_aabb(held)
         done = yield from self.m.turn_about((lo + hi) / 2, axis / np.linalg.norm(axis) * angle, UNTILT_RAD_PER_STEP,

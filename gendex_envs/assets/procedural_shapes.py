@@ -49,6 +49,11 @@ SURFACE = ("surface", "kitchenware")
 HANDOVER = ("handover", "marker")
 """A hand-over zone: where the robot leaves things for a person to take (the ``hand_over`` task skill)."""
 
+PEG = ("graspable", "peg", "toy")
+HOLDER = ("holder", "insert")
+"""Something a peg is inserted into: a fixed block with a hole a few millimetres wider than its peg (the ``insert``
+task skill)."""
+
 GENERATORS: dict[str, Callable[[], ProceduralShape]] = {}
 
 
@@ -356,6 +361,58 @@ _register("tray", _surface("tray", (34, 26, 0.6), 0.5, 0.6, (0.3, 0.35, 0.4, 1.0
 # the hand-over zone: a thin bright mat at the person's side of the table (a marker, never a support to stack on)
 _register("handover_mat", _surface("handover_mat", (22, 22, 0.6), 0.2, 1.0, (0.95, 0.75, 0.1, 1.0), bevel=0.2,
                                    tags=HANDOVER))
+
+
+def _peg(asset_id, width, height, square, rgba, color):
+    """A wooden peg standing on its end: a round one (``width`` its diameter, cm) or a square one (``width`` its
+    side), ``height`` tall, the edge of the end that goes in first (its bottom) chamfered 2 mm."""
+    def make():
+        parts, w, c = Parts(), width / 2, 0.2
+        if square:
+            parts.convex(np.vstack([box_pts((width - 2 * c, width - 2 * c, c), (0, 0, c / 2)),
+                                    box_pts((width, width, height - c), (0, 0, (height + c) / 2))]), faceted=True)
+        else:
+            parts.convex(np.vstack([cyl_between([0, 0, 0], [0, 0, c], w - c, w, n=24),
+                                    cyl_between([0, 0, c], [0, 0, height], w, n=24)]))
+        volume = (width**2 if square else np.pi * w**2) * height * 1e-6
+        return _done(parts, id=asset_id, category="peg", tags=PEG, mass_kg=round(650 * volume, 4), friction=0.8,
+                     rgba=rgba, source=SOURCE_PRIMITIVES,
+                     params={"shape": "square" if square else "round", "width_m": width / 100, "color": color})
+    return make
+
+
+def _peg_holder(asset_id, hole, square, rgba, outer=9.0, height=5.0, floor=1.0):
+    """A block ``outer`` cm across and ``height`` tall with a hole ``hole`` cm across (round or square) down to a
+    ``floor`` cm thick: the walls round the hole are convex pieces (16 ring sectors, or four slabs), so the hole is
+    open for a peg a few millimetres narrower."""
+    def make():
+        parts, r = Parts(), hole / 2
+        parts.convex(box_pts((outer, outer, floor), (0, 0, floor / 2)), faceted=True)
+        if square:
+            side = (outer - hole) / 2
+            for sx in (-1, 1):
+                parts.convex(box_pts((side, outer, height - floor), (sx * (hole + side) / 2, 0, (height + floor) / 2)),
+                             faceted=True)
+            for sy in (-1, 1):
+                parts.convex(box_pts((hole, side, height - floor), (0, sy * (hole + side) / 2, (height + floor) / 2)),
+                             faceted=True)
+        else:
+            for pts in ring_hulls(r, outer / 2, floor, height, pieces=16, overlap=0.05):
+                parts.convex(pts)
+        return _done(parts, id=asset_id, category="peg_holder", tags=HOLDER, mass_kg=0.4, friction=0.6, rgba=rgba,
+                     source=SOURCE_PRIMITIVES, params={"shape": "square" if square else "round",
+                                                       "hole_m": hole / 100, "hole_floor_m": floor / 100,
+                                                       "top_z_m": height / 100})
+    return make
+
+
+_register("peg_round", _peg("peg_round", 2.4, 10.0, False, (0.85, 0.2, 0.15, 1.0), "red"))
+_register("peg_square", _peg("peg_square", 2.4, 10.0, True, (0.2, 0.35, 0.85, 1.0), "blue"))
+_register("peg_thin", _peg("peg_thin", 1.8, 11.0, False, (0.95, 0.8, 0.15, 1.0), "yellow"))
+# each hole 5-6 mm wider than its peg: 2.5-3 mm of clearance a side
+_register("peg_holder_round", _peg_holder("peg_holder_round", 3.0, False, (0.72, 0.55, 0.35, 1.0)))
+_register("peg_holder_square", _peg_holder("peg_holder_square", 3.0, True, (0.72, 0.55, 0.35, 1.0)))
+_register("peg_holder_thin", _peg_holder("peg_holder_thin", 2.3, False, (0.6, 0.45, 0.3, 1.0)))
 _register("cracker_box", _box("cracker_box", (16, 6, 21), 0.411, 0.6, (0.85, 0.2, 0.15, 1.0), BOX))
 _register("sugar_box", _box("sugar_box", (9, 4, 17.5), 0.514, 0.6, (0.95, 0.9, 0.55, 1.0), BOX))
 _register("pudding_box", _box("pudding_box", (8.9, 3.5, 11), 0.187, 0.6, (0.55, 0.35, 0.2, 1.0), BOX))

@@ -12,7 +12,16 @@ import yaml
 
 from generator.backends import placed as placed_tasks
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
-from generator.backends.roles import DRAWER_OUT_M, _acts, _round, drawer_joint, graspable, handover_zone
+from generator.backends.roles import (
+    DRAWER_OUT_M,
+    _acts,
+    _round,
+    drawer_joint,
+    graspable,
+    handover_zone,
+    insertable,
+    socket,
+)
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
@@ -35,6 +44,11 @@ HANDOVER_REGION_M = ((0.36, 0.44), (-0.22, 0.22))
 or more beyond the movable objects' region; hand-written trials with the mat at (0.4, -0.2): 18 of 20 handed over)."""
 HANDOVER_RANDOMIZE = {"xy_m": [0.03, 0.05], "yaw_deg": 0.0}
 """How far the mat moves at reset."""
+INSERT_RANDOMIZE = {"xy_m": [0.05, 0.05]}
+HOLDER_YAW_DEG = 20.0
+"""How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
+stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
+(a square one up to 45°: the solver lines it up with its hole)."""
 ARTICULATED_REGION_M = ((0.52, 0.68), (-0.2, 0.2))
 """The same for articulated objects (their front faces the robot): OpenCabinet, OpenDrawer and CloseDrawer succeed
 48-50/50 at (0.55-0.6, 0-0.1) +-5 cm; a batch sampled over x 0.3..0.75, y +-0.45 lost 3/10 drawer openings to
@@ -116,6 +130,10 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
             entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
             entry["fixed"] = True
             entry["randomize"] = dict(HANDOVER_RANDOMIZE)
+        elif socket(a) or insertable(a):  # a holder stays put; the hole and the peg move at reset
+            entry["fixed"] = socket(a)
+            entry["randomize"] = dict(INSERT_RANDOMIZE, yaw_deg=HOLDER_YAW_DEG if socket(a) else
+                                      180.0 if _round(a) else 45.0)
         elif o["role"] == "articulated":
             j = a["joints"][0]
             entry["fixed"] = True

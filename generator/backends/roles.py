@@ -57,6 +57,30 @@ def handed(a: dict) -> bool:
     return graspable(a) or vessel
 
 
+def insertable(a: dict) -> bool:
+    """A peg: what the offline author inserts into a holder."""
+    return "peg" in a["tags"] and not a.get("joints")
+
+
+def socket(a: dict) -> bool:
+    """A holder with a hole a peg goes into (an asset tagged ``insert``)."""
+    return "insert" in a["tags"] and not a.get("joints")
+
+
+HOLE_CLEARANCE_M = (0.004, 0.008)
+"""A peg fits a hole of its own shape this much wider (2-4 mm a side): the catalog's pairs have 5-6 mm; the solver
+centres the peg to 1.2 mm."""
+
+
+def fits_hole(peg: dict, holder: dict) -> bool:
+    """Whether ``peg`` goes into ``holder``'s hole: the same shape, the hole :data:`HOLE_CLEARANCE_M` wider."""
+    from gendex_envs.assets.catalog import get_asset
+
+    p, h = (get_asset(a["id"]).entry.params for a in (peg, holder))
+    gap = float(h.get("hole_m", 0.0)) - float(p.get("width_m", 1.0))
+    return p.get("shape") == h.get("shape") and HOLE_CLEARANCE_M[0] <= gap <= HOLE_CLEARANCE_M[1]
+
+
 def handover_zone(a: dict) -> bool:
     """The hand-over mat: where the robot leaves what it hands to a person."""
     return "handover" in a["tags"] and not a.get("joints")

@@ -7,6 +7,9 @@ calls them among its static checks, with the same :class:`~generator.critic.phys
     Nearer, a task is half done at reset (a nudge finishes it), and a start on the mat is done by holding still.
     Fix: the object moves away from the zone along the axis it is already most apart on (towards the robot when it
     starts on the zone's middle) until that axis alone leaves the gap.
+``insert``
+    The same for a peg and the holder it goes into (an asset tagged ``insert``): a peg that starts next to its hole
+    is half inserted by a nudge. Gap :data:`INSERT_APART_M`, the same fix.
 """
 
 from __future__ import annotations
@@ -31,13 +34,32 @@ def _gaps(a_lo, a_hi, b_lo, b_hi) -> np.ndarray:
     return np.maximum(0.0, np.maximum(b_lo - a_hi, a_lo - b_hi))
 
 
+INSERT_APART_M = 0.05
+"""Least gap (m) between a peg's footprint and its holder's, both widened by their randomization (a peg must be
+lifted over the holder's 5 cm wall: a nudge inserts nothing)."""
+APART: dict[str, tuple[str, float, str]] = {"handover": ("handover", HANDOVER_APART_M, "hand-over zone"),
+                                            "insert": ("insert", INSERT_APART_M, "holder")}
+"""Check -> (the target's catalog tag, least gap, what the target is called)."""
+
+
 def handover_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
     """The ``handover`` check (module docstring): one violation per object that starts too near its zone."""
+    _apart_checks("handover", spec, placed, meas, violations)
+
+
+def insert_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+    """The ``insert`` check (module docstring): one violation per peg that starts too near its holder."""
+    _apart_checks("insert", spec, placed, meas, violations)
+
+
+def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: dict,
+                  violations: list[Violation]) -> None:
     from generator.critic.physical import Violation, moves, rounded
 
+    tag, apart, called = APART[check]
     for c in spec.success.conditions:
         if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed") or c.target not in placed
-                or c.object not in placed or "handover" not in placed[c.target].record.tags):
+                or c.object not in placed or tag not in placed[c.target].record.tags):
             continue
         obj, zone = placed[c.object], placed[c.target]
         wo, wz = np.asarray(obj.spec.randomize.xy_m), np.asarray(zone.spec.randomize.xy_m)
@@ -45,19 +67,19 @@ def handover_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, viola
         z_lo, z_hi = zone.lo[:2] - wz, zone.hi[:2] + wz
         gaps = _gaps(o_lo, o_hi, z_lo, z_hi)
         gap = float(np.linalg.norm(gaps))
-        meas[c.object] = {"zone": c.target, "gap_m": rounded(gap), "limit_m": HANDOVER_APART_M}
-        if gap >= HANDOVER_APART_M:
+        meas[c.object] = {"zone": c.target, "gap_m": rounded(gap), "limit_m": apart}
+        if gap >= apart:
             continue
         d = obj.centre_xy - zone.centre_xy
         axis = int(np.argmax(np.abs(d))) if np.abs(d).max() > 0.01 else 0
         sign = 1.0 if d[axis] > 0.01 else -1.0  # on the mat: towards the robot
         step = np.zeros(2)
-        step[axis] = (z_hi[axis] + HANDOVER_APART_M - o_lo[axis] if sign > 0
-                      else z_lo[axis] - HANDOVER_APART_M - o_hi[axis]) + sign * 1e-3
+        step[axis] = (z_hi[axis] + apart - o_lo[axis] if sign > 0
+                      else z_lo[axis] - apart - o_hi[axis]) + sign * 1e-3
         violations.append(Violation(
-            "handover", c.object, f"{c.object!r} starts {gap:.3f} m from the hand-over zone {c.target!r} (footprints "
-            f"widened by their randomization); a hand-over carries it at least {HANDOVER_APART_M} m",
-            measured=gap, limit=HANDOVER_APART_M, fix=moves(c.object, step), other=c.target))
+            check, c.object, f"{c.object!r} starts {gap:.3f} m from the {called} {c.target!r} (footprints widened by "
+            f"their randomization); it must be carried at least {apart} m",
+            measured=gap, limit=apart, fix=moves(c.object, step), other=c.target))
 
 
-__all__ = ["HANDOVER_APART_M", "handover_checks"]
+__all__ = ["APART", "HANDOVER_APART_M", "INSERT_APART_M", "handover_checks", "insert_checks"]

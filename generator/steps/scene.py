@@ -161,6 +161,26 @@ def hand_over_settles(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + tuple(extra)))
 
 
+INSERTED_TILT_DEG = 10.0
+"""An inserted peg stands within this of upright (in its hole it can lean about 4°; one lying across the holder's top
+is 90° off)."""
+
+
+def inserted_upright(spec: TaskSpec) -> TaskSpec:
+    """Give every object the success sets in or over a holder (an asset tagged ``insert``) an ``upright``
+    condition: an inserted peg stands in its hole."""
+    by_name = {o.name: o for o in spec.objects}
+    conds = spec.success.conditions
+    have = {c.object for c in conds if c.type == "upright" and not c.negate}
+    pegs = [c.object for c in conds if c.type in SET_DOWN_CONDITIONS and not c.negate and c.target in by_name
+            and "insert" in asset_dict(by_name[c.target].asset)["tags"] and c.object not in have]
+    if not pegs:
+        return spec
+    log.info("success of %s: %s must stand upright in the hole", spec.name, ", ".join(dict.fromkeys(pegs)))
+    extra = tuple(ConditionSpec(type="upright", object=o, max_tilt_deg=INSERTED_TILT_DEG) for o in dict.fromkeys(pegs))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
+
+
 def twist_holds_cap(spec: TaskSpec) -> TaskSpec:
     """Give a success that a ``twist`` stage's cap be turned (``joint_open`` on the stage's target) a ``grasped``
     condition on that cap: unscrewing ends with the cap in the hand (the plan step gives the stage the same,
@@ -214,7 +234,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return twist_holds_cap(hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec))))))
+    return inserted_upright(twist_holds_cap(hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

@@ -55,7 +55,7 @@ class _Trials:
 def _choose(monkeypatch, outcomes, set_on=None, fits=None):
     """``outcomes[i](plan)``: the trial result of candidate i. Returns (chosen plan, plans tried)."""
     plans = tuple(_plan(i) for i in range(len(outcomes)))
-    monkeypatch.setattr(rigid, "GraspSynthesizer", lambda *a: _Synth(plans=plans))
+    monkeypatch.setattr(rigid, "GraspSynthesizer", lambda *a, **kw: _Synth(plans=plans))
     monkeypatch.setattr(rigid, "object_heading", lambda *a: 0.0)
     monkeypatch.setattr(rigid, "px_bodies", lambda obj: [types.SimpleNamespace(mass=0.1)])
     monkeypatch.setattr(rigid, "fits_on", lambda shape, target: fits)
@@ -65,7 +65,8 @@ def _choose(monkeypatch, outcomes, set_on=None, fits=None):
     prims.m = types.SimpleNamespace(ik=ik, collision=types.SimpleNamespace(is_free=None), target=lambda: np.zeros(3),
                                     with_hand=lambda q, hand: q, avoid_objects=lambda exclude: None)
     prims.env = types.SimpleNamespace(objects=("cube", "bowl"), articulations=(), table_height=0.0,
-                                      obj=lambda name: None)
+                                      obj=lambda name: None,
+                                      asset_record=lambda name: types.SimpleNamespace(tags=("container",)))
     prims._hand, prims._trials, prims._synth, prims.trial_log = object(), _Trials(outcomes), None, []
     shape = types.SimpleNamespace(footprint=lambda: types.SimpleNamespace(center=np.zeros(2)))
     prims._shapes = {"cube": shape, "bowl": shape}

@@ -1,0 +1,78 @@
+"""Which dexterous skill a request means once its objects are known: the instruction reader reads a verb first
+(*put*, *open*, *insert*), and these rules look at what the verb acts on.
+
+- a hand-over mat among the objects: ``hand_over`` (*set the bottle on the hand-over mat*); the mat is the task's own;
+- a screw-top model opened, turned, taken off or pressed: ``twist`` (*open the jar*, *take the lid off the bottle*);
+  screwing one on is refused, saying what is built;
+- a peg put, placed, inserted or fitted into a holder (or a peg inserted): ``insert`` (*put the square peg in the
+  square hole*, *push the peg into the hole*, *insert the peg*); a peg picked up, or pushed to the goal, stays a
+  lift or a push.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from generator.errors import InstructionError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from generator.instruction import Mention
+
+PUT_SKILLS = ("put_in", "place_on", "place_at", "lift", "push")
+"""Skills whose verb (*put*, *set*, *place*, *take*, *move*) may mean a hand-over or an insertion by its objects."""
+
+
+@dataclasses.dataclass
+class Read:
+    """What the reader has so far: the skill, its roles, a relation or region, and the objects mentioned."""
+
+    skill: str | None
+    roles: tuple[str, ...]
+    relation: str | None
+    region: str | None
+    mentions: list[Mention]
+
+
+def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -> Read:
+    """``r`` with its skill replaced where its objects say which dexterous skill is meant (module docstring)."""
+    from generator.instruction import ROLE_TESTS, SKILL_ROLES, _by_id
+
+    def plays(m: Mention, role: str) -> bool:
+        return bool(m.asset) and ROLE_TESTS[role](_by_id(assets, m.asset))
+
+    zone = [m for m in r.mentions if plays(m, "handover")]
+    if zone and r.skill in (*PUT_SKILLS, "hand_over"):
+        # the mat is the task's own, not an object to assign
+        r = Read("hand_over", SKILL_ROLES["hand_over"], None, None, [m for m in r.mentions if m not in zone])
+    screws = [m for m in (_screw_model(m, assets) for m in r.mentions) if m is not None]
+    tighten = r.skill == "close" or words[-1:] == ["on"] or any(w in ("screw", "tighten") for w in words)
+    capped = r.skill != "take_out" or any(w in ("lid", "cap", "top") for w in words)  # not 'take the apple out of'
+    if screws and capped and r.skill in ("open", "turn", "take_out", "press", "close", "twist"):
+        if tighten:
+            raise InstructionError(f'"{text}": screwing a cap on (tightening it) is not built yet; GenDex unscrews '
+                                   "caps and lids ('unscrew the jar lid')")
+        r = dataclasses.replace(r, skill="twist", roles=SKILL_ROLES["twist"], mentions=screws[:1])
+    socket = any(plays(m, "socket") for m in r.mentions)
+    peg_only = r.skill == "put_in" and all(plays(m, "insertable") for m in r.mentions)  # 'insert the peg'
+    if r.mentions and (r.skill == "insert" or peg_only or (socket and r.skill in ("put_in", "place_on", "place_at",
+                                                                                  "push"))):
+        r = Read("insert", SKILL_ROLES["insert"], None, None, r.mentions)
+    return r
+
+
+def _screw_model(m: Mention, assets: Sequence[dict]) -> Mention | None:
+    """``m`` as the model with a screw cap it may name (*the jar*: the rigid jar's name, and the screw-top jar's
+    kind), None when it names none."""
+    from generator.instruction import ROLE_TESTS, _by_id
+
+    if not m.asset:
+        return None
+    kind = _by_id(assets, m.asset)["category"]
+    ids = [*(m.options or (m.asset,)), *(a["id"] for a in assets if a["category"] == kind)]
+    screw = next((i for i in ids if ROLE_TESTS["screwable"](_by_id(assets, i))), None)
+    return None if screw is None else dataclasses.replace(m, asset=screw, options=(screw,))
+
+
+__all__ = ["PUT_SKILLS", "Read", "object_skill"]
