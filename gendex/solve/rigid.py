@@ -95,8 +95,11 @@ within the tolerance)."""
 INSERT_CORRECTIONS = 8
 INSERT_TOLERANCE_M = 0.0012
 INSERT_TILT_RAD = 0.02
+INSERT_SETTLE_STEPS = 6
+INSERT_M_PER_STEP = 0.003
 """Into a holder (an asset tagged ``insert``: a hole a few mm wider than its peg) the object's *bottom* is centred
-over the hole to this tolerance, after the hand stands it up to within ``INSERT_TILT_RAD``."""
+over the hole to this tolerance, after the hand stands it up to within ``INSERT_TILT_RAD``, waiting
+``INSERT_SETTLE_STEPS`` after each correction (a peg pinched high swings), then lowered this slowly."""
 PLACE_PRESS_M = 0.015
 PLACE_RESTING_M = 0.008
 """A place lowers the held object's lowest point to this far *below* the surface under it, and stops as soon as the
@@ -490,12 +493,12 @@ class RigidPrimitives:
                 break
             if insert and off > last:  # a peg pinched high swung rather than followed: back to the nearest
                 yield from m.cartesian(-move, c.motion.lift_m_per_step, guard=True, partial=True)
-                yield from m.hold(c.motion.settle_steps)
+                yield from m.hold(INSERT_SETTLE_STEPS)
                 break
             last, move = off, np.array([error[0], error[1], 0.0])
             yield from m.cartesian(move, c.motion.lift_m_per_step, guard=True, paced=True,
                                    partial=insert)  # a mm short of a hole: the next try, or the chamfer
-            yield from m.hold(c.motion.settle_steps)
+            yield from m.hold(INSERT_SETTLE_STEPS if insert else c.motion.settle_steps)
         lo, hi = m.world_aabb(held)
         xy = (lo[:2] + hi[:2]) / 2
         surface = self.shape(target).top_at(xy) if point is None else self.env.table_height if floor is None else floor
@@ -505,7 +508,7 @@ class RigidPrimitives:
         drop = float(lo[2] - surface + PLACE_PRESS_M)
         if drop <= 0:
             return
-        speed = c.motion.lift_m_per_step
+        speed = INSERT_M_PER_STEP if insert else c.motion.lift_m_per_step
         speed *= m.pace(int(np.ceil(drop / speed)))
         n = max(1, int(np.ceil(drop / speed)))
         palm0, z0 = m.ik.fk(m.qpos()).p[2], float(self.env.obj(held).pose.p[0, 2])
