@@ -61,9 +61,9 @@ class JointEntry:
     spring: float | None = None
     """Stiffness of the detent spring at scale 1 (N/m for a prismatic joint, N·m/rad for a revolute one)."""
     friction_limit: float | None = None
-    """Dry friction the simulation applies (N for a prismatic joint, N·m for a revolute one; scale 1): the joint
-    stays where it was left until pushed harder than this, and resists with this much while it moves (a screw
-    cap's thread). None: only the URDF's damping (SAPIEN's URDF loader does not apply the URDF's friction)."""
+    """Dry friction the simulation applies (N for a prismatic joint, N·m for a revolute one; unscaled at any object
+    scale): the joint stays where it was left until pushed harder than this, and resists with this much while it
+    moves (a screw cap's thread). None: only the URDF's damping (SAPIEN's URDF loader drops the URDF's friction)."""
 
 
 @dataclass(frozen=True)
