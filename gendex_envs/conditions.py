@@ -13,7 +13,7 @@ from gendex_envs.typed_yaml import MAX_POSITION_M, quote
 
 ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
                         "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
-                        "at_rest"]
+                        "at_rest", "wiped"]
 Part = Literal["handle"]
 Relation = Literal["left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_region"]
 Region = Literal["left", "right", "near", "far", "centre", "near_left", "near_right", "far_left", "far_right"]
@@ -47,7 +47,8 @@ class ConditionSpec:
     min_height_m: float | None = None
     """lifted: required rise above the object's height at reset (m), > 0."""
     min_fraction: float | None = None
-    """joint_open: required opening as a fraction of the joint range, in (0, 1]."""
+    """joint_open: required opening as a fraction of the joint range; wiped: the share of the target's marks wiped;
+    in (0, 1]."""
     max_dist_m: float | None = None
     """near: object to target; hand_at: palm to the point; fingertips_near: mean fingertip distance (m), > 0."""
     min_deg: float | None = None
@@ -107,12 +108,17 @@ class ConditionSpec:
     """at_rest: the fastest the object's origin may move (m/s, > 0; default 0.02)."""
     max_spin_rad_s: float | None = None
     """at_rest: the fastest the object may spin (rad/s, > 0; default 0.3)."""
+    min_press_n: float | None = None
+    """wiped: a mark is wiped when the object passes over it pressing on the target with at least this force (N, > 0;
+    default 1.0: four times a thick sponge's weight, so one lying there, or pushed along by its side, presses too
+    little)."""
 
 
 CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_force_n": 0.3, "max_force_n": 0.3,
                                       "ring_radius_m": 0.0, "above_m": 0.0, "min_gap_m": 0.05, "max_gap_m": 0.3,
                                       "max_offset_m": 0.1, "max_error": 0.1, "max_tilt_deg": 15.0,
-                                      "min_tilt_deg": 150.0, "max_speed_m_s": 0.02, "max_spin_rad_s": 0.3}
+                                      "min_tilt_deg": 150.0, "max_speed_m_s": 0.02, "max_spin_rad_s": 0.3,
+                                      "min_press_n": 1.0}
 """Values of optional condition fields left out."""
 
 CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
@@ -143,13 +149,16 @@ CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
                 "min_tilt_deg away from world up"),
     "at_rest": (("object",), ("max_speed_m_s", "max_spin_rad_s"), "the object is still: it moves at most "
                 "max_speed_m_s and spins at most max_spin_rad_s"),
+    "wiped": (("object", "target", "min_fraction"), ("min_press_n",),
+              "the object has passed over at least min_fraction of target's marks (a wipe area's sites) while pressing "
+              "on target with min_press_n or more; a mark once wiped stays wiped for the episode"),
 }
 """Condition type -> (required fields, optional fields, meaning). ``type`` and ``negate`` apply to every type."""
 assert set(CONDITION_FIELDS) == set(CONDITION_TYPES)
 
 
 _POSITIVE = {"min_height_m", "max_dist_m", "min_force_n", "max_palm_force_n", "max_force_n", "max_xy_m",
-             "min_spread_m", "max_offset_m", "max_speed_m_s", "max_spin_rad_s"}
+             "min_spread_m", "max_offset_m", "max_speed_m_s", "max_spin_rad_s", "min_press_n"}
 
 
 def condition_problems(c: ConditionSpec, at: str, ref) -> list[str]:

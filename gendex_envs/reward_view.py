@@ -303,6 +303,10 @@ class RewardView:
         """[N, 3] the middle of the floor of the space the joint's link holds things in (a drawer's bin)."""
         return _fresh(holds_point(_env(self), name, joint))
 
+    def wiped_share(self, name: str, target: str) -> torch.Tensor:
+        """[N] the share of wipe area ``target``'s marks that ``name`` (a sponge) has wiped, pressed, this episode."""
+        return _fresh(_env(self).wipes.share_of(name, target))
+
     # ---- goal and success
     @property
     def goal_pos(self) -> torch.Tensor:

@@ -161,6 +161,8 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
                     else (obj.linear_velocity, obj.angular_velocity))
         return ((torch.linalg.norm(lin, dim=-1) <= _param(c, "max_speed_m_s"))
                 & (torch.linalg.norm(ang, dim=-1) <= _param(c, "max_spin_rad_s")))
+    if t == "wiped":
+        return env.wipes.share(c) >= c.min_fraction - 1e-6
     if t == "over":
         p, q = rest_point(env, c.object), env.obj_pose(c.target).p
         dz = p[:, 2] - q[:, 2]

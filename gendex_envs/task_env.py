@@ -65,6 +65,7 @@ from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
 from gendex_envs.start_states import StartStates
 from gendex_envs.success import Judge, SuccessTracker, conditions_hold
 from gendex_envs.task_version import TaskVersion
+from gendex_envs.wiping import Wipes
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +76,6 @@ VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 HAND_CAMERA = "hand_camera"
 DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_rewards.py"
 """Reward module of an in-memory spec: no failure, reward = reaching the first stage's target."""
-
 
 RENDER_MODES = (None, "rgb_array", "sensors", "all", "human")
 
@@ -283,7 +283,7 @@ class TaskEnv(BaseEnv):
             self._obj_reset_pos = {n: torch.zeros(self.num_envs, 3) for n in self.objects}
             self._obj_reset_quat = {n: torch.zeros(self.num_envs, 4) for n in self.objects}
         self.success_tracker = SuccessTracker(self.task_spec.success, self.num_envs, self.device)
-        self.detents = Detents(self)
+        self.detents, self.wipes = Detents(self), Wipes(self)
         self.goal_site = None
         if self.task_spec.goal is not None:
             gb = self.scene.create_actor_builder()
@@ -413,8 +413,8 @@ class TaskEnv(BaseEnv):
         self.agent.contacts.invalidate()
 
     def _after_control_step(self):
-        # From here to the end of step() the state is frozen: observation, evaluation and reward may share reads.
-        self._frame = {}
+        self._frame = {}  # the state is frozen until step() ends: observation, evaluation, reward share reads
+        self.wipes.update()  # marks a pressed sponge passed over this step
 
     def step(self, action):
         try:
@@ -429,9 +429,7 @@ class TaskEnv(BaseEnv):
         """Memoise ``compute()`` for the rest of the current step (no caching outside ``step``)."""
         if self._frame is None:
             return compute()
-        if key not in self._frame:
-            self._frame[key] = compute()
-        return self._frame[key]
+        return self._frame[key] if key in self._frame else self._frame.setdefault(key, compute())
 
     def _initialize_episode(self, env_idx: torch.Tensor, options: dict):
         self.agent.contacts.invalidate()
@@ -464,6 +462,7 @@ class TaskEnv(BaseEnv):
                 self._obj_reset_pos[name][env_idx] = entity.pose.p[env_idx]
                 self._obj_reset_quat[name][env_idx] = entity.pose.q[env_idx]
             self.success_tracker.reset(env_idx)
+            self.wipes.reset(env_idx)
 
     # ------------------------------------------------------------------ API for reward code
     def obj_pose(self, name: str) -> Pose:

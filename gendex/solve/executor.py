@@ -62,6 +62,7 @@ from gendex.solve.set_down import (
     set_down_point,
 )
 from gendex.solve.twist import TWIST_PRIMITIVES, TwistPrimitives
+from gendex.solve.wipe import wipe
 from gendex_envs.errors import ExecutionError
 from gendex_envs.spec import GOAL_TARGET
 from gendex_envs.success import SET_DOWN_CONDITIONS
@@ -71,7 +72,7 @@ from gendex_envs.wrappers import time_limit
 log = logging.getLogger(__name__)
 
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
-                    "release": "release", "push": "push"}
+                    "release": "release", "push": "push", "wipe": "wipe"}
 """Skill -> primitive for a rigid target."""
 TO_A_PLACE = ("carry", "place")
 """Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object
@@ -84,7 +85,8 @@ ARTICULATED_PRIMITIVES = {"reach": "approach_handle", "grasp": "hook", "open": "
 PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press", "turn": "press", "press": "press"}
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
-               "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500}
+               "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500,
+               "wipe": 200}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
@@ -313,7 +315,8 @@ class StageExecutor:
         taken only when no trial does better (:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp`)."""
         spec = self._env.task_spec
         conds = (*spec.success.conditions, *(c for s in spec.stages[self.stage_index + 1:] for c in s.success or ()))
-        return next((c.target for c in conds if c.type in SET_DOWN_CONDITIONS and c.object == name and not c.negate
+        return next((c.target for c in conds if c.type in (*SET_DOWN_CONDITIONS, "wiped") and c.object == name
+                     and not c.negate
                      and c.target in self._env.objects and c.target not in self._env.articulations), None)
 
     def _grip_conditions(self, name: str) -> tuple:
@@ -385,6 +388,10 @@ class StageExecutor:
         conds = (*(stage.success or ()), *self._env.task_spec.success.conditions)
         return next((c.target for c in conds if c.type in SET_DOWN_CONDITIONS and c.object == held and not c.negate
                      and c.target in self._env.objects and c.target not in self._env.articulations), None)
+
+    def _wipe(self, stage) -> Iterator[np.ndarray]:
+        """Wipe the target (a spill) with the held sponge (:mod:`gendex.solve.wipe`)."""
+        yield from wipe(self.rigid, stage.target)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         """Let go; an object held over what a condition wants it in, on or by is first set down there (a dropped tall

@@ -216,7 +216,8 @@ class RigidPrimitives:
         shape = self.shape(name)
         others = tuple(self.shape(o) for o in env.objects if o != name and o not in env.articulations)
         prefer = object_heading(shape.footprint().center, m.ik.base.p[:2])
-        into_hole = set_on is not None and "insert" in env.asset_record(set_on).tags  # a peg: held high
+        # held high: a peg (it goes into its hole bottom first), a sponge (pressed on a spill, the forearm clear)
+        into_hole = set_on is not None and bool({"insert", "wipe_area"} & set(env.asset_record(set_on).tags))
         synth = GraspSynthesizer(self.hand, shape, env.table_height, prefer, others, px_bodies(env.obj(name))[0].mass,
                                  high_first=into_hole)
         self._synth = synth
@@ -240,7 +241,9 @@ class RigidPrimitives:
             return result.held and fitting and not result.shoved
 
         budget = max(c.max_trials, c.thin_trials) if c.max_trials and "tip" in synth.families() else c.max_trials
-        for plan in synth.candidates():
+        # a sponge to wipe with is pinched: held palm down, the wrist is too low to press it flat (5 of 20 seeds)
+        wiping = set_on is not None and "wipe_area" in env.asset_record(set_on).tags
+        for plan in (p for p in synth.candidates() if not (wiping and p.kind == "top")):
             open_q = m.with_hand(q0, plan.open_hand)
             q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
             q_at = None if q_pre is None else m.ik.solve(plan.palm, q_pre, restarts=0)
@@ -476,7 +479,7 @@ class RigidPrimitives:
         if held is None:
             raise ExecutionError(f"placing on {target!r} needs an object in the hand; it holds nothing", "slipped")
         insert = point is None and "insert" in self.env.asset_record(target).tags
-        yield from self._stand_as_before(held, INSERT_TILT_RAD if insert else None)
+        yield from self.stand_as_before(held, INSERT_TILT_RAD if insert else None)
         if insert:
             yield from self._square_to(held, target)
         goal_xy = (np.asarray(point, dtype=np.float64) if point is not None
@@ -546,10 +549,10 @@ class RigidPrimitives:
             if done >= 1.0:
                 return
 
-    def _stand_as_before(self, held: str, min_rad: float | None = None) -> Iterator[np.ndarray]:
+    def stand_as_before(self, held: str, min_rad: float | None = None) -> Iterator[np.ndarray]:
         """Turn the hand about the held object's centre back to the object's tilt at reset (when: see
-        :data:`UNTILT_TOPPLE_RAD`; ``min_rad``: any tilt over it): a bottle a side grasp lifted 24° askew falls when
-        let go, on thumb or tray; a peg must go into its hole straight."""
+        :data:`UNTILT_TOPPLE_RAD`; ``min_rad``: any tilt over it, of any object): a bottle a side grasp lifted 24°
+        askew falls when let go, on thumb or tray; a peg must go into its hole straight, a sponge onto a spill flat."""
         q_now = self.env.obj(held).pose.q[0].cpu().numpy()
         q_init = self.env.init_obj_quat(held)[0].cpu().numpy()
         up_now = sapien.Pose(q=q_now).to_transformation_matrix()[:3, 2]
@@ -559,7 +562,8 @@ class RigidPrimitives:
         standing = self._shapes[held].posed(sapien.Pose(q=q_init).to_transformation_matrix())
         base = standing.footprint()
         topple = float(np.arctan2(base.width / 2, standing.centroid()[2] - base.bottom))
-        if topple > UNTILT_TOPPLE_RAD or not (topple / 2 if min_rad is None else min_rad) < angle <= UNTILT_MAX_RAD:
+        if (min_rad is None and topple > UNTILT_TOPPLE_RAD
+                or not (topple / 2 if min_rad is None else min_rad) < angle <= UNTILT_MAX_RAD):
             return
         axis, (lo, hi) = np.cross(up_now, up_then), self.m.world_aabb(held)
         done = yield from self.m.turn_about((lo + hi) / 2, axis / np.linalg.norm(axis) * angle, UNTILT_RAD_PER_STEP,

@@ -53,6 +53,11 @@ PEG = ("graspable", "peg", "toy")
 HOLDER = ("holder", "insert")
 """Something a peg is inserted into: a fixed block with a hole a few millimetres wider than its peg (the ``insert``
 task skill)."""
+WIPER = ("graspable", "kitchenware", "wiper")
+"""What wipes a spill: a sponge thick enough to be pinched high and pressed flat on it (the ``wipe`` task skill)."""
+SPILL = ("spill", "wipe_area")
+"""A marked area to wipe: a thin fixed stain on the table with marks a pressed sponge must pass over (the ``wipe``
+task skill)."""
 
 GENERATORS: dict[str, Callable[[], ProceduralShape]] = {}
 
@@ -406,6 +411,28 @@ def _peg_holder(asset_id, hole, square, rgba, outer=9.0, height=5.0, floor=1.0):
     return make
 
 
+def _spill(asset_id, size, round_, rgba, color, pitch=4.0, inset=1.5):
+    """A stain on the table, 3 mm thick: a disc (``size`` its diameter, cm) or a rectangle (``size`` x, y). Its
+    marks lie on a grid of ``pitch`` cm centred on it, each at least ``inset`` cm inside its edge
+    (:func:`gendex_envs.wiping.spill_marks`): the sites a pressed sponge has to pass over."""
+    def make():
+        parts, t = Parts(), 0.3
+        sx, sy = (size, size) if round_ else size
+        if round_:
+            parts.convex(cyl_between([0, 0, 0], [0, 0, t], sx / 2, n=32))
+        else:
+            parts.convex(box_pts((sx, sy, t), (0, 0, t / 2)), faceted=True)
+        return _done(parts, id=asset_id, category="spill", tags=SPILL, mass_kg=0.05, friction=0.6, rgba=rgba,
+                     source=SOURCE_PRIMITIVES, params={"shape": "round" if round_ else "rectangle", "top_z_m": t / 100,
+                                                       "size_x_m": sx / 100, "size_y_m": sy / 100,
+                                                       "marks_pitch_m": pitch / 100, "marks_inset_m": inset / 100,
+                                                       "color": color})
+    return make
+
+
+_register("spill_round", _spill("spill_round", 18.0, True, (0.4, 0.22, 0.1, 1.0), "brown"))
+_register("spill_square", _spill("spill_square", (16.0, 16.0), False, (0.9, 0.5, 0.1, 1.0), "orange"))
+_register("spill_long", _spill("spill_long", (26.0, 10.0), False, (0.6, 0.1, 0.15, 1.0), "red"))
 _register("peg_round", _peg("peg_round", 2.4, 10.0, False, (0.85, 0.2, 0.15, 1.0), "red"))
 _register("peg_square", _peg("peg_square", 2.4, 10.0, True, (0.2, 0.35, 0.85, 1.0), "blue"))
 _register("peg_thin", _peg("peg_thin", 1.8, 11.0, False, (0.95, 0.8, 0.15, 1.0), "yellow"))
@@ -418,6 +445,8 @@ _register("sugar_box", _box("sugar_box", (9, 4, 17.5), 0.514, 0.6, (0.95, 0.9, 0
 _register("pudding_box", _box("pudding_box", (8.9, 3.5, 11), 0.187, 0.6, (0.55, 0.35, 0.2, 1.0), BOX))
 _register("gelatin_box", _box("gelatin_box", (8.5, 2.8, 7.3), 0.097, 0.6, (0.85, 0.2, 0.3, 1.0), BOX))
 _register("sponge", _box("sponge", (9, 6, 3), 0.01, 1.2, (0.95, 0.85, 0.2, 1.0), ("graspable", "kitchenware"), 0.3))
+# a thick foam block sponge (a car-wash sponge): tall enough for the palm to press on its top, fingers round its sides
+_register("sponge_block", _box("sponge_block", (10, 7, 6), 0.025, 1.2, (0.2, 0.55, 0.9, 1.0), WIPER, 0.5, "sponge"))
 _register("block_small", _box("block_small", (4, 4, 4), 0.038, 0.7, (0.85, 0.2, 0.2, 1.0), BLOCK, 0.15, "block"))
 _register("block_medium", _box("block_medium", (5, 5, 5), 0.075, 0.7, (0.2, 0.6, 0.25, 1.0), BLOCK, 0.15, "block"))
 _register("block_large", _box("block_large", (6, 6, 6), 0.13, 0.7, (0.2, 0.35, 0.85, 1.0), BLOCK, 0.15, "block"))
