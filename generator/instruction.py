@@ -196,6 +196,8 @@ ROLE_TESTS = {
     "screwable": lambda a: "cap" in part_kinds(a),
     "insertable": lambda a: "peg" in a["tags"] and not a.get("joints"),
     "socket": lambda a: "insert" in a["tags"] and not a.get("joints"),
+    "wiper": lambda a: "wiper" in a["tags"] and not a.get("joints"),
+    "wipe_area": lambda a: "wipe_area" in a["tags"] and not a.get("joints"),
 }
 """What an object must be to play each role."""
 
@@ -204,7 +206,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "stack": ("block", "block"), "push": ("pushable",), "open": ("openable",), "close": ("openable",),
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
-    "twist": ("screwable",), "insert": ("insertable", "socket"),
+    "twist": ("screwable",), "insert": ("insertable", "socket"), "wipe": ("wiper", "wipe_area"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -590,8 +592,10 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
                                            detail=f"not in the catalog; the closest {role} object"
                                                   + (f" among the {kind} objects" if pool is not able else "")))
             continue
-        named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and (
-            a["category"] == _by_id(assets, m.asset)["category"]))]
+        kind = _by_id(assets, m.asset)["category"]
+        named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and a["category"] == kind)]
+        if m.asset == kind and not test(_by_id(assets, m.asset)):  # a name that is its kind's too names its kind
+            named = [a for a in assets if a["category"] == kind]  # where it cannot play the role ('the sponge')
         if m.options and (m.qualifier or m.part == "drawer"):  # 'the right fridge', 'the top drawer': only the
             # models the qualifier or the drawer's place chose
             named = [a for a in named if a["id"] in m.options]

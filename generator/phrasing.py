@@ -29,6 +29,7 @@ import numpy as np
 
 NAMES: dict[str, tuple[str, ...]] = {
     "peg_holder": ("peg holder", "holder", "pegboard"),
+    "spill": ("spill", "stain", "mess"),
     "bowl": ("bowl", "serving bowl", "mixing bowl"),
     "pot": ("pot", "cooking pot", "saucepan"),
     "plate": ("plate", "dinner plate", "dish"),
@@ -66,6 +67,7 @@ MODEL_WORDS: dict[str, str] = {
     "drawer_chest_3": "three-drawer", "trash_can_small": "small", "trash_can_tall": "tall",
     "box_with_lid_small": "small", "box_with_lid_large": "large", "laptop_13in": "13-inch", "laptop_15in": "15-inch",
     "peg_round": "round", "peg_square": "square", "peg_thin": "thin",
+    "spill_round": "round", "spill_square": "square", "spill_long": "long",
 }
 """Words that tell a model from its siblings (articulated models, pegs), read back by :mod:`generator.instruction` as
 that model: two tasks on sibling models must not read alike."""
@@ -184,6 +186,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "slot the {o} down into the {d} and let go of it",
         "put the {o} into the {d}'s hole, standing straight",
         "push the {o} into the {d} until it sits on the bottom of the hole",
+    ),
+    "wipe": (
+        "wipe the {d} with the {o}",
+        "wipe up the {d} on the {s} with the {o}",
+        "scrub the {d} with the {o} until it is clean",
+        "mop up the {d} with the {o}",
+        "wipe the {d} clean with the {o}",
     ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",

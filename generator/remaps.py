@@ -6,7 +6,9 @@
   screwing one on is refused, saying what is built;
 - a peg put, placed, inserted or fitted into a holder (or a peg inserted): ``insert`` (*put the square peg in the
   square hole*, *push the peg into the hole*, *insert the peg*); a peg picked up, or pushed to the goal, stays a
-  lift or a push.
+  lift or a push;
+- a wipe names its sponge and its spill in either order (*wipe the spill with the sponge*, *use the sponge to wipe
+  the spill*): the sponge is put first; a spill named alone gets the catalog's sponge after it.
 """
 
 from __future__ import annotations
@@ -59,6 +61,13 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
     if r.mentions and (r.skill == "insert" or peg_only or (socket and r.skill in ("put_in", "place_on", "place_at",
                                                                                   "push"))):
         r = Read("insert", SKILL_ROLES["insert"], None, None, r.mentions)
+    if r.skill == "wipe":  # a sponge: a wiper, or named by a kind that has one ('the sponge')
+        kinds = {a["category"] for a in assets if ROLE_TESTS["wiper"](a)}
+        wipers = [m for m in r.mentions
+                  if plays(m, "wiper") or (m.asset and _by_id(assets, m.asset)["category"] in kinds)]
+        rest = [m for m in r.mentions if m not in wipers]
+        roles = SKILL_ROLES["wipe"] if wipers or not rest else ("wipe_area", "wiper")
+        r = dataclasses.replace(r, roles=roles, mentions=wipers + rest)
     return r
 
 

@@ -57,6 +57,30 @@ def _get_obs_extra(env, info):
 """Reward of a push: the palm to the object, the object to the goal mark (format with ``fail`` and ``obj``)."""
 
 
+_WIPE = '''REWARD_MAX = 5.0
+
+
+def evaluate(env):
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    return {{"fail": fail, "contact": rt.contact(force), "wiped": env.wiped_share({obj!r}, {area!r})}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    over = rt.place(p, env.obj_pose({area!r}).p) * (info["contact"] > 0.2)
+    reward = reach + info["contact"] + over + 2.0 * info["wiped"]
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p,
+            "obj_to_area": env.obj_pose({area!r}).p - env.obj_pose({obj!r}).p, "wiped": info["wiped"][:, None]}}
+'''
+"""Reward of a wipe (format with ``fail``, ``obj``: the sponge, ``area``: the spill): the palm to the sponge, holding
+it, the held sponge over the spill, then the share of the spill's marks wiped."""
+
+
 def _header(title: str) -> str:
     """The module header, its title wrapped to docstring width (an instruction may be a long sentence)."""
     return _HEADER_TEMPLATE.format(title=textwrap.fill(title, width=100))
@@ -100,6 +124,8 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
     src = _header(title)
     if kind == "push" or (cond.get("target") == "goal" and kind not in JOINT_SKILLS):
         return src + _PUSH.format(fail=fail, obj=obj)
+    if cond["type"] == "wiped" and kind in ("carry", "wipe"):
+        return src + _WIPE.format(fail=fail, obj=cond["object"], area=cond["target"])
     if kind in JOINT_SKILLS:
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
@@ -335,6 +361,8 @@ def _get_obs_extra(env, info):
     target = cond.get("target")
     if target == "goal":  # a push: the object towards the goal mark, never lifted
         return src + _PUSH.format(fail=fail, obj=obj)
+    if cond["type"] == "wiped":
+        return src + _WIPE.format(fail=fail, obj=obj, area=target)
     carry = _carry_term(target, placed_goal(cond, spec))
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1

@@ -32,12 +32,12 @@ from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
                "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out", "press",
-               "hand_over", "twist", "insert")
+               "hand_over", "twist", "insert", "wipe")
 """The task skills: the solver issue's thirteen in its order, then the task language's places (``place_at``: set
 down beside, between or in a region), taking an object out of a container (``take_out``), then the dexterous
 skills' (``press``: a button or switch pushed past its detent; ``hand_over``: an object left still on the hand-over
 mat; ``twist``: a cap unscrewed, regrasped between turns of the hand; ``insert``: a peg put into its holder's
-hole)."""
+hole; ``wipe``: a spill's marks passed over by a sponge pressed on it)."""
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
@@ -91,10 +91,12 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
         return "turn" if part == "lever" else f"{'close' if negate else 'open'}_{part}"
     if kind == "rotated":
         return "reorient"
+    if kind == "wiped":
+        return None if negate else "wipe"
     return None
 
 
-STAGE_TASK_SKILLS = ("reorient", "push", "turn", "press", "twist")
+STAGE_TASK_SKILLS = ("reorient", "push", "turn", "press", "twist", "wipe")
 """Stage skills that are task skills by themselves, whatever the success condition."""
 
 

@@ -57,6 +57,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("insert", ("insert", "plug", "slot", "fit", "peg"),
               "a peg put into the hole of its holder (2.5-3 mm of clearance a side), upright, and let go: a round, "
               "square or thin peg", "insert the square peg into the square hole"),
+    TaskSkill("wipe", ("wipe up", "wipe", "clean up", "clean", "scrub", "mop up", "mop", "sponge"),
+              "a spill on the table wiped with a sponge pressed down on it, over at least 90 % of its marks (a round, "
+              "square or long spill)", "wipe the spill with the sponge"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
@@ -90,6 +93,12 @@ SYNONYMS: dict[str, str] = {
     "pegboard": "peg_holder", "hole": "peg_holder", "round hole": "peg_holder_round",
     "square hole": "peg_holder_square",
     "thin hole": "peg_holder_thin", "small hole": "peg_holder_thin", "narrow hole": "peg_holder_thin",
+    "stain": "spill", "mess": "spill", "puddle": "spill", "round spill": "spill_round",
+    "round stain": "spill_round", "puddle of coffee": "spill_round", "coffee spill": "spill_round",
+    "square spill": "spill_square", "square stain": "spill_square", "juice spill": "spill_square",
+    "long spill": "spill_long", "long stain": "spill_long", "streak": "spill_long", "sauce spill": "spill_long",
+    "car sponge": "sponge_block", "foam sponge": "sponge_block", "thick sponge": "sponge_block",
+    "sponge block": "sponge_block", "big sponge": "sponge_block",
     "round peg": "peg_round", "square peg": "peg_square", "thin peg": "peg_thin", "dowel": "peg_thin",
     "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
     "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",

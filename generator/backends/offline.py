@@ -39,6 +39,7 @@ from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
+from generator.backends.dexterous import insert_task, wipe_task
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
@@ -62,15 +63,18 @@ from generator.backends.roles import (
     receptacle,
     socket,
     sticks_out,
+    wipe_area,
+    wiper,
 )
 from generator.backends.wording import camel as _camel
+from generator.backends.wording import carry_steps
 from generator.backends.wording import fence as _fence
 from generator.backends.wording import step as _step
 from generator.backends.wording import word as _w
 from generator.constructs import amount_text, amount_word, joint_fraction
 from generator.errors import BackendError
 from generator.instruction import InstructionError, is_surface
-from generator.phrasing import MODEL_WORDS, Part, object_words, painted, phrase, phrase_parts, qualifiers
+from generator.phrasing import Part, object_words, painted, phrase, phrase_parts, qualifiers
 from generator.reword import ProposalWording
 
 MODEL_ID = "gendex-offline-1"
@@ -88,7 +92,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "twist", "insert", "several", "composed")
+              "press", "hand_over", "twist", "insert", "wipe", "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -104,11 +108,6 @@ HANDOVER_XY_M = 0.08
 """A handed-over object lies on the mat when its middle is this close to the mat's (the mat is 22 cm square)."""
 HANDOVER_DZ_M = (-0.01, 0.05)
 """... and this high above the mat's base: standing on it, or lying on it on its side (a can: 3.3 cm up)."""
-INSERT_XY_M = 0.005
-"""An inserted peg's bottom is this close to its hole's axis (the hole leaves 2.5-3 mm a side; a peg standing beside
-the holder is 4 cm or more off it)."""
-INSERT_DZ_M = (-0.005, 0.01)
-"""... and this far above the hole's floor (a peg resting on the holder's top, or on its rim, is 2 cm or more up)."""
 
 
 class OfflineBackend:
@@ -188,8 +187,9 @@ class OfflineBackend:
         by_id = {a["id"]: a for a in assets}
         zone = next((a for a in assets if handover_zone(a)), None)
         out += [("hand_over", self._handover_task(a, zone)) for a in assets if zone is not None and handed(a)]
-        out += [("insert", self._insert_task(a, b)) for a in assets if insertable(a) for b in assets
+        out += [("insert", insert_task(a, b, self._words)) for a in assets if insertable(a) for b in assets
                 if socket(b) and fits_hole(a, b)]
+        out += [("wipe", wipe_task(a, b, self._words)) for a in assets if wiper(a) for b in assets if wipe_area(b)]
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
@@ -262,14 +262,7 @@ class OfflineBackend:
             "success_text": f"The {_w(n)} is held at least 10 cm above where it started.",
         }
 
-    @staticmethod
-    def _carry_steps(n: str, t: str, where: str) -> list[dict]:
-        return [
-            _step("reach", n, "arm", f"Bring the open hand to the {_w(n)}."),
-            _step("grasp", n, "hand", f"Close the fingers around the {_w(n)}."),
-            _step("carry", t, "arm", f"Carry the {_w(n)} {where} the {_w(t)}."),
-            _step("release", n, "hand", f"Open the hand to let go of the {_w(n)}."),
-        ]
+    _carry_steps = staticmethod(carry_steps)
 
     def _put_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
         n, t = a["category"], b["category"]
@@ -361,27 +354,6 @@ class OfflineBackend:
             "success": {"type": "over", "object": n, "target": t, "max_xy_m": HANDOVER_XY_M,
                         "min_dz_m": HANDOVER_DZ_M[0], "max_dz_m": HANDOVER_DZ_M[1]},
             "success_text": f"The {_w(n)} has been let go on the hand-over mat and rests there.",
-        }
-
-    def _insert_task(self, a: dict, b: dict, colors: tuple[str | None, ...] = ()) -> dict:
-        """Insert peg ``a`` into holder ``b``'s hole and let go; the scene step adds that it stands upright
-        (:func:`generator.steps.scene.inserted_upright`)."""
-        from gendex_envs.assets.catalog import get_asset
-
-        n, t = "peg", "holder"
-        shape = MODEL_WORDS.get(a["id"], "")
-        floor = float(get_asset(b["id"]).entry.params["hole_floor_m"])
-        return {
-            "name": _camel("insert", *painted(a, colors, 0)),
-            "description": phrase("insert", a, self._words(_camel("insert", a["id"])), other=b,
-                                  other_qualifier=shape, **qualifiers(a, None, colors)),
-            "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
-                        {"name": t, "asset": b["id"], "role": "support"}],
-            "steps": [*self._carry_steps(n, t, "over")[:3],
-                      _step("release", n, "hand", f"Lower the {_w(n)} into the {_w(t)}'s hole and let go of it.")],
-            "success": {"type": "over", "object": n, "target": t, "max_xy_m": INSERT_XY_M,
-                        "min_dz_m": round(floor + INSERT_DZ_M[0], 4), "max_dz_m": round(floor + INSERT_DZ_M[1], 4)},
-            "success_text": f"The {shape} peg stands in the {_w(t)}'s hole, down on its floor, let go.",
         }
 
     def _push_task(self, a: dict) -> dict:
@@ -547,7 +519,11 @@ class OfflineBackend:
                       if len(mentions) > 1 else next(iter(fits), None))
             if holder is None:
                 raise InstructionError(f"the catalog has no holder with a hole the {peg['id']} fits")
-            proposal = self._insert_task(peg, holder, colors)
+            proposal = insert_task(peg, holder, self._words, colors)
+        elif skill == "wipe":
+            k = 0 if mentions and wiper(assets[mentions[0]["asset"]]) else 1  # the reader may put the spill first
+            sponge, spill = pick(k, wiper, "sponge to wipe with"), pick(1 - k, wipe_area, "spill to wipe")
+            proposal = wipe_task(sponge, spill, self._words, (colors[k], colors[1 - k]) if len(colors) > 1 else colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -570,7 +546,7 @@ class OfflineBackend:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
                 "(see GenDex/RotateTennisBall-v0 and `gendex train`). It writes: lift, put_in, place_on, stack, "
-                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert.")
+                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe.")
         name, k = proposal["name"], 2
         while proposal["name"] in existing:
             proposal["name"] = f"{name}{k}"

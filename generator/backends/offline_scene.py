@@ -21,11 +21,13 @@ from generator.backends.roles import (
     handover_zone,
     insertable,
     socket,
+    wipe_area,
+    wiper,
 )
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
-STAGE_HORIZONS = {"twist": 700}
+STAGE_HORIZONS = {"twist": 700, "wipe": 250}
 """Stage horizons (control steps) of skills that take longer than a stage's usual 40 (a twist: 5-6 grasps a turn,
 about 90 steps each; hand-written trials 525-741 steps with the reach)."""
 PUSH_M = 0.22
@@ -45,6 +47,13 @@ or more beyond the movable objects' region; hand-written trials with the mat at 
 HANDOVER_RANDOMIZE = {"xy_m": [0.03, 0.05], "yaw_deg": 0.0}
 """How far the mat moves at reset."""
 INSERT_RANDOMIZE = {"xy_m": [0.05, 0.05]}
+SPILL_REGION_M = ((0.06, 0.18), (-0.15, 0.15))
+"""Where a spill's middle is put: the hand must reach 9-13 cm past it on every side, low, holding a sponge (a spill
+at the movable region's edge, x 0.0, y -0.3, lost 3 of 7 wipes to the arm's reach)."""
+WIPE_RANDOMIZE = {"xy_m": [0.04, 0.04], "yaw_deg": 90.0}
+SPILL_RANDOMIZE = {"xy_m": [0.05, 0.05], "yaw_deg": 30.0}
+"""How far a sponge and its (fixed) spill move at reset: the sponge +-4 cm, turned either way up to 90 deg; the spill
++-5 cm, turned up to 30 deg (their footprints stay 3 cm apart, :data:`generator.critic.skill_checks.WIPE_APART_M`)."""
 HOLDER_YAW_DEG = 20.0
 """How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
 stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
@@ -130,6 +139,12 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
             entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
             entry["fixed"] = True
             entry["randomize"] = dict(HANDOVER_RANDOMIZE)
+        elif wipe_area(a) or wiper(a):  # a spill stays put (it moves at reset); the sponge starts beside it
+            if wipe_area(a):
+                (x0, x1), (y0, y1) = SPILL_REGION_M
+                entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
+            entry["fixed"] = wipe_area(a)
+            entry["randomize"] = dict(SPILL_RANDOMIZE if wipe_area(a) else WIPE_RANDOMIZE)
         elif socket(a) or insertable(a):  # a holder stays put; the hole and the peg move at reset
             entry["fixed"] = socket(a)
             entry["randomize"] = dict(INSERT_RANDOMIZE, yaw_deg=HOLDER_YAW_DEG if socket(a) else

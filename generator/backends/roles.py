@@ -81,6 +81,16 @@ def fits_hole(peg: dict, holder: dict) -> bool:
     return p.get("shape") == h.get("shape") and HOLE_CLEARANCE_M[0] <= gap <= HOLE_CLEARANCE_M[1]
 
 
+def wiper(a: dict) -> bool:
+    """A sponge that wipes: pinched high and pressed flat on a spill (an asset tagged ``wiper``)."""
+    return "wiper" in a["tags"] and not a.get("joints")
+
+
+def wipe_area(a: dict) -> bool:
+    """A spill with marks to wipe (an asset tagged ``wipe_area``)."""
+    return "wipe_area" in a["tags"] and not a.get("joints")
+
+
 def handover_zone(a: dict) -> bool:
     """The hand-over mat: where the robot leaves what it hands to a person."""
     return "handover" in a["tags"] and not a.get("joints")

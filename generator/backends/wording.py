@@ -15,6 +15,16 @@ def step(skill: str, target: str, control_joint: str, instruction: str) -> dict:
     return {"skill": skill, "target": target, "control_joint": control_joint, "instruction": instruction}
 
 
+def carry_steps(n: str, t: str, where: str) -> list[dict]:
+    """The steps that pick up object ``n`` and take it ``where`` (above, over) object ``t``, then let go."""
+    return [
+        step("reach", n, "arm", f"Bring the open hand to the {word(n)}."),
+        step("grasp", n, "hand", f"Close the fingers around the {word(n)}."),
+        step("carry", t, "arm", f"Carry the {word(n)} {where} the {word(t)}."),
+        step("release", n, "hand", f"Open the hand to let go of the {word(n)}."),
+    ]
+
+
 def fence(lang: str, body: str) -> str:
     return f"```{lang}\n{body.rstrip()}\n```\n"
 

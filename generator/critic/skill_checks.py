@@ -10,6 +10,9 @@ calls them among its static checks, with the same :class:`~generator.critic.phys
 ``insert``
     The same for a peg and the holder it goes into (an asset tagged ``insert``): a peg that starts next to its hole
     is half inserted by a nudge. Gap :data:`INSERT_APART_M`, the same fix.
+``wipe``
+    The same for a sponge and the spill it wipes (an asset tagged ``wipe_area``): a sponge that starts on the spill
+    is half way there. Gap :data:`WIPE_APART_M`, the same fix.
 """
 
 from __future__ import annotations
@@ -37,8 +40,11 @@ def _gaps(a_lo, a_hi, b_lo, b_hi) -> np.ndarray:
 INSERT_APART_M = 0.05
 """Least gap (m) between a peg's footprint and its holder's, both widened by their randomization (a peg must be
 lifted over the holder's 5 cm wall: a nudge inserts nothing)."""
+WIPE_APART_M = 0.03
+"""Least gap (m) between a sponge's footprint and its spill's, both widened by their randomization."""
 APART: dict[str, tuple[str, float, str]] = {"handover": ("handover", HANDOVER_APART_M, "hand-over zone"),
-                                            "insert": ("insert", INSERT_APART_M, "holder")}
+                                            "insert": ("insert", INSERT_APART_M, "holder"),
+                                            "wipe": ("wipe_area", WIPE_APART_M, "spill")}
 """Check -> (the target's catalog tag, least gap, what the target is called)."""
 
 
@@ -52,13 +58,18 @@ def insert_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violati
     _apart_checks("insert", spec, placed, meas, violations)
 
 
+def wipe_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+    """The ``wipe`` check (module docstring): one violation per sponge that starts too near its spill."""
+    _apart_checks("wipe", spec, placed, meas, violations)
+
+
 def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: dict,
                   violations: list[Violation]) -> None:
     from generator.critic.physical import Violation, moves, rounded
 
     tag, apart, called = APART[check]
     for c in spec.success.conditions:
-        if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed") or c.target not in placed
+        if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed", "wiped") or c.target not in placed
                 or c.object not in placed or tag not in placed[c.target].record.tags):
             continue
         obj, zone = placed[c.object], placed[c.target]
@@ -82,4 +93,5 @@ def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: d
             measured=gap, limit=apart, fix=moves(c.object, step), other=c.target))
 
 
-__all__ = ["APART", "HANDOVER_APART_M", "INSERT_APART_M", "handover_checks", "insert_checks"]
+__all__ = ["APART", "HANDOVER_APART_M", "INSERT_APART_M", "WIPE_APART_M", "handover_checks", "insert_checks",
+           "wipe_checks"]

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from gendex_envs.spec import parse_task_spec, spec_to_dict
-from generator.backends.base import ModelRequest
 from generator.backends.offline import HANDOVER_DZ_M, HANDOVER_XY_M, OfflineBackend
 from generator.backends.offline_scene import HANDOVER_REGION_M
 from generator.catalog_view import asset_dicts
@@ -20,8 +19,6 @@ from generator.instruction import read_instruction
 from generator.phrasing import split
 from generator.reward_library import compose_task_module, roles_of
 from generator.stats import condition_skill
-from generator.steps.propose import parse_proposal
-from generator.steps.scene import adjust_sizes, parse_scene
 from generator.steps.validate import check_reward_source
 
 
@@ -44,26 +41,14 @@ def test_hand_words_elsewhere_leave_other_skills_alone(text, skill):
     assert read_instruction(text, asset_dicts()).skill == skill
 
 
-def _guided(text: str, seed: int = 5):
-    b = OfflineBackend(seed=seed)
-    reading = read_instruction(text, asset_dicts())
-    answer = b.complete(ModelRequest(step="propose_guided", prompt="", context={
-        "reading": reading.to_dict(), "assets": asset_dicts()})).text
-    p = parse_proposal(answer)
-    ids = {o.asset for o in p.objects}
-    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
-               "candidate_index": 0, "index": 0, "attempt": 0}
-    return p, adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
-
-
 @pytest.mark.parametrize("text, obj, upright", [("hand me the bottle", "bottle", True),
                                                 ("pass me the apple", "apple", False),
                                                 ("give me the mug", "mug", True)])
-def test_a_hand_over_is_carried_to_the_mat_and_left_there_still_and_standing(text, obj, upright):
+def test_a_hand_over_is_carried_to_the_mat_and_left_there_still_and_standing(text, obj, upright, guided):
     """The proposal carries the object onto the hand-over mat (the task's own object, fixed on the far side of the
     table), its command reads back as a hand-over, and the success asks the object let go, at rest and, unless it
     rolls, standing as it stood; the critic finds the scene sound and the reward module passes the validator."""
-    p, spec = _guided(text)
+    p, spec = guided(text)
     assert [o.asset for o in p.objects] == [obj, "handover_mat"]
     assert read_instruction(split(p.description)[1], asset_dicts()).skill == "hand_over"
     mat = spec.object("mat")
@@ -79,11 +64,11 @@ def test_a_hand_over_is_carried_to_the_mat_and_left_there_still_and_standing(tex
     check_reward_source(compose_task_module(spec_to_dict(spec), roles_of(dataclasses.asdict(p))))
 
 
-def test_the_critic_moves_an_object_that_starts_on_or_by_the_mat_clear_of_it():
+def test_the_critic_moves_an_object_that_starts_on_or_by_the_mat_clear_of_it(guided):
     """Held still, a bottle that starts on the mat is handed over: the critic's ``handover`` check measures the gap
     between the two footprints widened by their randomization and its fix moves the bottle until the gap is
     HANDOVER_APART_M."""
-    _, spec = _guided("hand me the bottle")
+    _, spec = guided("hand me the bottle")
     raw = spec_to_dict(spec)
     mat = spec.object("mat")
     for dx in (0.0, -0.12, -0.2):

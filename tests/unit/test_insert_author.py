@@ -10,8 +10,8 @@ import pytest
 
 from gendex_envs.assets.catalog import get_asset
 from gendex_envs.spec import parse_task_spec, spec_to_dict
-from generator.backends.base import ModelRequest
-from generator.backends.offline import INSERT_DZ_M, INSERT_XY_M, OfflineBackend
+from generator.backends.dexterous import INSERT_DZ_M, INSERT_XY_M
+from generator.backends.offline import OfflineBackend
 from generator.backends.offline_scene import HOLDER_YAW_DEG, INSERT_RANDOMIZE
 from generator.backends.roles import HOLE_CLEARANCE_M, fits_hole
 from generator.catalog_view import asset_dicts
@@ -23,8 +23,7 @@ from generator.instruction import read_instruction
 from generator.phrasing import split
 from generator.reward_library import compose_task_module, roles_of
 from generator.stats import condition_skill
-from generator.steps.propose import parse_proposal
-from generator.steps.scene import INSERTED_TILT_DEG, adjust_sizes, parse_scene
+from generator.steps.scene import INSERTED_TILT_DEG
 from generator.steps.validate import check_reward_source
 
 PAIRS = {"peg_round": "peg_holder_round", "peg_square": "peg_holder_square", "peg_thin": "peg_holder_thin"}
@@ -60,26 +59,14 @@ def test_pegs_picked_up_and_other_insertions_keep_their_skills(text, skill):
     assert read_instruction(text, asset_dicts()).skill == skill
 
 
-def _guided(text: str, seed: int = 5):
-    b = OfflineBackend(seed=seed)
-    reading = read_instruction(text, asset_dicts())
-    answer = b.complete(ModelRequest(step="propose_guided", prompt="", context={
-        "reading": reading.to_dict(), "assets": asset_dicts()})).text
-    p = parse_proposal(answer)
-    ids = {o.asset for o in p.objects}
-    context = {"proposal": dataclasses.asdict(p), "assets": [a for a in asset_dicts() if a["id"] in ids],
-               "candidate_index": 0, "index": 0, "attempt": 0}
-    return p, adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
-
-
 @pytest.mark.parametrize("text, peg", [("insert the square peg into the square hole", "peg_square"),
                                        ("plug the thin peg into its hole", "peg_thin"),
                                        ("insert the peg", "peg_round")])
-def test_an_insert_carries_the_peg_over_its_fitting_holder_and_sets_it_down_in_the_hole(text, peg):
+def test_an_insert_carries_the_peg_over_its_fitting_holder_and_sets_it_down_in_the_hole(text, peg, guided):
     """The proposal takes the peg to the holder its hole fits (fixed, both moved at reset), its command reads back as
     an insert, and the success asks the peg's bottom within INSERT_XY_M of the hole's axis, on the hole's floor,
     upright, let go; the critic finds the scene sound and the reward module passes the validator."""
-    p, spec = _guided(text)
+    p, spec = guided(text)
     assert [o.asset for o in p.objects] == [peg, PAIRS[peg]]
     assert [s.skill for s in p.steps] == ["reach", "grasp", "carry", "release"]
     assert read_instruction(split(p.description)[1], asset_dicts()).skill == "insert"
@@ -99,15 +86,15 @@ def test_an_insert_carries_the_peg_over_its_fitting_holder_and_sets_it_down_in_t
     check_reward_source(compose_task_module(spec_to_dict(spec), roles_of(dataclasses.asdict(p))))
 
 
-def test_a_peg_that_does_not_fit_the_named_hole_is_refused_naming_the_one_it_fits():
+def test_a_peg_that_does_not_fit_the_named_hole_is_refused_naming_the_one_it_fits(guided):
     with pytest.raises(InstructionError, match="peg_holder_square"):
-        _guided("put the square peg in the round hole")
+        guided("put the square peg in the round hole")
 
 
-def test_the_critic_moves_a_peg_that_starts_by_its_holder_clear_of_it():
+def test_the_critic_moves_a_peg_that_starts_by_its_holder_clear_of_it(guided):
     """A peg next to its hole is half inserted by a nudge: the ``insert`` check measures the gap between the footprints
     widened by their randomization and its fix moves the peg until the gap is INSERT_APART_M."""
-    _, spec = _guided("insert the square peg into the square hole")
+    _, spec = guided("insert the square peg into the square hole")
     raw = spec_to_dict(spec)
     holder = spec.object("holder")
     for dy in (0.0, 0.08, -0.12):

@@ -64,7 +64,7 @@ def test_objects_the_catalog_lacks_are_substituted_and_said_so():
     assert r.objects[0].how == "kind" and r.substitutions == {"fruit": r.objects[0].asset}
 
 
-@pytest.mark.parametrize("text", ["throw the ball", "cut the apple", "wipe the table", ""])
+@pytest.mark.parametrize("text", ["throw the ball", "cut the apple", "fold the towel", ""])
 def test_a_request_outside_the_skills_is_refused_with_what_is_possible(text):
     with pytest.raises(InstructionError) as e:
         read(text)

@@ -98,9 +98,11 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
                "candidate_index": 0, "index": 0, "attempt": 0}
     spec = spec_to_dict(adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="",
                                                                           context=context)).text, p), p))
+    inside = {o.name for o in p.objects if o.starts_in}  # moves with the container it starts in
     for obj in spec["objects"]:
         r = obj["randomize"]
-        assert min(r["xy_m"]) >= (0.05 if obj.get("fixed") else 0.08) and r["yaw_deg"] >= 15.0, obj
+        assert (min(r["xy_m"]) >= (0.05 if obj.get("fixed") else 0.08) or obj["name"] in inside) \
+            and r["yaw_deg"] >= 15.0, obj
 
 
 def test_the_size_step_fits_a_grasped_object_to_the_hand_as_the_grasp_benchmark_measures_it():

@@ -27,6 +27,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
     "twist": ("screw_jar", None), "insert": ("peg_square", "peg_holder_square"),
+    "wipe": ("sponge_block", "spill_square"),
 }
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees"), "put_in_drawer": ("bottom ", None),
@@ -41,7 +42,8 @@ def test_every_command_reads_back_as_its_task(skill):
     generator.instruction as the same skill on the same objects in the same roles: the author writes only what a
     person could ask for and GenDex would understand."""
     main, other = CASES[skill]
-    q_main, q_other = {"stack": ("medium", "large"), "insert": ("square", "square")}.get(skill, ("", ""))
+    q_main, q_other = {"stack": ("medium", "large"), "insert": ("square", "square"),
+                      "wipe": ("", "square")}.get(skill, ("", ""))
     for template in COMMANDS[skill]:
         for o in names_for(ASSETS[main], q_main):
             for d in (names_for(ASSETS[other], q_other) if other else (o,)):
@@ -54,7 +56,7 @@ def test_every_command_reads_back_as_its_task(skill):
                 got = [ASSETS[m.asset]["category"] for m in r.objects]
                 want = [ASSETS[main]["category"]] + ([ASSETS[other]["category"]] if other else [])
                 assert got == want, (text, got)
-                if skill == "stack":
+                if skill in ("stack", "wipe"):
                     assert [m.asset for m in r.objects] == [main, other], text
                 assert not r.substitutions, (text, r.substitutions)
 
@@ -71,6 +73,8 @@ def test_every_name_the_author_uses_is_read_back_as_its_category():
                 text, k = f"set the apple on the {w}", 1
             elif "insert" in a["tags"]:  # a holder: what a peg goes into
                 text, k = f"put the peg in the {w}", 1
+            elif "wipe_area" in a["tags"]:  # a spill: what a sponge wipes
+                text, k = f"wipe the {w} with the sponge", 1
             r = read_instruction(text, list(ASSETS.values()))
             assert ASSETS[r.objects[k].asset]["category"] == cat, (w, r.objects)
 
@@ -102,9 +106,12 @@ def test_sibling_models_are_worded_apart_and_read_back_as_themselves():
 
     for aid, words in MODEL_WORDS.items():
         verb = "close" if ASSETS[aid].get("joints") else "pick up"  # the pegs: a round, a square, a thin one
+        spill = "wipe_area" in ASSETS[aid]["tags"]  # the spills: wiped
         for name in names_for(ASSETS[aid], words):
-            r = read_instruction(f"{verb} the {name}", list(ASSETS.values()))
-            assert [m.asset for m in r.objects] == [aid] and not r.substitutions, (name, r.lines())
+            r = read_instruction(f"wipe the {name} with the sponge" if spill else f"{verb} the {name}",
+                                 list(ASSETS.values()))
+            got = [m.asset for m in r.objects if not spill or m.asset == aid]
+            assert got == [aid] and not r.substitutions, (name, r.lines())
     two = phrase("close_drawer", ASSETS["drawer_chest_2"], np.random.default_rng(0))
     three = phrase("close_drawer", ASSETS["drawer_chest_3"], np.random.default_rng(0))
     assert "two-drawer" in two and "three-drawer" in three

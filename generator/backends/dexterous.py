@@ -1,0 +1,67 @@
+"""The offline author's tasks of two dexterous skills that need an exact fit or a press: a peg put into the hole it
+fits (``insert``), and a spill wiped with a sponge pressed down on it (``wipe``). Each returns a proposal (a dict,
+as :mod:`generator.backends.offline` writes them); ``words(name)`` is the author's generator that words a task."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from generator.backends.wording import camel, carry_steps, step, word
+from generator.phrasing import MODEL_WORDS, painted, phrase, qualifiers
+
+INSERT_XY_M = 0.005
+"""An inserted peg's bottom is this close to its hole's axis (the hole leaves 2.5-3 mm a side; a peg standing beside
+the holder is 4 cm or more off it)."""
+INSERT_DZ_M = (-0.005, 0.01)
+"""... and this far above the hole's floor (a peg resting on the holder's top, or on its rim, is 2 cm or more up)."""
+WIPE_FRACTION = 0.9
+"""A wiped spill has had this share of its marks passed over by the pressed sponge (the solver goes back over what
+it missed; 12-16 marks: one may be left)."""
+
+Words = Callable[[str], np.random.Generator]
+
+
+def insert_task(a: dict, b: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dict:
+    """Insert peg ``a`` into holder ``b``'s hole and let go; the scene step adds that it stands upright
+    (:func:`generator.steps.scene.inserted_upright`)."""
+    from gendex_envs.assets.catalog import get_asset
+
+    n, t = "peg", "holder"
+    shape = MODEL_WORDS.get(a["id"], "")
+    floor = float(get_asset(b["id"]).entry.params["hole_floor_m"])
+    return {
+        "name": camel("insert", *painted(a, colors, 0)),
+        "description": phrase("insert", a, words(camel("insert", a["id"])), other=b, other_qualifier=shape,
+                              **qualifiers(a, None, colors)),
+        "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
+                    {"name": t, "asset": b["id"], "role": "support"}],
+        "steps": [*carry_steps(n, t, "over")[:3],
+                  step("release", n, "hand", f"Lower the {word(n)} into the {word(t)}'s hole and let go of it.")],
+        "success": {"type": "over", "object": n, "target": t, "max_xy_m": INSERT_XY_M,
+                    "min_dz_m": round(floor + INSERT_DZ_M[0], 4), "max_dz_m": round(floor + INSERT_DZ_M[1], 4)},
+        "success_text": f"The {shape} peg stands in the {word(t)}'s hole, down on its floor, let go.",
+    }
+
+
+def wipe_task(a: dict, b: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dict:
+    """Wipe spill ``b`` with sponge ``a``: pick it up, carry it over the spill, press it down on it and slide it
+    over the spill's marks (:mod:`gendex.solve.wipe`)."""
+    n, t = "sponge", "spill"
+    kind = MODEL_WORDS.get(b["id"], "")
+    return {
+        "name": camel("wipe", *painted(b, colors, 1)),
+        "description": phrase("wipe", a, words(camel("wipe", b["id"], a["id"])), other=b, other_qualifier=kind,
+                              **qualifiers(a, None, colors)),
+        "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
+                    {"name": t, "asset": b["id"], "role": "support"}],
+        "steps": [*carry_steps(n, t, "over")[:3],
+                  step("wipe", t, "arm", f"Press the {word(n)} down on the {word(t)} and wipe it all over.")],
+        "success": {"type": "wiped", "object": n, "target": t, "min_fraction": WIPE_FRACTION},
+        "success_text": f"The {word(n)} has been pressed down and passed over the {kind + ' ' if kind else ''}"
+                        f"{word(t)}'s marks.",
+    }
+
+
+__all__ = ["INSERT_DZ_M", "INSERT_XY_M", "WIPE_FRACTION", "insert_task", "wipe_task"]
