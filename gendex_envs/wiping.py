@@ -30,8 +30,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
 
 MARK_PAD_M = 0.008
-"""A mark counts as under the pressing object within this distance of the object's box: a sponge's edge rounds off
-3 mm, and a mark is a point where a stain is a few centimetres across."""
+"""A mark counts as under the pressing object within this distance of the object's box: a sponge's edges round off
+3-5 mm, and a mark is a point where a stain is a few centimetres across."""
 
 
 def press_of(c: ConditionSpec) -> float:

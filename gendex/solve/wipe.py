@@ -1,19 +1,23 @@
-"""The ``wipe`` primitive: slide a sponge over a wipe area's marks, pressed down (:mod:`gendex_envs.wiping`).
+"""The ``wipe`` primitive: slide a held sponge over a wipe area's marks, pressed down (:mod:`gendex_envs.wiping`).
 
-A sponge is wiped with the flat of the hand on it, as people do: :func:`approach_flat` brings the open hand palm down
-over it, fingers straight, and the sponge is pressed and dragged by friction at the palm (hand on sponge: 1.1; sponge
-sliding on a surface: 0.7-0.8, so it goes where the hand goes). A pinched sponge held on by friction at the pads, a
-few newtons: pressed onto the table, or dragged across its pads, it slid out from between the digits (4 of 10 tries
-lost it). :func:`wipe` then
+The sponge (a thick one, tagged ``wiper``) has been pinched high and carried over the area (the rigid primitives:
+:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp` pinches it, never palm down). What failed on the way here,
+and why the primitive is as it is: a 3 cm sponge pinched at its middle slid out from between the digits when pressed
+(10-30 N, as a plain set-down presses) or dragged across the pinch (4 of 10 tries); a flat, palm-down hand cannot
+come low enough over it (the forearm's housing met the table), and straight fingers pressing at an angle pushed it
+away. So :func:`wipe`
 
-1. lowers the hand until the sponge presses on what it lies on with :data:`PRESS_LOW_N` (the simulator's contact
-   forces, as the ``wiped`` condition reads them),
-2. slides it onto the area and over it in passes back and forth along world y, each pass as wide as the sponge's
-   footprint across it less :data:`WIPE_EDGE_M` a side and running :data:`WIPE_OVERRUN_M` past the outermost marks;
-   each step the palm goes down or up :data:`PRESS_STEP_M` to keep the press between :data:`PRESS_LOW_N` and
-   :data:`PRESS_HIGH_N`,
-3. goes back over any mark still unwiped (the env's own record of the marks), up to :data:`WIPE_TOUCH_UPS` times,
-4. lifts the hand off.
+1. levels the sponge in the hand and brings it over the area in the arm configuration that reaches the whole area
+   with the most room between the arm and the table (:meth:`_Wiper.over`),
+2. lowers it until it presses with :data:`PRESS_LOW_N` (the simulator's contact force between sponge and area, as
+   the ``wiped`` condition reads it),
+3. slides it along the line from the thumb to the fingers (:func:`pinch_axis`: the drag bears on a pad), pass after
+   pass across the marks, each as wide as the sponge across it less :data:`WIPE_EDGE_M` a side and running
+   :data:`WIPE_OVERRUN_M` past its outermost marks; each step the palm goes down or up :data:`PRESS_STEP_M` to keep
+   the press between :data:`PRESS_LOW_N` and :data:`PRESS_HIGH_N`; between passes the sponge is lifted
+   :data:`WIPE_HOVER_M` and set down again,
+4. goes back over the marks still unwiped (the env's own record of them), up to :data:`WIPE_TOUCH_UPS` times,
+5. lifts it off.
 """
 
 from __future__ import annotations
@@ -55,16 +59,16 @@ WIPE_LEVEL_RAD = 0.03
 """A held sponge tilted more than this is turned level before it is lowered (pressed at an edge, it rolled out of a
 pinch)."""
 ARM_CLEARANCE_M = 0.005
-"""The least gap between the arm's collision spheres and the table while wiping (the planner keeps 2 cm: a sponge
-pinched low is set down on a spill with the forearm's housing closer than that)."""
+"""The least gap between the arm's collision spheres and the table while wiping (the planner keeps 2 cm: at a
+spill's far corners the arm's wrist passes closer than that)."""
 OVER_YAWS_RAD = (0.0, 0.4, -0.4, 0.8, -0.8, 1.2, -1.2)
 """Turns of the hand about the vertical through the sponge tried before setting it down."""
 SET_DOWN_GAP_M = 0.02
 """How high over the area the sponge is brought before it is lowered onto it."""
 REARRANGE_DROP_M = 0.03
+"""How much lower than where the arm stopped another arm configuration must hold the palm."""
 REARRANGE_MAX_RAD = 1.5
 """... within this of the current configuration at every joint (a flip of the wrist swings the sponge about)."""
-"""How much lower than where the arm stopped another arm configuration must hold the palm."""
 SLIP_M = 0.03
 """A sponge that falls this far behind the palm while sliding has slipped out of the hand."""
 DESCENT_M_PER_STEP = 0.002
@@ -271,7 +275,6 @@ class _Wiper:
                 log.info("the arm reaches no further towards %s", np.round(xy, 3))
                 return
             yield action
-
 
 
 def wipe(rigid: RigidPrimitives, area: str) -> Iterator[np.ndarray]:
