@@ -46,6 +46,7 @@ def _check(value, shape: str, n: int, expr: str) -> None:
     ("GenDex/OpenCabinet-v0", "ARTICULATED", "cabinet", None),
     ("GenDex/PushBlockToGoal-v0", "NAME", "block", None),
     ("GenDex/OpenDrawer-v1", "ARTICULATED", "drawer_chest", "drawer_0_slide"),
+    ("GenDex/WipeSpillRound-v1", "NAME", "sponge", None),
 ])
 def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, name, joint):
     """Each documented member, evaluated on a task's objects (JOINT: a drawer's, on a task that has one), has the
@@ -58,9 +59,10 @@ def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, n
     checked = 0
     for expr, shape in _members():
         other = "ARTICULATED" if placeholder == "NAME" else "NAME"
-        if other in expr or ("goal_pos" in expr and u.goal_site is None) or ("JOINT" in expr and joint is None):
+        if other in expr or ("goal_pos" in expr and u.goal_site is None) or ("JOINT" in expr and joint is None) \
+                or ("AREA" in expr and "spill" not in u.objects):
             continue
-        code = expr.replace(placeholder, repr(name)).replace("JOINT", repr(joint))
+        code = expr.replace(placeholder, repr(name)).replace("JOINT", repr(joint)).replace("AREA", repr("spill"))
         value = eval(code, {"torch": torch}, {"env": view})
         _check(value, shape, u.num_envs, expr)
         checked += 1
