@@ -14,6 +14,11 @@ def quat_rotate(q_wxyz: torch.Tensor, v: torch.Tensor) -> torch.Tensor:
     return v + w * t + torch.linalg.cross(xyz, t, dim=-1)
 
 
+def quat_conj(q_wxyz: torch.Tensor) -> torch.Tensor:
+    """The conjugate (the inverse of a unit quaternion) of quaternions [..., 4]."""
+    return q_wxyz * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q_wxyz.dtype, device=q_wxyz.device)
+
+
 def quat_mul(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
     """Hamilton product a * b of quaternions [N, 4] -> [N, 4] (apply b, then a)."""
     aw, ax, ay, az = a.unbind(-1)
@@ -75,6 +80,5 @@ def tilt(q_wxyz: torch.Tensor, q0_wxyz: torch.Tensor) -> torch.Tensor:
     for an object standing as it stood at ``q0`` (turned about the vertical or not), pi for one turned upside down."""
     up = torch.zeros_like(q_wxyz[:, 1:])
     up[:, 2] = 1.0
-    conj = q0_wxyz * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q0_wxyz.dtype, device=q0_wxyz.device)
-    axis = quat_rotate(q_wxyz, quat_rotate(conj, up))
+    axis = quat_rotate(q_wxyz, quat_rotate(quat_conj(q0_wxyz), up))
     return torch.acos(axis[:, 2].clamp(-1.0, 1.0))

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import torch
 
 from gendex_envs.errors import TaskSpecError
-from gendex_envs.geometry import quat_rotate
+from gendex_envs.geometry import quat_conj, quat_rotate
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.conditions import ConditionSpec
@@ -129,7 +129,7 @@ class Wipes:
             area, wiper = env.obj_pose(w.area), env.obj_pose(w.wiper)
             n, m = pressed.shape[0], w.marks.shape[0]
             world = area.p[:, None, :] + quat_rotate(area.q[:, None, :].expand(n, m, 4), w.marks[None].expand(n, m, 3))
-            local = quat_rotate(_conj(wiper.q)[:, None, :].expand(n, m, 4), world - wiper.p[:, None, :])
+            local = quat_rotate(quat_conj(wiper.q)[:, None, :].expand(n, m, 4), world - wiper.p[:, None, :])
             gap = torch.linalg.norm(local - local.clamp(w.lo, w.hi), dim=-1)  # [N, M] distance to the box
             w.done |= pressed[:, None] & (gap <= MARK_PAD_M)
 
@@ -155,6 +155,3 @@ class Wipes:
         """[N] the share of the target's marks condition ``c``'s object has wiped so far this episode."""
         return self.wiped(c).float().mean(dim=1)
 
-
-def _conj(q: torch.Tensor) -> torch.Tensor:
-    return q * torch.tensor([1.0, -1.0, -1.0, -1.0], dtype=q.dtype, device=q.device)

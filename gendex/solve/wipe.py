@@ -110,19 +110,6 @@ def passes(marks: np.ndarray, along: np.ndarray, width_m: float) -> list[tuple[n
     return out
 
 
-def box_extent(m, name: str, direction: np.ndarray) -> float:
-    """How wide object ``name``'s box is along the horizontal ``direction`` as it is posed now."""
-    env = m.env
-    entry = env.asset_record(name).entry
-    scale = env.task_spec.object(name).scale
-    lo, hi = np.asarray(entry.bbox_min_m) * scale, np.asarray(entry.bbox_max_m) * scale
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    q = env.obj(name).pose.q[0].cpu().numpy()
-    rot = sapien.Pose(q=q).to_transformation_matrix()[:3, :3]
-    proj = (corners @ rot.T)[:, :2] @ direction
-    return float(proj.max() - proj.min())
-
-
 def pinch_axis(env, held: str) -> np.ndarray | None:
     """The horizontal unit vector from the thumb's tip to the fingers touching ``held`` (env 0): dragged along it,
     the sponge bears on a digit's pad. None when the thumb or no finger touches."""
@@ -147,8 +134,7 @@ class _Wiper:
         return float(self.env.wipes.force(self.cond)[0])
 
     def centre(self) -> np.ndarray:
-        lo, hi = self.m.world_aabb(self.held)
-        return (lo[:2] + hi[:2]) / 2
+        return self.m.object_geometry(self.held)[0]
 
     def clear(self, q: np.ndarray) -> bool:
         """The arm and the forearm's housing stay :data:`ARM_CLEARANCE_M` off the table at ``q`` (an elbow-down IK
@@ -293,7 +279,8 @@ def wipe(rigid: RigidPrimitives, area: str) -> Iterator[np.ndarray]:
     marks = marks_world(env, area, cond)
     along = pinch_axis(env, held)
     along = np.array([0.0, 1.0]) if along is None else along
-    plan = passes(marks, along, box_extent(m, held, np.array([-along[1], along[0]])))
+    lo_w, hi_w = rigid.shape(held).extent_along(np.array([-along[1], along[0], 0.0]))  # the sponge across the passes
+    plan = passes(marks, along, hi_w - lo_w)
     log.info("wiping %r with %r: %d marks in %d passes along (%.2f, %.2f)", area, held, len(marks), len(plan),
              *along)
     yield from w.hover(plan[0][0], lift=False)

@@ -11,7 +11,7 @@ import torch
 import yaml
 
 from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
-from gendex_envs.geometry import quat_rotate
+from gendex_envs.geometry import quat_conj, quat_rotate
 from gendex_envs.registry import HISTORY_FREE
 from gendex_envs.spec import parse_task_spec
 from gendex_envs.task_env import TaskEnv
@@ -61,8 +61,7 @@ def _under_sponge(env: TaskEnv) -> np.ndarray:
     w = next(iter(env.wipes.items.values()))
     area, sponge = env.obj_pose("spill"), env.obj_pose("sponge")
     marks = area.p[0] + quat_rotate(area.q[0].expand(len(w.marks), 4), w.marks)
-    conj = sponge.q[0] * torch.tensor([1.0, -1.0, -1.0, -1.0])
-    local = quat_rotate(conj.expand(len(marks), 4), marks - sponge.p[0])
+    local = quat_rotate(quat_conj(sponge.q[0]).expand(len(marks), 4), marks - sponge.p[0])
     gap = torch.linalg.norm(local - local.clamp(w.lo, w.hi), dim=-1)
     return (gap <= MARK_PAD_M).numpy()
 
