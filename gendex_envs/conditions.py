@@ -13,7 +13,7 @@ from gendex_envs.typed_yaml import MAX_POSITION_M, quote
 
 ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
                         "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
-                        "at_rest", "wiped"]
+                        "at_rest", "wiped", "hung"]
 Part = Literal["handle"]
 Relation = Literal["left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_region"]
 Region = Literal["left", "right", "near", "far", "centre", "near_left", "near_right", "far_left", "far_right"]
@@ -35,7 +35,7 @@ class ConditionSpec:
     object: str | None = None
     """Name of the object the condition is about (every type but ``hand_open``)."""
     target: str | None = None
-    """inside: the container; near: an object or 'goal'; over: the object to be above."""
+    """inside: the container; near: an object or 'goal'; over: the object to be above; hung: what it hangs on."""
     negate: bool = False
     """True: the condition must *not* hold (e.g. ``grasped`` negated: the hand has let go)."""
     part: Part | None = None
@@ -45,7 +45,8 @@ class ConditionSpec:
     """joint_open, joint_at, or with ``part: handle``: the joint (default: the asset's main joint); inside: the joint
     whose link holds the object (a drawer's slide: the object lies in the drawer's bin, open or shut)."""
     min_height_m: float | None = None
-    """lifted: required rise above the object's height at reset (m), > 0."""
+    """lifted: required rise above the object's height at reset (m), > 0; hung: the least rise (default 0.05: a
+    mug leant on a stand's base plate has risen 2 cm)."""
     min_fraction: float | None = None
     """joint_open: required opening as a fraction of the joint range; wiped: the share of the target's marks wiped;
     in (0, 1]."""
@@ -118,7 +119,7 @@ CONDITION_DEFAULTS: dict[str, Any] = {"min_fingers": 2, "thumb": True, "min_forc
                                       "ring_radius_m": 0.0, "above_m": 0.0, "min_gap_m": 0.05, "max_gap_m": 0.3,
                                       "max_offset_m": 0.1, "max_error": 0.1, "max_tilt_deg": 15.0,
                                       "min_tilt_deg": 150.0, "max_speed_m_s": 0.02, "max_spin_rad_s": 0.3,
-                                      "min_press_n": 1.0}
+                                      "min_press_n": 1.0, "min_height_m": 0.05}
 """Values of optional condition fields left out."""
 
 CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
@@ -152,6 +153,9 @@ CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
     "wiped": (("object", "target", "min_fraction"), ("min_press_n",),
               "the object has passed over at least min_fraction of target's marks (a wipe area's sites) while pressing "
               "on target with min_press_n or more; a mark once wiped stays wiped for the episode"),
+    "hung": (("object", "target"), ("min_height_m",),
+             "the object hangs on target: target bears at least half its weight (the simulator's contact force "
+             "between the two) and it has risen at least min_height_m since reset"),
 }
 """Condition type -> (required fields, optional fields, meaning). ``type`` and ``negate`` apply to every type."""
 assert set(CONDITION_FIELDS) == set(CONDITION_TYPES)

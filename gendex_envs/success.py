@@ -54,6 +54,10 @@ REGION_DEPTH_M = REGION_MARGIN_M + 0.08
 inside the region (it starts ``REGION_MARGIN_M`` out), so a place a few centimetres off still counts."""
 REGION_PARTS = {"left": (1, 1), "right": (1, -1), "near": (0, -1), "far": (0, 1)}
 """Region word -> (axis: 0 forward, 1 left; sign)."""
+HUNG_WEIGHT_SHARE = 0.5
+"""A ``hung`` object's target bears at least this share of its weight (a mug hung by its handle that leans its body
+on the post still hangs; one held up by the hand, its handle just touching the peg, does not)."""
+GRAVITY_M_S2 = 9.81
 
 
 def _param(c: ConditionSpec, name: str):
@@ -126,6 +130,12 @@ def _placed(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     return (along >= lo) & (along <= hi) & ((d @ side).abs() <= offset)
 
 
+def _weight_n(env: TaskEnv, name: str) -> float:
+    """Object ``name``'s weight (N): its catalog mass at its scale (uniform scaling keeps the density)."""
+    scale = next(o.scale for o in env.task_spec.objects if o.name == name)
+    return env.asset_record(name).entry.mass_kg * scale**3 * GRAVITY_M_S2
+
+
 def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     t = c.type
     if t == "placed":
@@ -163,6 +173,10 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
                 & (torch.linalg.norm(ang, dim=-1) <= _param(c, "max_spin_rad_s")))
     if t == "wiped":
         return env.wipes.share(c) >= c.min_fraction - 1e-6
+    if t == "hung":
+        force = env.scene.get_pairwise_contact_forces(env.obj(c.object), env.obj(c.target))  # [N, 3]
+        return ((torch.linalg.norm(force, dim=-1) >= HUNG_WEIGHT_SHARE * _weight_n(env, c.object))
+                & (env.obj_height(c.object) >= _param(c, "min_height_m")))
     if t == "over":
         p, q = rest_point(env, c.object), env.obj_pose(c.target).p
         dz = p[:, 2] - q[:, 2]

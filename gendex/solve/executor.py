@@ -48,6 +48,7 @@ import numpy as np
 
 from gendex.solve.articulated import HOOK_OPEN, HandlePrimitives
 from gendex.solve.grasp import GraspPlan
+from gendex.solve.hang import hang
 from gendex.solve.motion import ArmHandMotion
 from gendex.solve.policy import StagePolicy
 from gendex.solve.press import PressPrimitives
@@ -72,7 +73,8 @@ from gendex_envs.wrappers import time_limit
 log = logging.getLogger(__name__)
 
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
-                    "release": "release", "push": "push", "wipe": "wipe"}
+                    "release": "release", "push": "push", "wipe": "wipe",
+                    "hang": "hang"}
 """Skill -> primitive for a rigid target."""
 TO_A_PLACE = ("carry", "place")
 """Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object
@@ -86,10 +88,13 @@ PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press"
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
                "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500,
-               "wipe": 200}
+               "wipe": 200, "hang": 120}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
+SWING_WAIT_STEPS = 150
+"""A mug let go on a peg swings there a while (2-5 s): where the task's success has a ``hung`` condition the final
+hold goes on, at most this many steps, until the success conditions hold."""
 CARRY_EXTRA_STEPS = 15
 """A level carry takes its length over :data:`~gendex.solve.rigid.CARRY_M_PER_STEP` plus about this many steps
 (easing in and out, rising to the carry height)."""
@@ -270,6 +275,12 @@ class StageExecutor:
         # hold the last targets until the task reports success (or the episode ends)
         self.logs.append(StageLog("settle", "hold", "scripted"))
         yield from self.motion.hold(spec.success.hold_steps + 10)
+        if any(c.type == "hung" for c in spec.success.conditions):
+            for _ in range(SWING_WAIT_STEPS):
+                if bool(self._env.spec_success()[0]):
+                    break
+                yield from self.motion.hold(1)
+            yield from self.motion.hold(spec.success.hold_steps)
 
     def _run_policy(self, stage, files: PolicyFiles) -> Iterator[np.ndarray]:
         """Run the stage's trained policy until the stage's success conditions hold (for the steps its env counts
@@ -315,7 +326,7 @@ class StageExecutor:
         taken only when no trial does better (:meth:`~gendex.solve.rigid.RigidPrimitives.choose_grasp`)."""
         spec = self._env.task_spec
         conds = (*spec.success.conditions, *(c for s in spec.stages[self.stage_index + 1:] for c in s.success or ()))
-        return next((c.target for c in conds if c.type in (*SET_DOWN_CONDITIONS, "wiped") and c.object == name
+        return next((c.target for c in conds if c.type in (*SET_DOWN_CONDITIONS, "wiped", "hung") and c.object == name
                      and not c.negate
                      and c.target in self._env.objects and c.target not in self._env.articulations), None)
 
@@ -392,6 +403,10 @@ class StageExecutor:
     def _wipe(self, stage) -> Iterator[np.ndarray]:
         """Wipe the target (a spill) with the held sponge (:mod:`gendex.solve.wipe`)."""
         yield from wipe(self.rigid, stage.target)
+
+    def _hang(self, stage) -> Iterator[np.ndarray]:
+        """Hang the held mug by its handle on a peg of the target (:mod:`gendex.solve.hang`)."""
+        yield from hang(self.rigid, stage.target)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         """Let go; an object held over what a condition wants it in, on or by is first set down there (a dropped tall

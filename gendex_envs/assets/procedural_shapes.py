@@ -213,9 +213,12 @@ def _flare(r0, r1, h, n, umax=0.45 * np.pi):
     return np.column_stack([r0 + (r1 - r0) * np.sin(u) / np.sin(umax), h * (1 - np.cos(u)) / (1 - np.cos(umax))])
 
 
-def _handle(parts, x0, z0, x1, z1, reach, half_w, half_h, n=9):
+def _handle(parts, x0, z0, x1, z1, reach, half_w, half_h, n=9, wall_r=None):
     """A D-shaped handle in the xz-plane from (x0, z0) to (x1, z1) bulging out by ``reach`` along +x; both ends
-    leave horizontally so their caps sit inside the wall."""
+    leave horizontally so their caps sit inside the wall. ``wall_r`` (the wall's outer radius there): anchor
+    ``handle_hole`` is the middle of the opening between wall and handle (what a peg threads through)."""
+    if wall_r is not None:
+        parts.anchors["handle_hole"] = np.array([(wall_r + (x0 + x1) / 2 + reach - half_w) / 2, 0.0, (z0 + z1) / 2])
     s = np.linspace(0, 1, n)
     path = np.column_stack([x0 + (x1 - x0) * s + reach * np.sin(np.pi * s) ** 0.6, np.zeros(n), z0 + (z1 - z0) * s])
     vis, hulls = tube(path, half_w, half_h, normal=(0, 1, 0), n_around=10, hull_every=2)
@@ -229,8 +232,9 @@ def _container(asset_id, parts, mass, friction, rgba, tags=VESSEL, params=None, 
 
 def _mug():
     parts = _vessel_parts([(0, 0), (3.8, 0), (4.1, 0.3), (4.1, 9.5)], 0.5, 0.8)
-    _handle(parts, 3.85, 2.0, 3.85, 8.0, 2.6, 0.45, 0.65)
-    return _container("mug", parts, 0.3, 0.6, (0.2, 0.45, 0.75, 1.0), params={"capacity_ml": 350.0})
+    _handle(parts, 3.85, 2.0, 3.85, 8.0, 2.6, 0.45, 0.65, wall_r=4.1)
+    return _container("mug", parts, 0.3, 0.6, (0.2, 0.45, 0.75, 1.0), tags=VESSEL + ("hangable",),
+                      params={"capacity_ml": 350.0})
 
 
 def _cup():
@@ -592,6 +596,9 @@ def _knife():
 _register("spoon", _spoon)
 _register("fork", _fork)
 _register("knife", _knife)
+
+
+from gendex_envs.assets import procedural_hanging  # noqa: E402,F401  (registers the hooks a mug hangs on)
 
 
 def build_all() -> list[ProceduralShape]:
