@@ -198,6 +198,8 @@ ROLE_TESTS = {
     "socket": lambda a: "insert" in a["tags"] and not a.get("joints"),
     "wiper": lambda a: "wiper" in a["tags"] and not a.get("joints"),
     "wipe_area": lambda a: "wipe_area" in a["tags"] and not a.get("joints"),
+    "hangable": lambda a: "hangable" in a["tags"] and not a.get("joints"),
+    "hang_on": lambda a: "hang_on" in a["tags"] and not a.get("joints"),
 }
 """What an object must be to play each role."""
 
@@ -207,6 +209,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
     "twist": ("screwable",), "insert": ("insertable", "socket"), "wipe": ("wiper", "wipe_area"),
+    "hang": ("hangable", "hang_on"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 

@@ -30,6 +30,9 @@ import numpy as np
 NAMES: dict[str, tuple[str, ...]] = {
     "peg_holder": ("peg holder", "holder", "pegboard"),
     "spill": ("spill", "stain", "mess"),
+    "mug_hook": ("mug hook", "hook", "cup hook"),
+    "mug_tree": ("mug tree", "mug stand"),
+    "mug_rack": ("mug rack", "wall rack"),
     "bowl": ("bowl", "serving bowl", "mixing bowl"),
     "pot": ("pot", "cooking pot", "saucepan"),
     "plate": ("plate", "dinner plate", "dish"),
@@ -193,6 +196,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "scrub the {d} with the {o} until it is clean",
         "mop up the {d} with the {o}",
         "wipe the {d} clean with the {o}",
+    ),
+    "hang": (
+        "hang the {o} on the {d}",
+        "hang the {o} up on the {d} by its handle",
+        "hang the {o} up on the {d} by the handle",
+        "hang the {o} by its handle from the {d}",
+        "hang up the {o} on the {d}",
     ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",

@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 ROLES = ("graspable", "container", "articulated", "support")
-PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "joint_at", "near", "over", "placed", "wiped")
+PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "joint_at", "near", "over", "placed", "wiped", "hung")
 """Success condition types a proposal may state (the task's success; stages get theirs in the plan step)."""
 
 

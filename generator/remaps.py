@@ -68,6 +68,9 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
         rest = [m for m in r.mentions if m not in wipers]
         roles = SKILL_ROLES["wipe"] if wipers or not rest else ("wipe_area", "wiper")
         r = dataclasses.replace(r, roles=roles, mentions=wipers + rest)
+    if r.skill == "hang":  # 'hang the mug on the tree', 'onto the rack, hang the mug': the mug first
+        hung = [m for m in r.mentions if plays(m, "hangable")]
+        r = dataclasses.replace(r, mentions=hung + [m for m in r.mentions if m not in hung])
     return r
 
 

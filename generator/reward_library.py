@@ -81,6 +81,33 @@ def _get_obs_extra(env, info):
 it, the held sponge over the spill, then the share of the spill's marks wiped."""
 
 
+_HANG = '''REWARD_MAX = 5.0
+UP_M = 0.15
+
+
+def evaluate(env):
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    return {{"fail": fail, "contact": rt.contact(force), "height": env.obj_height({obj!r})}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    held = info["contact"] > 0.2
+    up = rt.lift(info["height"], UP_M) * held
+    near = rt.place(p, env.obj_pose({stand!r}).p) * held
+    reward = reach + info["contact"] + up + near
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p,
+            "obj_to_stand": env.obj_pose({stand!r}).p - env.obj_pose({obj!r}).p}}
+'''
+"""Reward of a hang (format with ``fail``, ``obj``: the mug, ``stand``: what it hangs on): the palm to the mug,
+holding it, the held mug raised and brought to the stand; success (hung on a peg, let go, still) pays the most."""
+
+
 def _header(title: str) -> str:
     """The module header, its title wrapped to docstring width (an instruction may be a long sentence)."""
     return _HEADER_TEMPLATE.format(title=textwrap.fill(title, width=100))
@@ -126,6 +153,8 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
         return src + _PUSH.format(fail=fail, obj=obj)
     if cond["type"] == "wiped" and kind in ("carry", "wipe"):
         return src + _WIPE.format(fail=fail, obj=cond["object"], area=cond["target"])
+    if cond["type"] == "hung":
+        return src + _HANG.format(fail=fail, obj=cond["object"], stand=cond["target"])
     if kind in JOINT_SKILLS:
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
@@ -363,6 +392,8 @@ def _get_obs_extra(env, info):
         return src + _PUSH.format(fail=fail, obj=obj)
     if cond["type"] == "wiped":
         return src + _WIPE.format(fail=fail, obj=obj, area=target)
+    if cond["type"] == "hung":
+        return src + _HANG.format(fail=fail, obj=obj, stand=target)
     carry = _carry_term(target, placed_goal(cond, spec))
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1

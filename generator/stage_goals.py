@@ -66,6 +66,8 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         return [dict(c) for c in task_conditions if c.get("target") == target] or None
     if skill == "push":  # the task's own condition on the pushed object (near the goal mark)
         return [dict(c) for c in task_conditions if c.get("object") == target] or None
+    if skill == "hang":  # hung on the peg, still in the hand: the release stage ends where the task does
+        return None
     if skill == "wipe":  # the task's wipe of this area
         return [dict(c) for c in task_conditions if c.get("type") == "wiped" and c.get("target") == target] or None
     return None

@@ -60,6 +60,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("wipe", ("wipe up", "wipe", "clean up", "clean", "scrub", "mop up", "mop", "sponge"),
               "a spill on the table wiped with a sponge pressed down on it, over at least 90 % of its marks (a round, "
               "square or long spill)", "wipe the spill with the sponge"),
+    TaskSkill("hang", ("hang up", "hang"),
+              "a mug hung by its handle on a peg of a mug hook, mug tree or mug rack, and let go (it hangs there, "
+              "off the table, at rest)", "hang the mug on the mug tree"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
@@ -99,6 +102,9 @@ SYNONYMS: dict[str, str] = {
     "long spill": "spill_long", "long stain": "spill_long", "streak": "spill_long", "sauce spill": "spill_long",
     "car sponge": "sponge_block", "foam sponge": "sponge_block", "thick sponge": "sponge_block",
     "sponge block": "sponge_block", "big sponge": "sponge_block",
+    "hook": "mug_hook", "wall hook": "mug_hook", "cup hook": "mug_hook", "coat hook": "mug_hook",
+    "mug stand": "mug_tree", "cup tree": "mug_tree", "tree": "mug_tree", "wall rack": "mug_rack",
+    "cup rack": "mug_rack", "hanging rack": "mug_rack", "rack": "mug_rack",
     "round peg": "peg_round", "square peg": "peg_square", "thin peg": "peg_thin", "dowel": "peg_thin",
     "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
     "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",

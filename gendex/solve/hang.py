@@ -23,8 +23,9 @@ Measured while developing (seeds 0-8 and 20-27, stands +-3 cm and 30 deg, the mu
 
 from __future__ import annotations
 
+import dataclasses
 import logging
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -61,6 +62,7 @@ REAIM_RAD = 0.07
 """The mug is turned back upright, its opening along the peg, when off by more than this (4 deg: the opening leaves
 5 mm a side round the peg over its 12 mm length)."""
 REAIM_TRIES = 3
+REARM_TRIES = 5
 ALONG_STEP_M = 0.008
 ALONG_MORE_M = 0.02
 """A way to thread the mug is taken only where IK follows the palm's straight line onto the peg, and this much
@@ -194,6 +196,26 @@ class _Hanger:
                 return False
         return True
 
+    def rearm(self, t: Thread) -> Generator[np.ndarray, None, bool]:
+        """Where the arm cannot start the straight line onto the peg (centring moved it to the end of a joint's
+        range), move it, planned, to another configuration holding the palm where it is that follows the line; False
+        if there is none."""
+        m = self.m
+        palm = m.ik.fk(m.target())
+        here = dataclasses.replace(t, pre=palm, on=sapien.Pose(palm.p + (t.on.p - t.pre.p), palm.q))
+        for _ in range(REARM_TRIES):
+            q = m.ik.solve(palm, m.target(), restarts=20, valid=m.collision.is_free)
+            if q is None or not self.along(here, q):
+                continue
+            try:
+                path = m.plan_arm(q, max_step_rad=self.step_rad)
+            except ExecutionError:
+                continue
+            log.info("the arm could not start onto the peg: another arm configuration")
+            yield from path
+            return True
+        return False
+
     def misaligned(self, t: Thread) -> float:
         """How far (rad) the mug is from upright with its opening's axis along the peg: the larger of its tilt and
         its turn about the vertical."""
@@ -254,7 +276,12 @@ def hang(rigid: RigidPrimitives, stand: str) -> Iterator[np.ndarray]:
             break
         yield from path
     yield from h.centre(t, t.hole_pre)
-    yield from m.cartesian(t.hole_on - t.hole_pre, THREAD_M_PER_STEP, guard=True)
+    done = yield from m.cartesian(t.hole_on - t.hole_pre, THREAD_M_PER_STEP, guard=True, partial=True)
+    if done == 0.0 and (yield from h.rearm(t)):  # stuck before the tip: the same palm pose, another arm configuration
+        done = yield from m.cartesian(t.hole_on - t.hole_pre, THREAD_M_PER_STEP, guard=True, partial=True)
+    if done < 1.0:
+        raise ExecutionError(f"the arm reaches no further threading the {held!r} onto {stand!r} ({done:.0%} of the "
+                             "way)", cause="no_ik")
     yield from h.centre(t, t.hole_on)
     yield from h.lower()
 

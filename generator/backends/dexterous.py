@@ -1,5 +1,6 @@
 """The offline author's tasks of two dexterous skills that need an exact fit or a press: a peg put into the hole it
-fits (``insert``), and a spill wiped with a sponge pressed down on it (``wipe``). Each returns a proposal (a dict,
+fits (``insert``), a spill wiped with a sponge pressed down on it (``wipe``), and a mug hung by its handle on a peg
+(``hang``). Each returns a proposal (a dict,
 as :mod:`generator.backends.offline` writes them); ``words(name)`` is the author's generator that words a task."""
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ INSERT_XY_M = 0.005
 the holder is 4 cm or more off it)."""
 INSERT_DZ_M = (-0.005, 0.01)
 """... and this far above the hole's floor (a peg resting on the holder's top, or on its rim, is 2 cm or more up)."""
+HANG_LIFT_M = 0.05
+"""A hung mug has risen at least this far since reset (one leant on a stand's 1.5 cm base plate has not)."""
 WIPE_FRACTION = 0.9
 """A wiped spill has had this share of its marks passed over by the pressed sponge (the solver goes back over what
 it missed; 12-16 marks: one may be left)."""
@@ -64,4 +67,24 @@ def wipe_task(a: dict, b: dict, words: Words, colors: tuple[str | None, ...] = (
     }
 
 
-__all__ = ["INSERT_DZ_M", "INSERT_XY_M", "WIPE_FRACTION", "insert_task", "wipe_task"]
+def hang_task(a: dict, b: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dict:
+    """Hang mug ``a`` by its handle on a peg of stand ``b`` and let go (:mod:`gendex.solve.hang`); the scene step adds
+    that it is let go and still (:func:`generator.steps.scene.hung_lets_go`)."""
+    n, t = "mug", "stand"
+    kind = MODEL_WORDS.get(b["id"], "")
+    return {
+        "name": camel("hang", *painted(a, colors, 0), "on", b["id"].rsplit("_", 1)[-1]),
+        "description": phrase("hang", a, words(camel("hang", a["id"], b["id"])), other=b,
+                              **qualifiers(a, None, colors)),
+        "objects": [{"name": n, "asset": a["id"], "role": "graspable"},
+                    {"name": t, "asset": b["id"], "role": "support"}],
+        "steps": [*carry_steps(n, t, "over")[:2],
+                  step("hang", t, "arm", f"Slide the {word(n)}'s handle onto a peg of the {word(t)} and lower it."),
+                  step("release", n, "hand", f"Let go of the {word(n)}: it hangs on the peg.")],
+        "success": {"type": "hung", "object": n, "target": t, "min_height_m": HANG_LIFT_M},
+        "success_text": f"The {word(n)} hangs by its handle on the {kind + ' ' if kind else ''}{word(t)}, let go and "
+                        "still.",
+    }
+
+
+__all__ = ["HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "WIPE_FRACTION", "hang_task", "insert_task", "wipe_task"]

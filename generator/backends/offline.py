@@ -39,7 +39,7 @@ from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
-from generator.backends.dexterous import insert_task, wipe_task
+from generator.backends.dexterous import hang_task, insert_task, wipe_task
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
@@ -58,6 +58,8 @@ from generator.backends.roles import (
     graspable,
     handed,
     handover_zone,
+    hangable,
+    hook_stand,
     insertable,
     openable,
     receptacle,
@@ -92,7 +94,8 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "twist", "insert", "wipe", "several", "composed")
+              "press", "hand_over", "twist", "insert", "wipe", "hang", "several",
+              "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -190,6 +193,7 @@ class OfflineBackend:
         out += [("insert", insert_task(a, b, self._words)) for a in assets if insertable(a) for b in assets
                 if socket(b) and fits_hole(a, b)]
         out += [("wipe", wipe_task(a, b, self._words)) for a in assets if wiper(a) for b in assets if wipe_area(b)]
+        out += [("hang", hang_task(a, b, self._words)) for a in assets if hangable(a) for b in assets if hook_stand(b)]
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
@@ -524,6 +528,11 @@ class OfflineBackend:
             k = 0 if mentions and wiper(assets[mentions[0]["asset"]]) else 1  # the reader may put the spill first
             sponge, spill = pick(k, wiper, "sponge to wipe with"), pick(1 - k, wipe_area, "spill to wipe")
             proposal = wipe_task(sponge, spill, self._words, (colors[k], colors[1 - k]) if len(colors) > 1 else colors)
+        elif skill == "hang":
+            proposal = hang_task(pick(0, hangable, "mug to hang by its handle"),
+                                 pick(1, hook_stand, "hook, mug tree or rack to hang it on") if len(mentions) > 1
+                                 else next(x for x in sorted(assets.values(), key=lambda x: x["id"]) if hook_stand(x)),
+                                 self._words, colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -546,7 +555,7 @@ class OfflineBackend:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
                 "(see GenDex/RotateTennisBall-v0 and `gendex train`). It writes: lift, put_in, place_on, stack, "
-                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe.")
+                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe, hang.")
         name, k = proposal["name"], 2
         while proposal["name"] in existing:
             proposal["name"] = f"{name}{k}"

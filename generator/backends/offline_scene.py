@@ -19,6 +19,8 @@ from generator.backends.roles import (
     drawer_joint,
     graspable,
     handover_zone,
+    hangable,
+    hook_stand,
     insertable,
     socket,
     wipe_area,
@@ -27,7 +29,7 @@ from generator.backends.roles import (
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
-STAGE_HORIZONS = {"twist": 700, "wipe": 250}
+STAGE_HORIZONS = {"twist": 700, "wipe": 250, "hang": 250}
 """Stage horizons (control steps) of skills that take longer than a stage's usual 40 (a twist: 5-6 grasps a turn,
 about 90 steps each; hand-written trials 525-741 steps with the reach)."""
 PUSH_M = 0.22
@@ -55,6 +57,14 @@ SPILL_RANDOMIZE = {"xy_m": [0.05, 0.05], "yaw_deg": 30.0}
 """How far a sponge and its (fixed) spill move at reset: the sponge +-8 cm, turned either way up to 90 deg; the spill
 +-5 cm, turned up to 30 deg (their footprints stay 3 cm apart, :data:`generator.critic.skill_checks.WIPE_APART_M`).
 With the sponge at +-4 cm a blind replay of one recorded wipe of the square spill wiped it on 6 of 50 new seeds."""
+STAND_REGION_M = ((0.14, 0.24), (0.1, 0.2))
+"""Where a mug stand's middle is put (y on either side): its pegs 20-30 cm up, ahead of the robot, where the arm
+reaches round them with a mug in the hand, and off the middle, where the hand hangs at the robot's rest pose (a
+34 cm mug tree at y 0 met its fingers)."""
+STAND_RANDOMIZE = {"xy_m": [0.03, 0.03], "yaw_deg": 30.0}
+HANG_RANDOMIZE = {"xy_m": [0.08, 0.08], "yaw_deg": 90.0}
+"""How far a stand (fixed) and the mug to hang on it move at reset: the stand +-3 cm, turned up to 30 deg (its pegs
+still face the robot's side); the mug +-8 cm, turned either way up to 90 deg."""
 HOLDER_YAW_DEG = 20.0
 """How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
 stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
@@ -102,6 +112,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     drawers = {c["target"]: c["joint"] for c in (proposal["success"], *(proposal.get("also") or ()))
                if c["type"] == "inside" and c.get("joint")}
     by_name = {o["name"]: o for o in proposal["objects"]}
+    hung = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "hung"}
     for box in (o for o in proposal["objects"] if o["name"] in inside.values()):  # taken out of a drawer
         if drawer_joint(assets[box["asset"]]):
             drawers[box["name"]] = drawer_joint(assets[box["asset"]])
@@ -146,6 +157,13 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
             entry["fixed"] = wipe_area(a)
             entry["randomize"] = dict(SPILL_RANDOMIZE if wipe_area(a) else WIPE_RANDOMIZE)
+        elif hook_stand(a) or (hangable(a) and o["name"] in hung):  # a stand stays put (it moves at reset)
+            if hook_stand(a):
+                (x0, x1), (y0, y1) = STAND_REGION_M
+                y = float(rng.choice([-1.0, 1.0]) * rng.uniform(y0, y1))
+                entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(y, 3), 0.0]
+            entry["fixed"] = hook_stand(a)
+            entry["randomize"] = dict(STAND_RANDOMIZE if hook_stand(a) else HANG_RANDOMIZE)
         elif socket(a) or insertable(a):  # a holder stays put; the hole and the peg move at reset
             entry["fixed"] = socket(a)
             entry["randomize"] = dict(INSERT_RANDOMIZE, yaw_deg=HOLDER_YAW_DEG if socket(a) else

@@ -91,6 +91,16 @@ def wipe_area(a: dict) -> bool:
     return "wipe_area" in a["tags"] and not a.get("joints")
 
 
+def hangable(a: dict) -> bool:
+    """Something hung by its handle on a peg (an asset tagged ``hangable``: a mug, its handle's opening recorded)."""
+    return "hangable" in a["tags"] and not a.get("joints")
+
+
+def hook_stand(a: dict) -> bool:
+    """A stand with pegs to hang a mug on (an asset tagged ``hang_on``: a mug hook, tree or rack)."""
+    return "hang_on" in a["tags"] and not a.get("joints")
+
+
 def handover_zone(a: dict) -> bool:
     """The hand-over mat: where the robot leaves what it hands to a person."""
     return "handover" in a["tags"] and not a.get("joints")

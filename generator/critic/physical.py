@@ -69,7 +69,7 @@ How each check is measured (the thresholds are the module constants below):
     fraction is (q - closed) / (open - closed) of the joint the conditions name, else the asset's main joint.
     Fix: ``joint_fix`` = {object, joint, value} setting the joint to its closed (resp. open) value; the directive
     grammar has no joint edit.
-``handover``, ``insert``, ``wipe`` (static)
+``handover``, ``insert``, ``wipe``, ``hang`` (static)
     What a skill needs of the scene: :mod:`generator.critic.skill_checks` (an object to hand over starts clear of
     its hand-over zone, a peg of its holder, a sponge of its spill).
 """
@@ -92,12 +92,12 @@ from gendex_envs.placement import in_drawer
 from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec
 from generator.critic.directives import Directive
 from generator.critic.layout import Room, choose_move, front_zone
-from generator.critic.skill_checks import handover_checks, insert_checks, wipe_checks
+from generator.critic.skill_checks import handover_checks, hang_checks, insert_checks, wipe_checks
 
 log = logging.getLogger(__name__)
 
 CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "in_front", "scale",
-                  "joint_state", "handover", "insert", "wipe"]
+                  "joint_state", "handover", "insert", "wipe", "hang"]
 CHECKS: tuple[str, ...] = get_args(CheckId)
 
 # ----------------------------------------------------------------------------------------------- thresholds
@@ -612,6 +612,7 @@ def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dic
     handover_checks(spec, placed, meas["handover"], violations)  # what skills need (generator.critic.skill_checks)
     insert_checks(spec, placed, meas["insert"], violations)
     wipe_checks(spec, placed, meas["wipe"], violations)
+    hang_checks(spec, placed, meas["hang"], violations)
     return violations, meas, placed, unsupported
 
 

@@ -13,6 +13,9 @@ calls them among its static checks, with the same :class:`~generator.critic.phys
 ``wipe``
     The same for a sponge and the spill it wipes (an asset tagged ``wipe_area``): a sponge that starts on the spill
     is half way there. Gap :data:`WIPE_APART_M`, the same fix.
+``hang``
+    The same for a mug and the stand it hangs on (an asset tagged ``hang_on``): a mug that starts against the stand's
+    base leaves no room to grasp it clear of the pegs. Gap :data:`HANG_APART_M`, the same fix.
 """
 
 from __future__ import annotations
@@ -42,9 +45,12 @@ INSERT_APART_M = 0.05
 lifted over the holder's 5 cm wall: a nudge inserts nothing)."""
 WIPE_APART_M = 0.03
 """Least gap (m) between a sponge's footprint and its spill's, both widened by their randomization."""
+HANG_APART_M = 0.05
+"""Least gap (m) between a mug's footprint and its stand's, both widened by their randomization."""
 APART: dict[str, tuple[str, float, str]] = {"handover": ("handover", HANDOVER_APART_M, "hand-over zone"),
                                             "insert": ("insert", INSERT_APART_M, "holder"),
-                                            "wipe": ("wipe_area", WIPE_APART_M, "spill")}
+                                            "wipe": ("wipe_area", WIPE_APART_M, "spill"),
+                                            "hang": ("hang_on", HANG_APART_M, "stand")}
 """Check -> (the target's catalog tag, least gap, what the target is called)."""
 
 
@@ -63,13 +69,18 @@ def wipe_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violation
     _apart_checks("wipe", spec, placed, meas, violations)
 
 
+def hang_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+    """The ``hang`` check (module docstring): one violation per mug that starts too near its stand."""
+    _apart_checks("hang", spec, placed, meas, violations)
+
+
 def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: dict,
                   violations: list[Violation]) -> None:
     from generator.critic.physical import Violation, moves, rounded
 
     tag, apart, called = APART[check]
     for c in spec.success.conditions:
-        if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed", "wiped") or c.target not in placed
+        if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed", "wiped", "hung") or c.target not in placed
                 or c.object not in placed or tag not in placed[c.target].record.tags):
             continue
         obj, zone = placed[c.object], placed[c.target]
@@ -93,5 +104,5 @@ def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: d
             measured=gap, limit=apart, fix=moves(c.object, step), other=c.target))
 
 
-__all__ = ["APART", "HANDOVER_APART_M", "INSERT_APART_M", "WIPE_APART_M", "handover_checks", "insert_checks",
-           "wipe_checks"]
+__all__ = ["APART", "HANDOVER_APART_M", "HANG_APART_M", "INSERT_APART_M", "WIPE_APART_M", "handover_checks",
+           "hang_checks", "insert_checks", "wipe_checks"]

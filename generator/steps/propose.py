@@ -132,12 +132,15 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
     if succ.get("object") not in names:
         raise ProposalError(f"{where}.object {succ.get('object')!r} is not a proposed object; objects: {names}")
     targets = names + [GOAL_TARGET] if succ["type"] == "near" else names
-    if succ["type"] in ("inside", "near", "over", "wiped") and succ.get("target") not in targets:
+    if succ["type"] in ("inside", "near", "over", "wiped", "hung") and succ.get("target") not in targets:
         raise ProposalError(f"{where}.target {succ.get('target')!r} must name a proposed object for a "
                             f"{succ['type']!r} condition; allowed: {targets}")
     if succ["type"] == "wiped" and "wipe_area" not in assets[objects[names.index(succ["target"])].asset]["tags"]:
         raise ProposalError(f"{where}.target {succ['target']!r} has no marks to wipe: a wiped condition's target is a "
                             "wipe area (an asset tagged wipe_area: a spill)")
+    if succ["type"] == "hung" and "hang_on" not in assets[objects[names.index(succ["target"])].asset]["tags"]:
+        raise ProposalError(f"{where}.target {succ['target']!r} has no pegs to hang on: a hung condition's target is a "
+                            "stand tagged hang_on (a mug hook, tree or rack)")
     if succ["type"] == "placed":
         from gendex_envs.conditions import RELATIONS
 

@@ -181,6 +181,19 @@ def inserted_upright(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
 
 
+def hung_lets_go(spec: TaskSpec) -> TaskSpec:
+    """Give every object the success hangs on something (``hung``) a ``released`` and an ``at_rest`` condition: a
+    mug still held up by the hand, its handle touching the peg, or one swinging there, is not hung yet."""
+    conds = spec.success.conditions
+    have = {(c.type, c.object) for c in conds if not c.negate}
+    hung = dict.fromkeys(c.object for c in conds if c.type == "hung" and not c.negate)
+    extra = tuple(ConditionSpec(type=t, object=o) for o in hung for t in ("released", "at_rest") if (t, o) not in have)
+    if not extra:
+        return spec
+    log.info("success of %s: %s must be let go and hang still", spec.name, ", ".join(hung))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
+
+
 def twist_holds_cap(spec: TaskSpec) -> TaskSpec:
     """Give a success that a ``twist`` stage's cap be turned (``joint_open`` on the stage's target) a ``grasped``
     condition on that cap: unscrewing ends with the cap in the hand (the plan step gives the stage the same,
@@ -234,7 +247,8 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
-    return inserted_upright(twist_holds_cap(hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))))
+    settled = hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))
+    return hung_lets_go(inserted_upright(twist_holds_cap(settled)))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

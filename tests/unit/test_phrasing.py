@@ -27,7 +27,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
     "twist": ("screw_jar", None), "insert": ("peg_square", "peg_holder_square"),
-    "wipe": ("sponge_block", "spill_square"),
+    "wipe": ("sponge_block", "spill_square"), "hang": ("mug", "mug_tree"),
 }
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees"), "put_in_drawer": ("bottom ", None),
@@ -56,7 +56,7 @@ def test_every_command_reads_back_as_its_task(skill):
                 got = [ASSETS[m.asset]["category"] for m in r.objects]
                 want = [ASSETS[main]["category"]] + ([ASSETS[other]["category"]] if other else [])
                 assert got == want, (text, got)
-                if skill in ("stack", "wipe"):
+                if skill in ("stack", "wipe", "hang"):
                     assert [m.asset for m in r.objects] == [main, other], text
                 assert not r.substitutions, (text, r.substitutions)
 
@@ -75,6 +75,8 @@ def test_every_name_the_author_uses_is_read_back_as_its_category():
                 text, k = f"put the peg in the {w}", 1
             elif "wipe_area" in a["tags"]:  # a spill: what a sponge wipes
                 text, k = f"wipe the {w} with the sponge", 1
+            elif "hang_on" in a["tags"]:  # a stand: what a mug hangs on
+                text, k = f"hang the mug on the {w}", 1
             r = read_instruction(text, list(ASSETS.values()))
             assert ASSETS[r.objects[k].asset]["category"] == cat, (w, r.objects)
 
