@@ -132,7 +132,7 @@ def _placed(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
 
 def _weight_n(env: TaskEnv, name: str) -> float:
     """Object ``name``'s weight (N): its catalog mass at its scale (uniform scaling keeps the density)."""
-    scale = next(o.scale for o in env.task_spec.objects if o.name == name)
+    scale = env.task_spec.object(name).scale
     return env.asset_record(name).entry.mass_kg * scale**3 * GRAVITY_M_S2
 
 

@@ -83,6 +83,36 @@ def stage_run():
 
 
 @pytest.fixture
+def solved():
+    """``solved(spec, seed)``: the stage executor on a task env of ``spec`` (a TaskSpec) from ``reset(seed=seed)``
+    until the task succeeds, the solver stops or the episode ends; returns (succeeded, env, solver), the env closed
+    when the test ends."""
+    from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
+    from gendex_envs.registry import HISTORY_FREE
+    from gendex_envs.task_env import TaskEnv
+
+    made = []
+
+    def run(spec, seed: int):
+        env = TaskEnv(task_spec=spec, render_backend="none", **SOLVER_ENV_KWARGS["stages"], **HISTORY_FREE)
+        made.append(env)
+        solver = SOLVERS["stages"]()
+        obs, info = env.reset(seed=seed)
+        solver.reset(env, obs)
+        success = False
+        while not success and (action := solver.act(env, obs)) is not None:
+            obs, _, _, truncated, info = env.step(action)
+            success = bool(info["success"][0])
+            if bool(truncated):
+                break
+        return success, env, solver
+
+    yield run
+    for env in made:
+        env.close()
+
+
+@pytest.fixture
 def make_env():
     """Factory for GenDex envs that closes every env it made when the test ends."""
     made = []

@@ -95,7 +95,7 @@ def _anchor(params: dict, name: str) -> np.ndarray:
 def pegs_world(env, stand: str) -> list[tuple[np.ndarray, np.ndarray]]:
     """(root, tip) of each peg of ``stand`` in the world (env 0)."""
     rec, pose = env.asset_record(stand), env.obj_pose(stand)
-    scale = next(o.scale for o in env.task_spec.objects if o.name == stand)
+    scale = env.task_spec.object(stand).scale
     h = sapien.Pose(pose.p[0].cpu().numpy(), pose.q[0].cpu().numpy())
     params = rec.entry.params
     return [tuple((h * sapien.Pose(scale * _anchor(params, f"peg{k}_{end}"))).p for end in ("root", "tip"))
@@ -108,7 +108,7 @@ def hole_local(env, held: str) -> np.ndarray:
     if "handle_hole_x" not in params:
         raise ExecutionError(f"{held!r} has no handle to hang it by (its asset records no handle_hole)",
                              cause="unsupported")
-    scale = next(o.scale for o in env.task_spec.objects if o.name == held)
+    scale = env.task_spec.object(held).scale
     return scale * _anchor(params, "handle_hole")
 
 
@@ -118,7 +118,7 @@ def thread_poses(env, held: str, stand: str, palm: sapien.Pose, mug: sapien.Pose
     in_hand = palm.inv() * mug
     hole = hole_local(env, held)
     rec = env.asset_record(held)
-    scale = next(o.scale for o in env.task_spec.objects if o.name == held)
+    scale = env.task_spec.object(held).scale
     half_y = scale * max(-rec.bbox_min_m[1], rec.bbox_max_m[1])  # the mug's half width along the peg
     x_now = mug.to_transformation_matrix()[:3, 0]
     yaw_now = float(np.arctan2(x_now[1], x_now[0]))

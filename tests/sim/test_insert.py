@@ -9,8 +9,7 @@ import pytest
 import torch
 from mani_skill.utils.structs.pose import Pose
 
-from gendex.solve import SOLVER_ENV_KWARGS, SOLVERS
-from gendex_envs.registry import HISTORY_FREE, resolve_task
+from gendex_envs.registry import resolve_task
 from gendex_envs.success import condition_holds
 from gendex_envs.task_env import TaskEnv
 
@@ -51,21 +50,9 @@ def test_only_a_peg_down_in_the_hole_meets_the_success():
 
 
 @pytest.mark.parametrize("task, seed", [("GenDex/InsertPegSquare-v0", 22), ("GenDex/InsertPegThin-v0", 21)])
-def test_the_executor_puts_the_peg_into_its_hole(task, seed):
+def test_the_executor_puts_the_peg_into_its_hole(task, seed, solved):
     """One seed each (the rates over 50 unseen seeds are in benchmarks/results/skills.md): the square peg turned to
     its hole's sides, the thin one pinched high, both let go standing on the floor of the hole."""
-    env = _env(task, **SOLVER_ENV_KWARGS["stages"], **HISTORY_FREE)
-    try:
-        solver = SOLVERS["stages"]()
-        obs, info = env.reset(seed=seed)
-        solver.reset(env, obs)
-        success = False
-        while not success and (action := solver.act(env, obs)) is not None:
-            obs, _, _, truncated, info = env.step(action)
-            success = bool(info["success"][0])
-            if bool(truncated):
-                break
-        d = env.obj_pose("peg").p[0] - env.obj_pose("holder").p[0]
-        assert success and float(torch.linalg.norm(d[:2])) < 0.005, (task, d)
-    finally:
-        env.close()
+    success, env, _ = solved(resolve_task(task).spec, seed)
+    d = env.obj_pose("peg").p[0] - env.obj_pose("holder").p[0]
+    assert success and float(torch.linalg.norm(d[:2])) < 0.005, (task, d)
