@@ -73,8 +73,7 @@ from gendex_envs.wrappers import time_limit
 log = logging.getLogger(__name__)
 
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
-                    "release": "release", "push": "push", "wipe": "wipe",
-                    "hang": "hang"}
+                    "release": "release", "push": "push", "wipe": "wipe", "hang": "hang"}
 """Skill -> primitive for a rigid target."""
 TO_A_PLACE = ("carry", "place")
 """Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object

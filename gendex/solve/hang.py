@@ -58,11 +58,14 @@ CENTRE_TOLERANCE_M = 0.003
 """The opening's middle is centred on the peg's axis (before threading) within this; the opening leaves 5 mm a side
 round the peg."""
 CENTRE_TRIES = 4
+"""Moves at most to centre the opening, each from where it was measured."""
 REAIM_RAD = 0.07
 """The mug is turned back upright, its opening along the peg, when off by more than this (4 deg: the opening leaves
 5 mm a side round the peg over its 12 mm length)."""
 REAIM_TRIES = 3
+"""Re-aims at most after the planned move to the stand."""
 REARM_TRIES = 5
+"""IK restarts at most for another arm configuration where the line onto the peg cannot start."""
 ALONG_STEP_M = 0.008
 ALONG_MORE_M = 0.02
 """A way to thread the mug is taken only where IK follows the palm's straight line onto the peg, and this much
@@ -113,8 +116,9 @@ def hole_local(env, held: str) -> np.ndarray:
 
 
 def thread_poses(env, held: str, stand: str, palm: sapien.Pose, mug: sapien.Pose) -> list[Thread]:
-    """Every way to hang ``held`` on a peg of ``stand``, the least turn of the held mug about the vertical first.
-    ``palm`` and ``mug`` are their world poses now (the mug's pose in the hand stays as it is)."""
+    """Every way to hang ``held`` on a peg of ``stand``: those that keep the palm off the post's side of the opening
+    first (:data:`HAND_SIDE_M`), then the least turn of the held mug about the vertical. ``palm`` and ``mug`` are
+    their world poses now (the mug's pose in the hand stays as it is)."""
     in_hand = palm.inv() * mug
     hole = hole_local(env, held)
     rec = env.asset_record(held)
@@ -162,8 +166,9 @@ class _Hanger:
         return (self.mug() * sapien.Pose(hole_local(self.env, self.held))).p
 
     def choose(self) -> tuple[Thread, Iterator[np.ndarray]]:
-        """The first way whose both palm poses the arm reaches, the first without collision and by a planned path
-        from here, and that path."""
+        """The first way to thread the mug (in :func:`thread_poses`' order) whose first palm pose the arm reaches
+        without collision, whose straight line onto the peg it follows (:meth:`along`) and that a planned path
+        reaches from here: that way and the path."""
         m = self.m
         q_now = m.target()
         tried = thread_poses(self.env, self.held, self.stand, self.palm(), self.mug())
@@ -253,7 +258,7 @@ def hang(rigid: RigidPrimitives, stand: str) -> Iterator[np.ndarray]:
         raise ExecutionError(f"hanging something on {stand!r} needs it in the hand; it holds nothing", cause="slipped")
     h = _Hanger(rigid, stand)
     # the stand as a box per convex piece (its bounding box holds the pegs' whole reach), every other object as one
-    m.collision.set_obstacles([b for b in m.object_boxes(exclude=(held, stand))]
+    m.collision.set_obstacles(m.object_boxes(exclude=(held, stand))
                               + [Box(p.vertices.min(axis=0) - 0.01, p.vertices.max(axis=0) + 0.01, stand)
                                  for p in rigid.shape(stand).parts])
     lo, hi = m.world_aabb(held)
@@ -270,7 +275,7 @@ def hang(rigid: RigidPrimitives, stand: str) -> Iterator[np.ndarray]:
         if off <= REAIM_RAD:
             break
         log.info("the %r turned %.0f deg in the hand: aiming again", held, np.degrees(off))
-        try:  # the ways to thread it from how it is held now (the one it was on, if it still reaches)
+        try:  # the ways to thread it from how it is held now (the same way round needs no turn now: first)
             t, path = h.choose()
         except ExecutionError:
             break
