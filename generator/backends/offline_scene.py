@@ -63,8 +63,8 @@ reaches round them with a mug in the hand, and off the middle, where the hand ha
 34 cm mug tree at y 0 met its fingers)."""
 STAND_RANDOMIZE = {"xy_m": [0.03, 0.03], "yaw_deg": 30.0}
 HANG_RANDOMIZE = {"xy_m": [0.08, 0.08], "yaw_deg": 90.0}
-"""How far a stand (fixed) and the mug to hang on it move at reset: the stand +-3 cm, turned up to 30 deg (its pegs
-still face the robot's side); the mug +-8 cm, turned either way up to 90 deg."""
+"""How far a stand (fixed) and the mug to hang on it move at reset: the stand +-3 cm, turned up to 30 deg (a peg of
+each stand still faces the robot's side); the mug +-8 cm, turned either way up to 90 deg."""
 HOLDER_YAW_DEG = 20.0
 """How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
 stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
