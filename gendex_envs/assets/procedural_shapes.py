@@ -598,7 +598,8 @@ _register("fork", _fork)
 _register("knife", _knife)
 
 
-from gendex_envs.assets import procedural_hanging  # noqa: E402,F401  (registers the hooks a mug hangs on)
+# registers the hooks a mug hangs on, the beads a vessel pours and the vessels that pour them
+from gendex_envs.assets import procedural_hanging, procedural_pouring  # noqa: E402,F401
 
 
 def build_all() -> list[ProceduralShape]:

@@ -21,7 +21,7 @@ IDS = sorted(BY_ID)
 CONTAINERS = [e.id for e in ENTRIES if "container" in e.tags]
 TAGS = {"graspable", "container", "tableware", "food", "fruit", "ball", "tool", "utensil", "box", "block", "toy",
         "kitchenware", "surface", "handover", "marker", "peg", "holder", "insert", "wiper", "spill", "wipe_area",
-        "hangable", "hook", "hang_on"}
+        "hangable", "hook", "hang_on", "pourer", "pourable", "bead"}
 
 
 def _parse_obj(path) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -80,7 +80,7 @@ def test_library_is_complete_and_well_formed():
         assert re.fullmatch(r"[a-z][a-z0-9_]*", e.id), e.id
         assert e.kind == "rigid" and e.licence == "Apache-2.0" and e.source.startswith("gendex procedural")
         assert set(e.tags) <= TAGS and {"graspable", "surface", "handover", "insert", "wipe_area",
-                                        "hang_on"} & set(e.tags), (e.id, e.tags)
+                                        "hang_on", "pourable"} & set(e.tags), (e.id, e.tags)
         assert e.visual == f"{e.id}/visual.obj" and e.collision == f"{e.id}/collision.obj"
         assert all(0.0 <= c <= 1.0 for c in e.rgba)
     for must in ("apple", "banana", "tennis_ball", "golf_ball", "mug", "bowl", "plate", "cracker_box", "hammer",
