@@ -13,7 +13,7 @@ from gendex_envs.typed_yaml import MAX_POSITION_M, quote
 
 ConditionType = Literal["lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
                         "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
-                        "at_rest", "wiped", "hung"]
+                        "at_rest", "wiped", "hung", "poured"]
 Part = Literal["handle"]
 Relation = Literal["left_of", "right_of", "in_front_of", "behind", "next_to", "between", "in_region"]
 Region = Literal["left", "right", "near", "far", "centre", "near_left", "near_right", "far_left", "far_right"]
@@ -35,7 +35,8 @@ class ConditionSpec:
     object: str | None = None
     """Name of the object the condition is about (every type but ``hand_open``)."""
     target: str | None = None
-    """inside: the container; near: an object or 'goal'; over: the object to be above; hung: what it hangs on."""
+    """inside: the container; near: an object or 'goal'; over: the object to be above; hung: what it hangs on; poured:
+    the container the pieces go into."""
     negate: bool = False
     """True: the condition must *not* hold (e.g. ``grasped`` negated: the hand has let go)."""
     part: Part | None = None
@@ -49,7 +50,7 @@ class ConditionSpec:
     mug leant on a stand's base plate has risen 2 cm)."""
     min_fraction: float | None = None
     """joint_open: required opening as a fraction of the joint range; wiped: the share of the target's marks wiped;
-    in (0, 1]."""
+    poured: the share of the object's pieces that must lie in the target; in (0, 1]."""
     max_dist_m: float | None = None
     """near: object to target; hand_at: palm to the point; fingertips_near: mean fingertip distance (m), > 0."""
     min_deg: float | None = None
@@ -153,6 +154,9 @@ CONDITION_FIELDS: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
     "wiped": (("object", "target", "min_fraction"), ("min_press_n",),
               "the object has passed over at least min_fraction of target's marks (a wipe area's sites) while pressing "
               "on target with min_press_n or more; a mark once wiped stays wiped for the episode"),
+    "poured": (("object", "target", "min_fraction"), (),
+               "at least min_fraction of the loose pieces (objects tagged pourable: beads, marbles) that started in "
+               "the vessel object lie in the container target"),
     "hung": (("object", "target"), ("min_height_m",),
              "the object hangs on target: target bears at least half its weight (the simulator's contact force "
              "between the two) and it has risen at least min_height_m since reset"),

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import torch
 
+from gendex_envs import pouring
 from gendex_envs.holds import holds_point
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -302,6 +303,11 @@ class RewardView:
     def holds_point(self, name: str, joint: str | None = None) -> torch.Tensor:
         """[N, 3] the middle of the floor of the space the joint's link holds things in (a drawer's bin)."""
         return _fresh(holds_point(_env(self), name, joint))
+
+    def poured_share(self, name: str, target: str) -> torch.Tensor:
+        """[N] the share of the loose pieces (beads) that started in vessel ``name`` that now lie in container
+        ``target`` (:mod:`gendex_envs.pouring`)."""
+        return _fresh(pouring.share(_env(self), name, target))
 
     def wiped_share(self, name: str, target: str) -> torch.Tensor:
         """[N] the share of wipe area ``target``'s marks that ``name`` (a sponge) has wiped, pressed, this episode."""

@@ -62,7 +62,7 @@ Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
 Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient",
-                "press", "twist", "wipe", "hang"]
+                "press", "twist", "wipe", "hang", "pour"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
@@ -87,6 +87,8 @@ SKILL_MEANINGS: dict[str, str] = {
     "wipe": "slide the held object (a sponge) over the target's marks (a spill), pressed down on it",
     "hang": "thread the held object's handle (a mug's) onto a peg of the target (a hook or mug tree) and lower it "
             "onto the peg",
+    "pour": "tip the held vessel over the target (a bowl) until the loose pieces in it (beads) fall in, then stand it "
+            "up again",
 }
 """What each skill of :data:`SKILLS` does; the stage's ``target`` is the object it acts on."""
 assert set(SKILL_MEANINGS) == set(SKILLS)

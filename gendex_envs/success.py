@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import torch
 
+from gendex_envs import pouring
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import box_rest_point, tilt, xy_distance, z_twist
 from gendex_envs.holds import in_holds
@@ -136,6 +137,14 @@ def _weight_n(env: TaskEnv, name: str) -> float:
     return env.asset_record(name).entry.mass_kg * scale**3 * GRAVITY_M_S2
 
 
+def in_container(env: TaskEnv, name: str, target: str) -> torch.Tensor:
+    """[N] object ``name`` lies in rigid container ``target`` (the ``inside`` condition without a joint)."""
+    inner_r, top = env.container_extent(target)
+    box, p = env.obj_pose(target).p, rest_point(env, name)
+    dz = p[:, 2] - box[:, 2]
+    return (xy_distance(p, box) <= inner_r) & (dz >= -INSIDE_FLOOR_TOL_M) & (dz <= top)
+
+
 def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     t = c.type
     if t == "placed":
@@ -152,10 +161,9 @@ def _holds(env: TaskEnv, c: ConditionSpec) -> torch.Tensor:
     if t == "inside":
         if c.joint is not None:
             return in_holds(env, c.target, c.joint, rest_point(env, c.object))
-        inner_r, top = env.container_extent(c.target)
-        box, p = env.obj_pose(c.target).p, rest_point(env, c.object)
-        dz = p[:, 2] - box[:, 2]
-        return (xy_distance(p, box) <= inner_r) & (dz >= -INSIDE_FLOOR_TOL_M) & (dz <= top)
+        return in_container(env, c.object, c.target)
+    if t == "poured":
+        return pouring.share(env, c.object, c.target) >= c.min_fraction - 1e-6
     if t == "rotated":
         twist = z_twist(env.obj_pose(c.object).q, env.init_obj_quat(c.object))
         goal = math.radians(c.min_deg)

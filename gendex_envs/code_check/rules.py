@@ -138,7 +138,8 @@ VIEW_MEMBERS = frozenset({
     # RewardView
     "num_envs", "device", "table_height", "object_names", "stage_targets", "agent", "obj_pose", "obj",
     "init_obj_pos", "init_obj_quat", "obj_height", "hand_forces", "palm_pose", "tip_positions", "handle_link",
-    "handle_pos", "joint_qpos", "joint_open_fraction", "holds_point", "wiped_share", "goal_pos", "spec_success",
+    "handle_pos", "joint_qpos", "joint_open_fraction", "holds_point", "wiped_share", "poured_share", "goal_pos",
+    "spec_success",
     # PoseView, EntityView, AgentView, RobotView
     "p", "q", "raw_pose", "name", "part", "joint", "pose", "linear_velocity", "angular_velocity", "robot",
     "get_hand_group_obj_mean_force", "get_qpos", "get_qvel",

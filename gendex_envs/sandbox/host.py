@@ -106,6 +106,7 @@ MEMBERS = {
     "joint_open_fraction": (2, lambda v, n, j: v.joint_open_fraction(n, j)),
     "holds_point": (2, lambda v, n, j: v.holds_point(n, j)),
     "wiped_share": (2, lambda v, n, t: v.wiped_share(n, t)),
+    "poured_share": (2, lambda v, n, t: v.poured_share(n, t)),
     "goal_pos": (0, lambda v: v.goal_pos),
     "spec_success": (0, lambda v: v.spec_success()),
 }

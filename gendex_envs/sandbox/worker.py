@@ -216,6 +216,9 @@ class RemoteView:
     def holds_point(self, name: str, joint: str | None = None) -> torch.Tensor:
         return self._get("holds_point", name, joint).clone()
 
+    def poured_share(self, name: str, target: str) -> torch.Tensor:
+        return self._get("poured_share", name, target).clone()
+
     def wiped_share(self, name: str, target: str) -> torch.Tensor:
         return self._get("wiped_share", name, target).clone()
 

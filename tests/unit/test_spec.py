@@ -161,9 +161,9 @@ def test_allowed_value_constants() -> None:
     assert STAGE_METHODS == ("motion_planning", "RL")
     assert CONDITION_TYPES == ("lifted", "inside", "near", "joint_open", "rotated", "grasped", "released", "over",
                                "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
-                               "at_rest", "wiped", "hung")
+                               "at_rest", "wiped", "hung", "poured")
     assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
-                      "reorient", "press", "twist", "wipe", "hang")
+                      "reorient", "press", "twist", "wipe", "hang", "pour")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
