@@ -13,6 +13,7 @@ from gendex_envs.assets.catalog import THIN_M, THIN_SOLVER_ITERATIONS, catalog
 from gendex_envs.physx import px_bodies, px_objects
 from gendex_envs.spec import parse_task_spec
 from gendex_envs.task_env import TaskEnv
+from gendex_envs.typed_yaml import MAX_OBJECTS
 
 RIGID = sorted(r.id for r in catalog().values() if not r.articulated)
 ARTICULATED = sorted(r.id for r in catalog().values() if r.articulated)
@@ -58,13 +59,21 @@ def _idle(env: TaskEnv, seconds: float) -> None:
 
 @pytest.fixture(scope="module")
 def rigid_scene():
-    objs = [{"name": f"a_{aid}", "asset": aid, "pos_m": [x, y, 0.0]}
-            for aid, (x, y) in zip(RIGID, _grid_positions(len(RIGID), SPACING_M), strict=True)]
-    env = _make(objs)
-    start = {o["name"]: env.obj(o["name"]).pose.raw_pose[0].clone() for o in objs}
-    _idle(env, 2.0)
-    yield env, start
-    env.close()
+    """Every rigid asset on a grid, idled 2 s, in as many scenes as MAX_OBJECTS allows: asset id -> (env, its pose
+    before idling by object name)."""
+    envs, where = [], {}
+    for at in range(0, len(RIGID), MAX_OBJECTS):
+        chunk = RIGID[at:at + MAX_OBJECTS]
+        objs = [{"name": f"a_{aid}", "asset": aid, "pos_m": [x, y, 0.0]}
+                for aid, (x, y) in zip(chunk, _grid_positions(len(chunk), SPACING_M), strict=True)]
+        env = _make(objs)
+        envs.append(env)
+        start = {o["name"]: env.obj(o["name"]).pose.raw_pose[0].clone() for o in objs}
+        _idle(env, 2.0)
+        where.update({aid: (env, start) for aid in chunk})
+    yield where
+    for env in envs:
+        env.close()
 
 
 def test_catalog_is_large_enough():
@@ -78,7 +87,7 @@ def test_catalog_is_large_enough():
 
 @pytest.mark.parametrize("asset_id", RIGID)
 def test_rigid_asset_rests_on_table(rigid_scene, asset_id):
-    env, start = rigid_scene
+    env, start = rigid_scene[asset_id]
     name = f"a_{asset_id}"
     pose = env.obj(name).pose.raw_pose[0]
     assert torch.isfinite(pose).all()
@@ -91,13 +100,12 @@ def test_rigid_asset_rests_on_table(rigid_scene, asset_id):
 
 def test_only_thin_objects_get_more_contact_solver_iterations(rigid_scene):
     """A knife, a spoon or a fork is solved at THIN_SOLVER_ITERATIONS, everything else at the scene's 15."""
-    env, _ = rigid_scene
-    got = {aid: px_bodies(env.obj(f"a_{aid}"))[0].solver_position_iterations for aid in RIGID}
+    got = {aid: px_bodies(rigid_scene[aid][0].obj(f"a_{aid}"))[0].solver_position_iterations for aid in RIGID}
     thin = {aid for aid in RIGID if min(catalog()[aid].size_m) < THIN_M}
     assert {"knife", "spoon", "fork", "scissors"} <= thin and not {"apple", "dice", "plate", "marker"} & thin
     assert {aid for aid, n in got.items() if n == THIN_SOLVER_ITERATIONS} == thin
     assert {n for aid, n in got.items() if aid not in thin} == {15}
-    robot = px_objects(env.agent.robot)[0]
+    robot = px_objects(rigid_scene[RIGID[0]][0].agent.robot)[0]
     assert robot.solver_position_iterations == 15
     knife = catalog()["knife"]
     assert knife.solver_position_iterations(1.0) == THIN_SOLVER_ITERATIONS
@@ -106,7 +114,7 @@ def test_only_thin_objects_get_more_contact_solver_iterations(rigid_scene):
 
 @pytest.mark.parametrize("asset_id", RIGID)
 def test_rigid_asset_size_matches_catalog(rigid_scene, asset_id):
-    env, _ = rigid_scene
+    env, _ = rigid_scene[asset_id]
     lo, hi = entity_aabb(env.obj(f"a_{asset_id}"))
     record = catalog()[asset_id]
     expected = np.asarray(record.size_m)
