@@ -131,8 +131,15 @@ class AssetRecord:
         offset = sapien.Pose(p=[0.0, 0.0, self.origin_dz_m * scale])
         density = e.mass_kg / e.volume_m3 if e.volume_m3 else 500.0  # uniform scaling keeps density
         b = scene.create_actor_builder()
-        b.add_multiple_convex_collisions_from_file(str(self.path(e.collision)), pose=offset, scale=s,
-                                                   material=self._material(), density=density)
+        radius = e.params.get("radius_m") if "pourable" in e.tags else None
+        if radius:  # a bead: a true sphere, which rolls and stacks in a pile without the jitter of a faceted hull
+            r = float(radius) * scale * self.file_scale
+            solid = e.mass_kg / (4.0 / 3.0 * np.pi * float(radius) ** 3)
+            b.add_sphere_collision(pose=sapien.Pose(p=[0.0, 0.0, self.origin_dz_m * scale + r]), radius=r,
+                                   material=self._material(), density=solid)
+        else:
+            b.add_multiple_convex_collisions_from_file(str(self.path(e.collision)), pose=offset, scale=s,
+                                                       material=self._material(), density=density)
         textured = e.visual.endswith((".glb", ".gltf"))  # keep the file's own materials unless a colour is asked for
         look = None if textured and rgba is None else sapien.render.RenderMaterial(base_color=list(rgba or e.rgba),
                                                                                     roughness=0.6)
