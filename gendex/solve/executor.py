@@ -89,7 +89,7 @@ PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press"
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
                "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500,
-               "wipe": 200, "hang": 120, "pour": 200}
+               "wipe": 200, "hang": 120, "pour": 160}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""

@@ -13,6 +13,7 @@ import sapien
 from gendex_envs.assets.catalog import get_asset
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import tilt
+from gendex_envs.physx import px_bodies
 from gendex_envs.pouring import fill_layout, pieces, share
 from gendex_envs.spec import parse_task_spec
 from gendex_envs.success import condition_holds
@@ -58,6 +59,9 @@ def test_beads_start_in_the_glass_and_count_as_poured_only_where_they_lie():
     try:
         env.reset(seed=0)
         assert pieces(env, "glass") == tuple(f"bead_{k}" for k in range(BEADS))
+        shapes = px_bodies(env.obj("bead_0"))[0].collision_shapes  # a true sphere: a pile of them lies still
+        assert [type(c) for c in shapes] == [sapien.physx.PhysxCollisionShapeSphere]
+        assert shapes[0].radius == pytest.approx(get_asset("bead").entry.params["radius_m"])
         _still(env, 40)  # holding still pours nothing: they settled in the glass
         assert float(share(env, "glass", "bowl")[0]) == 0.0
         assert float(share(env, "glass", "glass")[0]) == 1.0
