@@ -9,6 +9,7 @@ import itertools
 import numpy as np
 import pytest
 import yaml
+from hulls import inside_hulls
 
 from gendex_envs.assets.catalog import get_asset
 from gendex_envs.assets.procedural_shapes import GENERATORS
@@ -17,15 +18,6 @@ from gendex_envs.pouring import fill_layout, spec_pieces
 from gendex_envs.spec import parse_task_spec
 
 POURERS = ("tumbler", "beaker", "paper_cup")
-
-
-def _inside(shape, points: np.ndarray) -> np.ndarray:
-    """[P] which points lie inside any collision hull of ``shape``."""
-    hit = np.zeros(len(points), dtype=bool)
-    for h in shape.hulls:
-        d = np.einsum("fk,pfk->pf", h.face_normals, points[:, None, :] - h.triangles[None, :, 0])
-        hit |= (d <= 1e-9).all(axis=1)
-    return hit
 
 
 def test_beads_are_loose_pieces_and_the_pourers_tall_open_vessels():
@@ -52,7 +44,7 @@ def test_beads_laid_in_a_vessel_clear_its_walls_and_each_other(vessel):
                        for u in np.linspace(0, 2 * np.pi, 16) for v in np.linspace(0, np.pi, 9)])
     shape = GENERATORS[vessel]()
     for c in centres:
-        assert not _inside(shape, c + (r - 0.0005) * sphere).any()  # none laid into the glass
+        assert not inside_hulls(shape.hulls, c + (r - 0.0005) * sphere).any()  # none laid into the glass
     assert centres[:, 2].min() - r >= get_asset(vessel).entry.params["cavity_z"]  # on its floor, not under it
     with pytest.raises(ValueError, match="do not fit"):
         fill_layout(get_asset(vessel), bead, 200)

@@ -9,6 +9,7 @@ from functools import cache
 import numpy as np
 import pytest
 import trimesh
+from hulls import inside_hulls
 
 from gendex_envs.assets import build_objects
 from gendex_envs.assets.manifest import DATA_DIR, MANIFEST, read_manifest
@@ -56,16 +57,6 @@ def _visual(asset_id: str) -> trimesh.Trimesh:
     blocks = _parse_obj(OBJECTS / BY_ID[asset_id].visual)
     assert len(blocks) == 1
     return trimesh.Trimesh(blocks[0][1], blocks[0][2], process=False)
-
-
-def _inside_any(hulls, points, tol=0.0) -> np.ndarray:
-    """Which points lie in (or within tol of) at least one convex hull (half-space test on its faces)."""
-    points = np.atleast_2d(points)
-    hit = np.zeros(len(points), dtype=bool)
-    for h in hulls:
-        d = np.einsum("pfk,fk->pf", points[:, None, :] - h.triangles[None, :, 0, :], h.face_normals)
-        hit |= np.all(d <= tol, axis=1)
-    return hit
 
 
 def _size(asset_id):
@@ -181,9 +172,9 @@ def test_container_cavity_is_open_and_floored(asset_id):
     x, y, floor, rim = p["cavity_x"], p["cavity_y"], p["cavity_z"], p["rim_z"]
     assert rim - floor > 0.02
     axis = np.column_stack([np.full(20, x), np.full(20, y), np.linspace(floor + 0.01, rim - 0.003, 20)])
-    assert not _inside_any(hulls, axis).any(), "the cavity is filled"
-    assert not _inside_any(hulls, [[x, y, floor + 0.01]]).any()
-    assert _inside_any(hulls, [[x, y, floor - 0.002]]).all(), "no floor under the cavity"
+    assert not inside_hulls(hulls, axis).any(), "the cavity is filled"
+    assert not inside_hulls(hulls, [[x, y, floor + 0.01]]).any()
+    assert inside_hulls(hulls, [[x, y, floor - 0.002]]).all(), "no floor under the cavity"
 
 
 @pytest.mark.parametrize("asset_id", CONTAINERS)
@@ -199,7 +190,7 @@ def test_container_wall_has_no_gaps(asset_id):
         for dr in (-0.001, 0.0, 0.001):
             ring = np.column_stack([p["cavity_x"] + (r + dr) * np.cos(theta), p["cavity_y"] + (r + dr) * np.sin(theta),
                                     np.full(len(theta), p[f"{s}_z"])])
-            assert _inside_any(hulls, ring).all(), (s, dr)
+            assert inside_hulls(hulls, ring).all(), (s, dr)
 
 
 def test_mug_has_a_handle():
@@ -208,7 +199,7 @@ def test_mug_has_a_handle():
     x_out = BY_ID["mug"].bbox_max_m[0]
     assert x_out - p["cavity_x"] > 0.06  # the handle reaches well beyond the 4.1 cm body radius
     grip = [[x_out - 0.005, p["cavity_y"], p["cavity_z"] + 0.04]]
-    assert _inside_any(hulls, grip).all()
+    assert inside_hulls(hulls, grip).all()
 
 
 # ------------------------------------------------------------------------------------------------ building blocks
@@ -226,10 +217,10 @@ def test_vessel_decomposition_matches_analytic_volume():
     wall = sum(m.volume for m in meshes[1:])  # wedges overlap by 2 x 12 % and fill the inner chord of their arc
     assert ring * (H - f) < wall < 1.5 * ring * H
     around = np.linspace(0, 2 * np.pi, 200)
-    assert _inside_any(meshes, revolve_pts([[R - t / 2, H / 2]], around)).all()  # the wall is closed
-    assert not _inside_any(meshes, revolve_pts([[R - t - 0.0015, H / 2]], around)).any()  # chords stay < 1.5 mm
-    assert not _inside_any(meshes, revolve_pts([[R + 0.0005, H / 2]], around)).any()
-    assert not _inside_any(meshes, [[0, 0, f + 0.01], [0.02, 0.0, 0.05]]).any()
+    assert inside_hulls(meshes, revolve_pts([[R - t / 2, H / 2]], around)).all()  # the wall is closed
+    assert not inside_hulls(meshes, revolve_pts([[R - t - 0.0015, H / 2]], around)).any()  # chords stay < 1.5 mm
+    assert not inside_hulls(meshes, revolve_pts([[R + 0.0005, H / 2]], around)).any()
+    assert not inside_hulls(meshes, [[0, 0, f + 0.01], [0.02, 0.0, 0.05]]).any()
     assert info["floor_z"] == f and info["top_z"] == H
 
 
@@ -238,7 +229,7 @@ def test_tube_chain_covers_its_path():
     vis, hulls = tube(path, 0.01, 0.01, hull_every=2)
     assert vis.is_watertight and vis.volume > 0 and len(hulls) == 4
     meshes = [trimesh.convex.convex_hull(h) for h in hulls]
-    assert _inside_any(meshes, path).all()
+    assert inside_hulls(meshes, path).all()
 
 
 # ------------------------------------------------------------------------------------------------ determinism
