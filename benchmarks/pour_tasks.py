@@ -17,6 +17,7 @@ from pathlib import Path
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from gendex_envs.task_version import TaskLayout
 from tests.sim.test_pour import _task  # the spec the tests check
 
 TASKS = (("PourBeadsTumbler", "tumbler", "bowl"), ("PourBeadsBeaker", "beaker", "bowl_large"),
@@ -56,10 +57,10 @@ def main() -> None:
     ap.add_argument("out", type=Path, help="folder to write <Name>/v0/ task folders into")
     out = ap.parse_args().out
     for name, vessel, bowl in TASKS:
-        folder = out / name / "v0"
-        folder.mkdir(parents=True, exist_ok=True)
-        (folder / "task.yaml").write_text(yaml.safe_dump({**_task(vessel, bowl), "name": name}, sort_keys=False))
-        (folder / "reward.py").write_text(REWARD)
+        files = TaskLayout(out / name / "v0")
+        files.spec.parent.mkdir(parents=True, exist_ok=True)
+        files.spec.write_text(yaml.safe_dump({**_task(vessel, bowl), "name": name}, sort_keys=False))
+        files.reward.write_text(REWARD)
 
 
 if __name__ == "__main__":
