@@ -63,12 +63,10 @@ WALL_M = 0.004
 
 @dataclass(frozen=True)
 class Pour:
-    """One way to pour: the palm pose before tipping, where the palm's origin is once tipped (it turns about itself,
-    coming down :data:`RISE_M`), the tip as a rotation vector (world), and the turn of the held vessel about the
-    vertical from now."""
+    """One way to pour: the palm pose before tipping (the tip turns the palm about itself, :func:`tip_pose`), the tip
+    as a rotation vector (world), and the turn of the held vessel about the vertical from now."""
 
     pre: sapien.Pose
-    tipped_at: np.ndarray
     rotvec: np.ndarray
     turn_rad: float
 
@@ -131,7 +129,7 @@ def pour_poses(env, held: str, target: str, palm: sapien.Pose, vessel: sapien.Po
         lip = points[int(np.argmin(points[:, 2]))]
         goal = np.array([centre[0], centre[1], rim + LIP_OVER_RIM_M]) - LIP_BACK_M * d
         at = goal - lip  # the palm's origin once tipped
-        out.append(Pour(sapien.Pose(at + RISE_M * up, palm0.q), at, a * TILT_RAD, float(abs(turn))))
+        out.append(Pour(sapien.Pose(at + RISE_M * up, palm0.q), a * TILT_RAD, float(abs(turn))))
     return out
 
 
