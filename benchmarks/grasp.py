@@ -86,7 +86,7 @@ def main() -> None:
     ap.add_argument("--markdown", type=Path, help="write a markdown table here")
     ap.add_argument("--record", action="store_true",
                     help="store the rates in gendex/solve/grasp_measured.json (the offline author only proposes "
-                         "objects measured at >= 90 %%)")
+                         "objects measured at >= 90 %%); with --objects, only theirs, the others' kept")
     args = ap.parse_args()
     logging.basicConfig(level=logging.ERROR)
     objects = args.objects or graspable()
@@ -123,7 +123,7 @@ def main() -> None:
     if args.record:
         from gendex.solve.lift_check import write_record
 
-        write_record(rows, seeds)
+        write_record(rows, seeds, merge=bool(args.objects))
 
 
 class _Serial:

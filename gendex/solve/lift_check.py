@@ -161,11 +161,16 @@ def measured_graspable(min_rate: float = 0.9, path: Path = MEASURED_FILE) -> fro
     return frozenset(a for a, rate in measured_rates(path).items() if rate >= min_rate)
 
 
-def write_record(rows: list[dict], seeds: list[int], path: Path = MEASURED_FILE) -> None:
-    """Record a ``benchmarks/grasp.py`` run (what :func:`measured_graspable` reads)."""
+def write_record(rows: list[dict], seeds: list[int], path: Path = MEASURED_FILE, merge: bool = False) -> None:
+    """Record a ``benchmarks/grasp.py`` run (what :func:`measured_graspable` reads). ``merge``: keep the record's other
+    assets and replace only those of ``rows`` (a run over some objects), each that was measured on other seeds than
+    the record's with its own."""
+    old = json.loads(path.read_text()) if merge and path.is_file() else {"seeds": seeds, "assets": {}}
+    assets = dict(old["assets"])
+    for r in rows:
+        assets[r["asset"]] = {"held": r["held"], "attempts": r["attempts"], "scale": r["scale"],
+                              **({"seeds": seeds} if seeds != old["seeds"] else {})}
     record = {"what": "lift-and-hold per graspable catalog asset at the scale a task holds it "
                       "(gendex.solve.lift_check), benchmarks/grasp.py",
-              "seeds": seeds,
-              "assets": {r["asset"]: {"held": r["held"], "attempts": r["attempts"], "scale": r["scale"]}
-                         for r in rows}}
+              "seeds": old["seeds"], "assets": assets}
     path.write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
