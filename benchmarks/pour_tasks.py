@@ -1,7 +1,7 @@
 """Write the three hand-written pour tasks the pour primitive was measured on before the offline author wrote any
 (records: ``benchmarks/results/skills.md``): a tumbler, a beaker and a paper cup, each holding twelve beads, poured
 into a bowl (the beaker into the large bowl). They are the spec of ``tests/sim/test_pour.py`` under three names, with
-a small reward module; they are not library tasks.
+the reward module the generator writes for a pour (:mod:`generator.reward_library`); they are not library tasks.
 
     .venv/bin/python benchmarks/pour_tasks.py /tmp/pourtasks
     GENDEX_TASKS_PATH=/tmp/pourtasks .venv/bin/python benchmarks/skill.py --tasks GenDex/PourBeadsTumbler-v0 \\
@@ -18,38 +18,11 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from gendex_envs.task_version import TaskLayout
+from generator.reward_library import compose_task_module
 from tests.sim.test_pour import _task  # the spec the tests check
 
 TASKS = (("PourBeadsTumbler", "tumbler", "bowl"), ("PourBeadsBeaker", "beaker", "bowl_large"),
          ("PourBeadsPaperCup", "paper_cup", "bowl"))
-REWARD = '''"""A hand-written pour task for measuring the pour primitive (not a library task)."""
-
-import torch
-
-from gendex_envs import reward_terms as rt
-
-REWARD_MAX = 5.0
-
-
-def evaluate(env):
-    fail = env.obj_pose('glass').p[:, 2] < env.table_height - 0.05  # fell off the table
-    force = env.agent.get_hand_group_obj_mean_force(env.obj('glass'))  # [N, 6, 1]
-    return {"fail": fail, "contact": rt.contact(force), "poured": env.poured_share('glass', 'bowl')}
-
-
-def compute_dense_reward(env, obs, action, info):
-    p = env.obj_pose('glass').p
-    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
-    held = info["contact"] > 0.2
-    near = rt.place(p, env.obj_pose('bowl').p) * held
-    reward = reach + info["contact"] + near + 2.0 * info["poured"]
-    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
-
-
-def _get_obs_extra(env, info):
-    return {"palm_to_obj": env.obj_pose('glass').p - env.palm_pose.p,
-            "obj_to_bowl": env.obj_pose('bowl').p - env.obj_pose('glass').p, "poured": info["poured"][:, None]}
-'''
 
 
 def main() -> None:
@@ -59,8 +32,9 @@ def main() -> None:
     for name, vessel, bowl in TASKS:
         files = TaskLayout(out / name / "v0")
         files.spec.parent.mkdir(parents=True, exist_ok=True)
-        files.spec.write_text(yaml.safe_dump({**_task(vessel, bowl), "name": name}, sort_keys=False))
-        files.reward.write_text(REWARD)
+        spec = {**_task(vessel, bowl), "name": name}
+        files.spec.write_text(yaml.safe_dump(spec, sort_keys=False))
+        files.reward.write_text(compose_task_module(spec, {"glass": "graspable", "bowl": "container"}))
 
 
 if __name__ == "__main__":

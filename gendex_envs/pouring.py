@@ -10,8 +10,10 @@ never disagree about one bead.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import weakref
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import torch
@@ -20,6 +22,7 @@ from gendex_envs.errors import TaskSpecError
 from gendex_envs.placement import starts_in
 
 if TYPE_CHECKING:  # pragma: no cover
+    from gendex_envs.spec import TaskSpec
     from gendex_envs.task_env import TaskEnv
 
 POURABLE_TAG = "pourable"
@@ -30,6 +33,8 @@ RING_FRACTION = 0.4
 mouth)."""
 PIECE_GAP_M = 0.0015
 """Gap between neighbouring pieces of a layer, and between layers, as laid (they settle at the first steps)."""
+MAX_PIECES = 24
+"""At most this many pieces fill one vessel (each is an object of the task, and a task holds at most 64)."""
 
 _PIECES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
@@ -89,3 +94,66 @@ def share(env: TaskEnv, vessel: str, target: str) -> torch.Tensor:
 
     names = pieces(env, vessel)
     return torch.stack([in_container(env, n, target) for n in names], dim=-1).float().mean(dim=-1)
+
+
+def lay_pieces(spec: TaskSpec, vessel: str, piece_asset: str, count: int,
+               names: Sequence[str] | None = None) -> TaskSpec:
+    """``spec`` with ``count`` pieces of catalog asset ``piece_asset`` laid in its object ``vessel`` where that
+    stands (its position, turn about the vertical and scale; :func:`fill_layout`), as objects named ``names`` (the
+    vessel's pieces before, which they replace; by default ``<piece_asset>_<k>``, the first free k). TaskSpecError
+    if the vessel is not an object of ``spec``, the asset is not a piece (tag :data:`POURABLE_TAG`), ``count`` is
+    outside 1..:data:`MAX_PIECES` or the pieces do not fit below the vessel's rim."""
+    from gendex_envs.assets.catalog import get_asset
+    from gendex_envs.spec import ObjectSpec
+
+    by_name = {o.name: o for o in spec.objects}
+    if vessel not in by_name:
+        raise TaskSpecError(f"cannot fill {vessel!r}: it is not an object of task {spec.name!r} ({sorted(by_name)})")
+    piece = get_asset(piece_asset)
+    if POURABLE_TAG not in piece.tags:
+        raise TaskSpecError(f"cannot fill {vessel!r} with {piece_asset!r}: a vessel holds loose pieces, catalog assets "
+                            f"tagged {POURABLE_TAG!r} (e.g. bead, marble)")
+    if not 1 <= count <= MAX_PIECES:
+        raise TaskSpecError(f"cannot fill {vessel!r} with {count} pieces: 1 to {MAX_PIECES} fill one vessel")
+    v = by_name[vessel]
+    try:
+        laid = fill_layout(get_asset(v.asset), piece, count, v.scale)
+    except ValueError as exc:
+        raise TaskSpecError(f"cannot fill {vessel!r} ({v.asset} at scale {v.scale:g}): {exc}") from None
+    kept = [o for o in spec.objects if o.name not in set(names or ())]
+    taken = {o.name for o in kept}
+    if names is None or len(names) != count:
+        fresh = (f"{piece_asset}_{k}" for k in range(count + len(taken) + 1))
+        names = [n for n in fresh if n not in taken][:count]
+    w, _, _, z = v.quat_wxyz
+    yaw = 2.0 * math.atan2(z, w)  # a vessel stands upright: its turn about the vertical
+    c, s = math.cos(yaw), math.sin(yaw)
+    x0, y0, z0 = v.pos_m
+    pieces_ = [ObjectSpec(name=n, asset=piece_asset, pos_m=(round(x0 + c * dx - s * dy, 4),
+                                                             round(y0 + s * dx + c * dy, 4), round(z0 + dz, 4)))
+               for n, (dx, dy, dz) in zip(names, laid, strict=True)]
+    return dataclasses.replace(spec, objects=(*kept, *pieces_))
+
+
+def spec_fills(spec: TaskSpec) -> dict[str, tuple[str, ...]]:
+    """The objects of ``spec`` that hold pieces, each with its pieces' names (:func:`spec_pieces`)."""
+    from gendex_envs.assets.catalog import get_asset
+
+    records = {o.name: get_asset(o.asset) for o in spec.objects}
+    out = {}
+    for o in spec.objects:
+        if POURABLE_TAG not in records[o.name].tags and "container" in records[o.name].tags:
+            found = spec_pieces(spec, records, o.name)
+            if found:
+                out[o.name] = found
+    return out
+
+
+def refill(spec: TaskSpec, fills: Mapping[str, Sequence[str]]) -> TaskSpec:
+    """``spec`` with the pieces of each vessel of ``fills`` (:func:`spec_fills` of the spec before an edit) laid
+    again where the vessel now stands: a vessel moved, turned or scaled carries its pieces, as at reset."""
+    by_name = {o.name: o for o in spec.objects}
+    for vessel, names in fills.items():
+        if vessel in by_name and names and names[0] in by_name:
+            spec = lay_pieces(spec, vessel, by_name[names[0]].asset, len(names), names)
+    return spec

@@ -200,6 +200,9 @@ ROLE_TESTS = {
     "wipe_area": lambda a: "wipe_area" in a["tags"] and not a.get("joints"),
     "hangable": lambda a: "hangable" in a["tags"] and not a.get("joints"),
     "hang_on": lambda a: "hang_on" in a["tags"] and not a.get("joints"),
+    "pourable": lambda a: "pourable" in a["tags"] and not a.get("joints"),
+    "pourer": lambda a: "pourer" in a["tags"] and not a.get("joints"),
+    "pour_into": lambda a: is_container(a) and "pourer" not in a["tags"] and min(a["size_m"][:2]) >= 0.14,
 }
 """What an object must be to play each role."""
 
@@ -209,7 +212,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
     "twist": ("screwable",), "insert": ("insertable", "socket"), "wipe": ("wiper", "wipe_area"),
-    "hang": ("hangable", "hang_on"),
+    "hang": ("hangable", "hang_on"), "pour": ("pourable", "pourer", "pour_into"),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -371,7 +374,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in no_object
                 or (len(w) < 3 and not w.isdigit())):
             continue
-        if w in _VERB_WORDS or w in _FILLER:
+        named_next = k > 0 and words[k - 1] in DETERMINERS and any(i == k + 1 for i, _, _ in spans)
+        if (w in _VERB_WORDS and not named_next) or w in _FILLER:  # 'the empty bowl': a word about the bowl
             continue
         in_phrase = k > 0 and (words[k - 1] in DETERMINERS or (unknown and unknown[-1][0] == k - 1)
                                or used[k - 1] or (k + 1 < len(words) and used[k + 1]))

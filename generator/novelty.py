@@ -69,6 +69,7 @@ def spec_signature(spec: TaskSpec) -> Signature:
 def proposal_signature(proposal: dict) -> Signature:
     """The signature of a proposal as a backend writes it (the JSON object the propose step parses)."""
     objects = {o["name"]: asset_dict(o["asset"]) for o in proposal["objects"]}
+    pieces = [asset_dict(o["fill"]["asset"]) for o in proposal["objects"] if o.get("fill")]  # objects of the spec
     found = set()
     for succ in (proposal["success"], *(proposal.get("also") or ())):
         obj, target = objects.get(succ.get("object")), objects.get(succ.get("target"))
@@ -81,7 +82,7 @@ def proposal_signature(proposal: dict) -> Signature:
     how = {_how(c["type"], bool(c.get("negate")), part_of(objects[c["object"]]) if objects.get(
         c.get("object"), {}).get("joints") else None) for c in (proposal["success"], *(proposal.get("also") or ()))}
     return (tuple(k for k in TASK_SKILLS if k in found) + tuple(sorted(how - {None})),
-            tuple(sorted({kind(a) for a in objects.values()})))
+            tuple(sorted({kind(a) for a in (*objects.values(), *pieces)})))
 
 
 def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:

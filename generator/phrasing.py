@@ -58,6 +58,9 @@ NAMES: dict[str, tuple[str, ...]] = {
     "cutting_board": ("cutting board", "chopping board"),
     "tray": ("tray", "serving tray"),
     "valve": ("valve", "ball valve", "shutoff valve"),
+    "tumbler": ("tumbler", "drinking glass", "water glass"),
+    "beaker": ("beaker", "lab beaker", "measuring beaker"),
+    "paper_cup": ("paper cup", "disposable cup", "takeaway cup"),
 }
 """Words for a catalog category (default: the category with spaces); every one is read back to that category by
 :mod:`generator.instruction`."""
@@ -74,6 +77,10 @@ MODEL_WORDS: dict[str, str] = {
 }
 """Words that tell a model from its siblings (articulated models, pegs), read back by :mod:`generator.instruction` as
 that model: two tasks on sibling models must not read alike."""
+
+PIECE_NAMES: dict[str, tuple[str, ...]] = {"bead": ("beads", "ceramic beads", "pellets"),
+                                           "marble": ("marbles", "glass marbles")}
+"""Words for the loose pieces a vessel pours (plural: there are a dozen), read back as that piece."""
 
 SURFACES = ("table", "tabletop", "counter", "worktop")
 
@@ -203,6 +210,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "hang the {o} up on the {d} by the handle",
         "hang the {o} by its handle from the {d}",
         "hang up the {o} on the {d}",
+    ),
+    "pour": (
+        "pour the {p} from the {o} into the {d}",
+        "tip the {p} out of the {o} into the {d} and stand the {o} up again",
+        "empty the {o} of {p} into the {d}",
+        "pour the {p} in the {o} out into the {d} and stand the {o} upright again",
+        "tip the {o} over the {d} until the {p} fall in",
     ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",
@@ -431,6 +445,8 @@ class Part:
     other_qualifier: str = ""
     amount: str = ""
     """How far a part-way open or turn goes, in words (*halfway*, *45 degrees*)."""
+    pieces: str = ""
+    """The catalog id of the pieces a pour pours (*beads*, *marbles*: :data:`PIECE_NAMES`)."""
 
 
 def command(part: Part, rng: np.random.Generator, surface: str) -> str:
@@ -440,7 +456,9 @@ def command(part: Part, rng: np.random.Generator, surface: str) -> str:
     articulated = bool(part.main.get("joints"))
     o = _pick(rng, names_for(part.main, part.main_qualifier or MODEL_WORDS.get(part.main["id"], "")))
     d = _pick(rng, names_for(part.other, part.other_qualifier)) if part.other is not None else o
-    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface, a=part.amount)
+    p = _pick(rng, PIECE_NAMES.get(part.pieces, (part.pieces.replace("_", " ") + "s",))) if part.pieces else ""
+    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface, a=part.amount,
+                                                   p=p)
 
 
 def qualifiers(a: dict, b: dict | None, colors: tuple[str | None, ...] = ()) -> dict[str, str]:
@@ -464,10 +482,11 @@ def painted(a: dict, colors: tuple[str | None, ...], k: int) -> tuple[str, ...]:
 
 
 def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | None = None,
-           main_qualifier: str = "", other_qualifier: str = "", amount: str = "",
+           main_qualifier: str = "", other_qualifier: str = "", amount: str = "", pieces: str = "",
            choose: Chooser | None = None) -> str:
     """An instruction for one :class:`Part` (see there and :func:`phrase_parts` for the arguments)."""
-    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier, amount)], rng, choose=choose)
+    return phrase_parts([Part(skill, main, other, main_qualifier, other_qualifier, amount, pieces)], rng,
+                        choose=choose)
 
 
 def direction(skill: str) -> str | None:
@@ -567,6 +586,6 @@ def split(instruction: str) -> tuple[str | None, str, str | None]:
     return situation, text[:1].lower() + text[1:] if situation is None else text, purpose
 
 
-__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS", "SITUATIONS_DIRECTED",
-           "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for", "object_words",
-           "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]
+__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PIECE_NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS",
+           "SITUATIONS_DIRECTED", "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for",
+           "object_words", "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]

@@ -8,7 +8,8 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 ROLES = ("graspable", "container", "articulated", "support")
-PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "joint_at", "near", "over", "placed", "wiped", "hung")
+PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "joint_at", "near", "over", "placed", "wiped", "hung",
+                            "poured")
 """Success condition types a proposal may state (the task's success; stages get theirs in the plan step)."""
 
 
@@ -25,6 +26,9 @@ class ProposedObject:
     """The named colour the task paints it (``gendex_envs.attributes.COLORS``); None: the asset's own."""
     starts_in: str | None = None
     """The name of the proposal's container this object starts inside (*take the apple out of the bowl*)."""
+    fill: dict[str, Any] | None = None
+    """What a vessel to pour from holds: ``{"asset": <a catalog piece, tag pourable>, "count": <pieces>}``; GenDex
+    lays the pieces in it (:func:`gendex_envs.pouring.lay_pieces`), each its own object of the task."""
 
 
 @dataclass(frozen=True)

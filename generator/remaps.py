@@ -8,7 +8,13 @@
   square hole*, *push the peg into the hole*, *insert the peg*); a peg picked up, or pushed to the goal, stays a
   lift or a push;
 - a wipe names its sponge and its spill in either order (*wipe the spill with the sponge*, *use the sponge to wipe
-  the spill*): the sponge is put first; a spill named alone gets the catalog's sponge after it.
+  the spill*): the sponge is put first; a spill named alone gets the catalog's sponge after it;
+- a pour names its pieces, its vessel and the container in any order, or leaves some out (*pour the beads from the
+  glass into the bowl*, *empty the beaker into the bowl*, *tip the glass of marbles into the large bowl*): the pieces
+  first, then the vessel, then the container, and what is left unsaid is the catalog's first that can be it; a
+  glass or a cup one pours from is the vessel of :data:`~generator.vocabulary.POUR_VESSELS` (a wine glass or a
+  teacup is none), and pieces the catalog lacks (*the rice*) are its closest pieces, a recorded substitution; a lid
+  tipped back (*tip the bin's lid back to open it*) is an ``open``.
 """
 
 from __future__ import annotations
@@ -71,7 +77,35 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
     if r.skill == "hang":  # 'hang the mug on the tree', 'onto the rack, hang the mug': the mug first
         hung = [m for m in r.mentions if plays(m, "hangable")]
         r = dataclasses.replace(r, mentions=hung + [m for m in r.mentions if m not in hung])
+    if r.skill == "pour" and r.mentions and all(plays(m, "openable") for m in r.mentions):
+        r = Read("open", SKILL_ROLES["open"], None, None, r.mentions)  # 'tip the bin's lid back to open it'
+    if r.skill == "pour":
+        r = _pour_order(r, plays, assets)
     return r
+
+
+def _pour_order(r: Read, plays, assets: Sequence[dict]) -> Read:
+    """A pour's mentions as pieces, vessel, container, with its roles in that order and the unsaid ones last (module
+    docstring)."""
+    from generator.instruction import SKILL_ROLES
+    from generator.vocabulary import POUR_VESSELS
+
+    mentions = []
+    for m in r.mentions:
+        word = m.phrase.split()[-1] if m.phrase else ""
+        if m.asset and not plays(m, "pourer") and word in POUR_VESSELS and not plays(m, "pour_into"):
+            vessel = POUR_VESSELS[word]
+            m = dataclasses.replace(m, asset=vessel, options=(vessel,), how="synonym", color=None,
+                                    detail=f"a {word} to pour from: the {vessel.replace('_', ' ')}")
+        mentions.append(m)
+    pieces = [m for m in mentions if plays(m, "pourable")]
+    vessels = [m for m in mentions if plays(m, "pourer") and m not in pieces]
+    rest = [m for m in mentions if m not in pieces and m not in vessels]
+    if not pieces and rest and rest[0].how == "substitute":  # 'pour the rice ...': pieces the catalog lacks
+        pieces, rest = rest[:1], rest[1:]
+    named = ["pourable"] * bool(pieces) + ["pourer"] * bool(vessels) + ["pour_into"] * bool(rest)
+    roles = tuple(named) + tuple(x for x in SKILL_ROLES["pour"] if x not in named)
+    return dataclasses.replace(r, roles=roles, mentions=pieces + vessels + rest)
 
 
 def _screw_model(m: Mention, assets: Sequence[dict]) -> Mention | None:

@@ -57,26 +57,30 @@ def _get_obs_extra(env, info):
 """Reward of a push: the palm to the object, the object to the goal mark (format with ``fail`` and ``obj``)."""
 
 
-_WIPE = '''REWARD_MAX = 5.0
+_SHARE = '''REWARD_MAX = 5.0
 
 
 def evaluate(env):
-{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
-    return {{"fail": fail, "contact": rt.contact(force), "wiped": env.wiped_share({obj!r}, {area!r})}}
+{{fail}}    force = env.agent.get_hand_group_obj_mean_force(env.obj({{obj!r}}))  # [N, 6, 1]
+    return {{{{"fail": fail, "contact": rt.contact(force), "{key}": env.{key}_share({{obj!r}}, {{{to}!r}})}}}}
 
 
 def compute_dense_reward(env, obs, action, info):
-    p = env.obj_pose({obj!r}).p
+    p = env.obj_pose({{obj!r}}).p
     reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
-    over = rt.place(p, env.obj_pose({area!r}).p) * (info["contact"] > 0.2)
-    reward = reach + info["contact"] + over + 2.0 * info["wiped"]
+    {near} = rt.place(p, env.obj_pose({{{to}!r}}).p) * (info["contact"] > 0.2)
+    reward = reach + info["contact"] + {near} + 2.0 * info["{key}"]
     return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
 
 
 def _get_obs_extra(env, info):
-    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p,
-            "obj_to_area": env.obj_pose({area!r}).p - env.obj_pose({obj!r}).p, "wiped": info["wiped"][:, None]}}
+    return {{{{"palm_to_obj": env.obj_pose({{obj!r}}).p - env.palm_pose.p,
+            "obj_to_{to}": env.obj_pose({{{to}!r}}).p - env.obj_pose({{obj!r}}).p, "{key}": info["{key}"][:, None]}}}}
 '''
+"""A reward towards a share of things done with a held object (format with ``key``: ``wiped`` or ``poured``, whose
+``env.<key>_share`` it reads, ``near``: the name of the term bringing the object to ``to``, the target's
+placeholder): the palm to the object, holding it, the held object brought to the target, then the share."""
+_WIPE = _SHARE.format(key="wiped", near="over", to="area")
 """Reward of a wipe (format with ``fail``, ``obj``: the sponge, ``area``: the spill): the palm to the sponge, holding
 it, the held sponge over the spill, then the share of the spill's marks wiped."""
 
@@ -108,6 +112,11 @@ def _get_obs_extra(env, info):
 holding it, the held mug raised and brought to the stand; success (hung on a peg, let go, still) pays the most."""
 
 
+_POUR = _SHARE.format(key="poured", near="near", to="into")
+"""Reward of a pour (format with ``fail``, ``obj``: the vessel, ``into``: the container): the palm to the vessel,
+holding it, the held vessel brought to the container, then the share of its pieces that lie in the container."""
+
+
 def _header(title: str) -> str:
     """The module header, its title wrapped to docstring width (an instruction may be a long sentence)."""
     return _HEADER_TEMPLATE.format(title=textwrap.fill(title, width=100))
@@ -137,7 +146,13 @@ def _stage(spec: dict, name: str) -> dict:
 
 
 def _rigid(spec: dict, roles: dict[str, str]) -> list[str]:
-    return [o["name"] for o in spec["objects"] if roles.get(o["name"]) != "articulated" and not o.get("fixed")]
+    """The objects whose fall off the table fails the task: the movable ones but the pieces a vessel pours (a bead
+    bouncing off the table is a pour that spilled a little: the share poured says how much)."""
+    from gendex_envs.assets.catalog import get_asset
+    from gendex_envs.pouring import POURABLE_TAG
+
+    return [o["name"] for o in spec["objects"] if roles.get(o["name"]) != "articulated" and not o.get("fixed")
+            and POURABLE_TAG not in get_asset(o["asset"]).tags]
 
 
 def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> str:
@@ -155,6 +170,8 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
         return src + _WIPE.format(fail=fail, obj=cond["object"], area=cond["target"])
     if cond["type"] == "hung":
         return src + _HANG.format(fail=fail, obj=cond["object"], stand=cond["target"])
+    if cond["type"] == "poured" and kind == "pour":
+        return src + _POUR.format(fail=fail, obj=cond["object"], into=cond["target"])
     if kind in JOINT_SKILLS:
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
@@ -394,6 +411,8 @@ def _get_obs_extra(env, info):
         return src + _WIPE.format(fail=fail, obj=obj, area=target)
     if cond["type"] == "hung":
         return src + _HANG.format(fail=fail, obj=obj, stand=target)
+    if cond["type"] == "poured":
+        return src + _POUR.format(fail=fail, obj=obj, into=target)
     carry = _carry_term(target, placed_goal(cond, spec))
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1

@@ -5,7 +5,8 @@ follow the reference tasks: a grasp holds the target with the thumb against two 
 fingers, no thumb), a lift holds it at the task's lift height, a release leaves the task's success met with the hand
 let go, an open, close or turn moves the joint past the task's fraction (a turn back below it when the task's
 condition is the joint shut: turning off; to the task's ``joint_at`` fraction when it has one; a twist's unscrewed
-cap ends in the hand), a push meets the task's condition on the pushed object, a wipe the task's wipe of its area.
+cap ends in the hand), a push meets the task's condition on the pushed object, a wipe the task's wipe of its area, a
+pour the task's pour into its container.
 Skills without a template (reach, carry, place, reorient) declare nothing, so the stage succeeds with the task.
 """
 
@@ -68,6 +69,8 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         return [dict(c) for c in task_conditions if c.get("object") == target] or None
     if skill == "hang":  # hung on the peg, still in the hand: the release stage ends where the task does
         return None
+    if skill == "pour":  # the task's pour into this container
+        return [dict(c) for c in task_conditions if c.get("type") == "poured" and c.get("target") == target] or None
     if skill == "wipe":  # the task's wipe of this area
         return [dict(c) for c in task_conditions if c.get("type") == "wiped" and c.get("target") == target] or None
     return None

@@ -63,6 +63,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("hang", ("hang up", "hang"),
               "a mug hung by its handle on a peg of a mug hook, mug tree or mug rack, and let go (it hangs there, "
               "off the table, at rest)", "hang the mug on the mug tree"),
+    TaskSkill("pour", ("pour out", "pour", "tip out", "tip", "empty out", "empty"),
+              "the beads or marbles in a glass, beaker or paper cup poured into a bowl (at least 75 % of them), and "
+              "the vessel stood up again", "pour the beads from the glass into the bowl"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",
@@ -105,6 +108,10 @@ SYNONYMS: dict[str, str] = {
     "hook": "mug_hook", "wall hook": "mug_hook", "cup hook": "mug_hook", "coat hook": "mug_hook",
     "mug stand": "mug_tree", "cup tree": "mug_tree", "tree": "mug_tree", "wall rack": "mug_rack",
     "cup rack": "mug_rack", "hanging rack": "mug_rack", "rack": "mug_rack",
+    "drinking glass": "tumbler", "water glass": "tumbler", "tumbler glass": "tumbler", "lab beaker": "beaker",
+    "measuring beaker": "beaker", "glass beaker": "beaker", "disposable cup": "paper_cup",
+    "takeaway cup": "paper_cup", "coffee cup": "paper_cup", "marbles": "marble", "glass marbles": "marble",
+    "glass beads": "marble", "pellets": "bead", "ceramic beads": "bead",
     "round peg": "peg_round", "square peg": "peg_square", "thin peg": "peg_thin", "dowel": "peg_thin",
     "hand over mat": "handover_mat", "hand over zone": "handover_mat", "handover zone": "handover_mat",
     "hand over area": "handover_mat", "handover area": "handover_mat", "hand over spot": "handover_mat",
@@ -114,6 +121,10 @@ SYNONYMS: dict[str, str] = {
     "wide mouth bottle": "screw_bottle", "water bottle": "screw_bottle", "sports bottle": "screw_bottle",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
+
+POUR_VESSELS: dict[str, str] = {"glass": "tumbler", "cup": "paper_cup", "beaker": "beaker", "tumbler": "tumbler"}
+"""What a vessel named in a pour is, where the word names no vessel one pours from (a glass of beads is a tumbler,
+not a wine glass; a cup of them a paper cup, not a teacup)."""
 
 KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block": "block", "food": "food",
                          "tool": "tool", "utensil": "utensil", "container": "container", "box": "box",
@@ -138,4 +149,5 @@ FILLER_WORDS = frozenset(
 """Words after the verb that name no object (places on the table among them)."""
 
 
-__all__ = ["FILLER_WORDS", "KINDS", "ORDINALS", "PARTS", "STOP_WORDS", "SYNONYMS", "TASK_SKILLS", "TaskSkill"]
+__all__ = ["FILLER_WORDS", "KINDS", "ORDINALS", "PARTS", "POUR_VESSELS", "STOP_WORDS", "SYNONYMS", "TASK_SKILLS",
+           "TaskSkill"]

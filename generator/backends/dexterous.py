@@ -1,6 +1,6 @@
-"""The offline author's tasks of two dexterous skills that need an exact fit or a press: a peg put into the hole it
-fits (``insert``), a spill wiped with a sponge pressed down on it (``wipe``), and a mug hung by its handle on a peg
-(``hang``). Each returns a proposal (a dict,
+"""The offline author's tasks of dexterous skills that need an exact fit, a press or a tip of the wrist: a peg put
+into the hole it fits (``insert``), a spill wiped with a sponge pressed down on it (``wipe``), a mug hung by its
+handle on a peg (``hang``), and the beads in a glass poured into a bowl (``pour``). Each returns a proposal (a dict,
 as :mod:`generator.backends.offline` writes them); ``words(name)`` is the author's generator that words a task."""
 
 from __future__ import annotations
@@ -22,6 +22,12 @@ HANG_LIFT_M = 0.05
 WIPE_FRACTION = 0.9
 """A wiped spill has had this share of its marks passed over by the pressed sponge (the solver goes back over what
 it missed; 12-16 marks: one may be left)."""
+
+POUR_FRACTION = 0.75
+"""A pour has put at least this share of the vessel's pieces in the container (9 of 12; holding the glass still, or
+knocking it over beside the bowl, puts none or a few there)."""
+POUR_PIECES = 12
+"""Pieces the offline author fills a vessel with: a third of a tumbler, two layers of beads, one of marbles."""
 
 Words = Callable[[str], np.random.Generator]
 
@@ -87,4 +93,30 @@ def hang_task(a: dict, b: dict, words: Words, colors: tuple[str | None, ...] = (
     }
 
 
-__all__ = ["HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "WIPE_FRACTION", "hang_task", "insert_task", "wipe_task"]
+def pour_task(piece: dict, vessel: dict, target: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dict:
+    """Pour the :data:`POUR_PIECES` pieces (catalog ``piece``) that fill ``vessel`` into container ``target``: grasp
+    the vessel by its side, tip it over the container, stand it up again (:mod:`gendex.solve.pour`); the scene step
+    lays the pieces in it and adds that it stands up again (:func:`generator.steps.scene.poured_stands_up`)."""
+    n, t = vessel["category"], target["category"]
+    size = target["id"].rsplit("_", 1)[-1] if target["id"] != target["category"] else ""
+    name = camel("pour", f"{piece['id']}s", "from", *painted(vessel, colors, 1), "into", target["id"])
+    words_of = qualifiers(vessel, target, colors[1:])
+    if size:  # the large bowl
+        words_of["other_qualifier"] = " ".join(w for w in (words_of.get("other_qualifier"), size) if w)
+    return {
+        "name": name,
+        "description": phrase("pour", vessel, words(name), other=target, pieces=piece["id"], **words_of),
+        "objects": [{"name": n, "asset": vessel["id"], "role": "graspable",
+                     "fill": {"asset": piece["id"], "count": POUR_PIECES}},
+                    {"name": t, "asset": target["id"], "role": "container"}],
+        "steps": [*carry_steps(n, t, "over")[:2],
+                  step("pour", t, "arm", f"Tip the {word(n)} over the {word(t)} until the {piece['id']}s fall in, "
+                                         f"then stand it up again.")],
+        "success": {"type": "poured", "object": n, "target": t, "min_fraction": POUR_FRACTION},
+        "success_text": f"At least {POUR_FRACTION:.0%} of the {piece['id']}s that filled the {word(n)} lie in the "
+                        f"{word(t)}, and the {word(n)} stands up again.",
+    }
+
+
+__all__ = ["HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "POUR_FRACTION", "POUR_PIECES", "WIPE_FRACTION", "hang_task",
+           "insert_task", "pour_task", "wipe_task"]

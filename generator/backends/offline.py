@@ -39,7 +39,7 @@ from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
-from generator.backends.dexterous import hang_task, insert_task, wipe_task
+from generator.backends.dexterous import hang_task, insert_task, pour_task, wipe_task
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
@@ -62,6 +62,9 @@ from generator.backends.roles import (
     hook_stand,
     insertable,
     openable,
+    pour_into,
+    pourable,
+    pourer,
     receptacle,
     socket,
     sticks_out,
@@ -94,8 +97,8 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "twist", "insert", "wipe", "hang", "several",
-              "composed")
+              "press", "hand_over", "twist", "insert", "wipe", "hang", "pour",
+              "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -194,6 +197,8 @@ class OfflineBackend:
                 if socket(b) and fits_hole(a, b)]
         out += [("wipe", wipe_task(a, b, self._words)) for a in assets if wiper(a) for b in assets if wipe_area(b)]
         out += [("hang", hang_task(a, b, self._words)) for a in assets if hangable(a) for b in assets if hook_stand(b)]
+        out += [("pour", pour_task(p, a, b, self._words)) for p in assets if pourable(p) for a in assets if pourer(a)
+                for b in assets if pour_into(b)]
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
@@ -533,6 +538,12 @@ class OfflineBackend:
                                  pick(1, hook_stand, "hook, mug tree or rack to hang it on") if len(mentions) > 1
                                  else next(x for x in sorted(assets.values(), key=lambda x: x["id"]) if hook_stand(x)),
                                  self._words, colors)
+        elif skill == "pour":  # the reader puts the pieces first, then the vessel, then the container
+            if colors and colors[0]:
+                raise InstructionError(f"painting the pieces a vessel pours is not built yet ('{colors[0]} "
+                                       f"{mentions[0]['phrase']}'); ask for them without a colour")
+            proposal = pour_task(pick(0, pourable, "pieces to pour"), pick(1, pourer, "glass, beaker or cup to pour "
+                                 "from"), pick(2, pour_into, "bowl to pour into"), self._words, colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -555,7 +566,7 @@ class OfflineBackend:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
                 "(see GenDex/RotateTennisBall-v0 and `gendex train`). It writes: lift, put_in, place_on, stack, "
-                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe, hang.")
+                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe, hang, pour.")
         name, k = proposal["name"], 2
         while proposal["name"] in existing:
             proposal["name"] = f"{name}{k}"

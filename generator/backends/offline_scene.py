@@ -29,7 +29,7 @@ from generator.backends.roles import (
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
-STAGE_HORIZONS = {"twist": 700, "wipe": 250, "hang": 250}
+STAGE_HORIZONS = {"twist": 700, "wipe": 250, "hang": 250, "pour": 250}
 """Stage horizons (control steps) of skills that take longer than a stage's usual 40 (a twist: 5-6 grasps a turn,
 about 90 steps each; hand-written trials 525-741 steps with the reach)."""
 PUSH_M = 0.22
@@ -65,6 +65,14 @@ STAND_RANDOMIZE = {"xy_m": [0.03, 0.03], "yaw_deg": 30.0}
 HANG_RANDOMIZE = {"xy_m": [0.08, 0.08], "yaw_deg": 90.0}
 """How far a stand (fixed) and the mug to hang on it move at reset: the stand +-3 cm, turned up to 30 deg (a peg of
 each stand still faces the robot's side); the mug +-8 cm, turned either way up to 90 deg."""
+POUR_VESSEL_REGION_M = ((-0.03, 0.05), (0.08, 0.13))
+"""Where a vessel to pour from is put (|y|: either side); the bowl it pours into goes further ahead on the other
+side, as far across as :data:`generator.critic.skill_checks.POUR_APART_M` asks and up to :data:`POUR_SPREAD_M` more
+(the pour primitive's measured layout: the glass at (0, -0.12), the bowl at (0.1, 0.15))."""
+POUR_BOWL_X_M = (0.06, 0.14)
+POUR_SPREAD_M = 0.04
+POUR_RANDOMIZE = ({"xy_m": [0.05, 0.05], "yaw_deg": 90.0}, {"xy_m": [0.03, 0.03], "yaw_deg": 30.0})
+"""How far they move at reset: the vessel +-5 cm, turned either way up to 90 deg; the bowl +-3 cm and 30 deg."""
 HOLDER_YAW_DEG = 20.0
 """How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
 stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
@@ -113,6 +121,9 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                if c["type"] == "inside" and c.get("joint")}
     by_name = {o["name"]: o for o in proposal["objects"]}
     hung = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "hung"}
+    poured = {c["object"]: c["target"] for c in (proposal["success"], *(proposal.get("also") or ()))
+              if c["type"] == "poured"}
+    pour_at = _pour_layout(poured, {o["name"]: assets[o["asset"]] for o in proposal["objects"]}, rng)
     for box in (o for o in proposal["objects"] if o["name"] in inside.values()):  # taken out of a drawer
         if drawer_joint(assets[box["asset"]]):
             drawers[box["name"]] = drawer_joint(assets[box["asset"]])
@@ -164,6 +175,9 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(y, 3), 0.0]
             entry["fixed"] = hook_stand(a)
             entry["randomize"] = dict(STAND_RANDOMIZE if hook_stand(a) else HANG_RANDOMIZE)
+        elif o["name"] in pour_at:  # a vessel on one side, the bowl it pours into on the other
+            entry["pos_m"] = pour_at[o["name"]]
+            entry["randomize"] = dict(POUR_RANDOMIZE[int(o["name"] not in poured)])
         elif socket(a) or insertable(a):  # a holder stays put; the hole and the peg move at reset
             entry["fixed"] = socket(a)
             entry["randomize"] = dict(INSERT_RANDOMIZE, yaw_deg=HOLDER_YAW_DEG if socket(a) else
@@ -206,6 +220,24 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
             # room for a re-planned approach, a regrasp or a slow door: twice the stages' horizons
             "max_episode_steps": max(250, 2 * sum(st["horizon"] for st in stages))}
     return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
+
+def _pour_layout(poured: dict[str, str], assets: dict[str, dict], rng: np.random.Generator) -> dict[str, list]:
+    """Where each vessel of ``poured`` (vessel -> container) and its container go (module constants): ``pos_m``
+    by object name."""
+    from generator.critic.skill_checks import POUR_APART_M
+
+    out = {}
+    for vessel, into in poured.items():
+        side = float(rng.choice([-1.0, 1.0]))  # the bowl's side of the table; the vessel's is the other
+        (x0, x1), (y0, y1) = POUR_VESSEL_REGION_M
+        vy = -side * float(rng.uniform(y0, y1))
+        half = (max(assets[vessel]["size_m"][:2]) + max(assets[into]["size_m"][:2])) / 2
+        moves = sum(r["xy_m"][1] for r in POUR_RANDOMIZE)
+        by = vy + side * (half + moves + POUR_APART_M + float(rng.uniform(0.0, POUR_SPREAD_M)))
+        out[vessel] = [round(float(rng.uniform(x0, x1)), 3), round(vy, 3), 0.0]
+        out[into] = [round(float(rng.uniform(*POUR_BOWL_X_M)), 3), round(by, 3), 0.0]
+    return out
+
 
 def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict:
     """One object of clutter: a graspable catalog object the task does not use, in ``region``: where the task's

@@ -101,6 +101,27 @@ def hook_stand(a: dict) -> bool:
     return "hang_on" in a["tags"] and not a.get("joints")
 
 
+def pourer(a: dict) -> bool:
+    """A tall open vessel the offline author pours from (an asset tagged ``pourer``: held by its side, tipped over a
+    bowl)."""
+    return "pourer" in a["tags"] and not a.get("joints")
+
+
+def pourable(a: dict) -> bool:
+    """Loose pieces a vessel holds and pours (an asset tagged ``pourable``: a bead, a marble)."""
+    return "pourable" in a["tags"] and not a.get("joints")
+
+
+POUR_INTO = frozenset({"bowl", "bowl_large"})
+"""What the offline author pours into: the bowls the pour primitive was measured on (``benchmarks/results/
+skills.md``)."""
+
+
+def pour_into(a: dict) -> bool:
+    """A container the offline author pours into (:data:`POUR_INTO`)."""
+    return a["id"] in POUR_INTO and not a.get("joints")
+
+
 def handover_zone(a: dict) -> bool:
     """The hand-over mat: where the robot leaves what it hands to a person."""
     return "handover" in a["tags"] and not a.get("joints")

@@ -69,9 +69,10 @@ How each check is measured (the thresholds are the module constants below):
     fraction is (q - closed) / (open - closed) of the joint the conditions name, else the asset's main joint.
     Fix: ``joint_fix`` = {object, joint, value} setting the joint to its closed (resp. open) value; the directive
     grammar has no joint edit.
-``handover``, ``insert``, ``wipe``, ``hang`` (static)
+``handover``, ``insert``, ``wipe``, ``hang``, ``pour`` (static)
     What a skill needs of the scene: :mod:`generator.critic.skill_checks` (an object to hand over starts clear of
-    its hand-over zone, a peg of its holder, a sponge of its spill).
+    its hand-over zone, a peg of its holder, a sponge of its spill). No check measures the pieces laid in a vessel to
+    pour (:mod:`gendex_envs.pouring`): they move with it.
 """
 
 from __future__ import annotations
@@ -89,15 +90,16 @@ import numpy as np
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
 from gendex_envs.conditions import CONDITION_DEFAULTS
 from gendex_envs.placement import in_drawer
+from gendex_envs.pouring import spec_fills
 from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec
 from generator.critic.directives import Directive
 from generator.critic.layout import Room, choose_move, front_zone
-from generator.critic.skill_checks import handover_checks, hang_checks, insert_checks, wipe_checks
+from generator.critic.skill_checks import skill_checks
 
 log = logging.getLogger(__name__)
 
 CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "in_front", "scale",
-                  "joint_state", "handover", "insert", "wipe", "hang"]
+                  "joint_state", "handover", "insert", "wipe", "hang", "pour"]
 CHECKS: tuple[str, ...] = get_args(CheckId)
 
 # ----------------------------------------------------------------------------------------------- thresholds
@@ -599,7 +601,8 @@ def _joint_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violati
 
 
 def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dict[str, dict], dict[str, Placed], dict]:
-    placed = {o.name: _place(o) for o in spec.objects}
+    pieces = {n for names in spec_fills(spec).values() for n in names}
+    placed = {o.name: _place(o) for o in spec.objects if o.name not in pieces}
     violations: list[Violation] = []
     meas: dict[str, dict] = {c: {} for c in CHECKS}
     if overlap:
@@ -609,10 +612,7 @@ def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dic
     _clutter_in_front(spec, placed, meas["in_front"], violations)
     _scale_checks(spec, placed, meas["scale"], violations)
     _joint_checks(spec, placed, meas["joint_state"], violations)
-    handover_checks(spec, placed, meas["handover"], violations)  # what skills need (generator.critic.skill_checks)
-    insert_checks(spec, placed, meas["insert"], violations)
-    wipe_checks(spec, placed, meas["wipe"], violations)
-    hang_checks(spec, placed, meas["hang"], violations)
+    skill_checks(spec, placed, meas, violations)  # what skills need (generator.critic.skill_checks)
     return violations, meas, placed, unsupported
 
 

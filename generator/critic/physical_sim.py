@@ -65,8 +65,8 @@ def _contact_penetrations(env, spec: TaskSpec, placed: dict[str, Placed], boxes:
     for c in env.scene.px.get_contacts():
         ids = [b.entity.per_scene_id for b in c.bodies]
         a, b = (owner.get(i) for i in ids)
-        if a == b:  # inside one articulation, or neither is an object
-            continue
+        if a == b or any(n is not None and n not in placed for n in (a, b)):
+            continue  # inside one articulation, neither is an object, or a piece laid in a vessel
         if a is None:  # keep the object first
             a, b, ids = b, a, ids[::-1]
         depth = -min(p.separation for p in c.points)
@@ -148,7 +148,7 @@ def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, 
             speed = float(np.linalg.norm(end - before[name]) / dt)
             flo[name] = {"drop_m": rounded(drop), "speed_mps": rounded(speed),
                          "moved_m": rounded(float(np.linalg.norm(end - start[name])))}
-            if spec.object(name).fixed or name in off_table:
+            if spec.object(name).fixed or name in off_table or name not in placed:
                 continue
             if drop > FALL_TOL_M:
                 fix = unsupported_fix.get(name) or (Directive.move(name, "z", -math.floor((drop - 0.002) * 1000)

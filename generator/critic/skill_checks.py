@@ -16,6 +16,10 @@ calls them among its static checks, with the same :class:`~generator.critic.phys
 ``hang``
     The same for a mug and the stand it hangs on (an asset tagged ``hang_on``): a mug that starts against the stand's
     base leaves no room to grasp it clear of the pegs. Gap :data:`HANG_APART_M`, the same fix.
+``pour``
+    The same for a vessel and the container it pours into (a ``poured`` condition): a vessel that starts against the
+    bowl leaves the hand no room to grasp it, and tipped where it stands it pours half its pieces in. Gap
+    :data:`POUR_APART_M`, the same fix.
 """
 
 from __future__ import annotations
@@ -47,40 +51,34 @@ WIPE_APART_M = 0.03
 """Least gap (m) between a sponge's footprint and its spill's, both widened by their randomization."""
 HANG_APART_M = 0.05
 """Least gap (m) between a mug's footprint and its stand's, both widened by their randomization."""
-APART: dict[str, tuple[str, float, str]] = {"handover": ("handover", HANDOVER_APART_M, "hand-over zone"),
-                                            "insert": ("insert", INSERT_APART_M, "holder"),
-                                            "wipe": ("wipe_area", WIPE_APART_M, "spill"),
-                                            "hang": ("hang_on", HANG_APART_M, "stand")}
-"""Check -> (the target's catalog tag, least gap, what the target is called)."""
+POUR_APART_M = 0.05
+"""Least gap (m) between a vessel's footprint and the container it pours into, both widened by their
+randomization."""
+_CARRIED = (*SET_DOWN_CONDITIONS, "placed", "wiped", "hung")
+APART: dict[str, tuple[str, float, str, tuple[str, ...]]] = {
+    "handover": ("handover", HANDOVER_APART_M, "hand-over zone", _CARRIED),
+    "insert": ("insert", INSERT_APART_M, "holder", _CARRIED),
+    "wipe": ("wipe_area", WIPE_APART_M, "spill", _CARRIED),
+    "hang": ("hang_on", HANG_APART_M, "stand", _CARRIED),
+    "pour": ("container", POUR_APART_M, "container", ("poured",))}
+"""Check -> (the target's catalog tag, least gap, what the target is called, the success conditions it checks)."""
 
 
-def handover_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
-    """The ``handover`` check (module docstring): one violation per object that starts too near its zone."""
-    _apart_checks("handover", spec, placed, meas, violations)
-
-
-def insert_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
-    """The ``insert`` check (module docstring): one violation per peg that starts too near its holder."""
-    _apart_checks("insert", spec, placed, meas, violations)
-
-
-def wipe_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
-    """The ``wipe`` check (module docstring): one violation per sponge that starts too near its spill."""
-    _apart_checks("wipe", spec, placed, meas, violations)
-
-
-def hang_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
-    """The ``hang`` check (module docstring): one violation per mug that starts too near its stand."""
-    _apart_checks("hang", spec, placed, meas, violations)
+def skill_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict[str, dict],
+                 violations: list[Violation]) -> None:
+    """Every check of :data:`APART` (module docstring), each measured into ``meas[check]``: one violation per object
+    that starts too near the target its success takes it to."""
+    for check in APART:
+        _apart_checks(check, spec, placed, meas[check], violations)
 
 
 def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: dict,
                   violations: list[Violation]) -> None:
     from generator.critic.physical import Violation, moves, rounded
 
-    tag, apart, called = APART[check]
+    tag, apart, called, kinds = APART[check]
     for c in spec.success.conditions:
-        if (c.negate or c.type not in (*SET_DOWN_CONDITIONS, "placed", "wiped", "hung") or c.target not in placed
+        if (c.negate or c.type not in kinds or c.target not in placed
                 or c.object not in placed or tag not in placed[c.target].record.tags):
             continue
         obj, zone = placed[c.object], placed[c.target]
@@ -104,5 +102,5 @@ def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: d
             measured=gap, limit=apart, fix=moves(c.object, step), other=c.target))
 
 
-__all__ = ["APART", "HANDOVER_APART_M", "HANG_APART_M", "INSERT_APART_M", "WIPE_APART_M", "handover_checks",
-           "hang_checks", "insert_checks", "wipe_checks"]
+__all__ = ["APART", "HANDOVER_APART_M", "HANG_APART_M", "INSERT_APART_M", "POUR_APART_M", "WIPE_APART_M",
+           "skill_checks"]

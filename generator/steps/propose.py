@@ -82,7 +82,8 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
         if o.get("color") is not None and o["color"] not in COLORS:
             raise ProposalError(f"objects[{i}]: color {o['color']!r} is not one of {list(COLORS)}")
         objects.append(ProposedObject(str(o["name"]), str(o["asset"]), str(o["role"]), o.get("color"),
-                                      None if o.get("starts_in") is None else str(o["starts_in"])))
+                                      None if o.get("starts_in") is None else str(o["starts_in"]),
+                                      _fill(o.get("fill"), f"objects[{i}]", o["asset"], assets)))
     if not 1 <= len(objects) <= MAX_OBJECTS:
         raise ProposalError(f"a task uses 1 to {MAX_OBJECTS} objects, the proposal has {len(objects)}")
     names = [o.name for o in objects]
@@ -124,6 +125,27 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
                     substitutions={str(k): str(v) for k, v in subs.items()} if isinstance(subs, dict) else {})
 
 
+def _fill(fill: Any, where: str, vessel: str, assets: dict) -> dict | None:
+    """A proposed object's ``fill`` (what a vessel to pour from holds), checked; None when it has none."""
+    from gendex_envs.pouring import MAX_PIECES, POURABLE_TAG
+
+    if fill is None:
+        return None
+    pieces = sorted(a for a, x in assets.items() if POURABLE_TAG in x["tags"])
+    pourers = sorted(a for a, x in assets.items() if "pourer" in x["tags"])
+    if not isinstance(fill, dict) or set(fill) != {"asset", "count"}:
+        raise ProposalError(f"{where}.fill must be {{\"asset\": <piece>, \"count\": <1-{MAX_PIECES}>}}; got {fill!r}")
+    if "pourer" not in assets[vessel]["tags"]:
+        raise ProposalError(f"{where}.fill: {vessel!r} is no vessel to pour from; vessels (tag pourer): {pourers}")
+    if fill["asset"] not in pieces:
+        raise ProposalError(f"{where}.fill.asset {fill['asset']!r} is not a piece a vessel holds; pieces (tag "
+                            f"{POURABLE_TAG}): {pieces}")
+    count = fill["count"]
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_PIECES:
+        raise ProposalError(f"{where}.fill.count {count!r} must be a whole number of pieces, 1 to {MAX_PIECES}")
+    return {"asset": str(fill["asset"]), "count": int(count)}
+
+
 def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedObject], assets: dict) -> dict:
     """One success condition of a proposal, checked: a known type naming proposed objects."""
     if not isinstance(succ, dict) or succ.get("type") not in PROPOSAL_CONDITION_TYPES:
@@ -132,7 +154,7 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
     if succ.get("object") not in names:
         raise ProposalError(f"{where}.object {succ.get('object')!r} is not a proposed object; objects: {names}")
     targets = names + [GOAL_TARGET] if succ["type"] == "near" else names
-    if succ["type"] in ("inside", "near", "over", "wiped", "hung") and succ.get("target") not in targets:
+    if succ["type"] in ("inside", "near", "over", "wiped", "hung", "poured") and succ.get("target") not in targets:
         raise ProposalError(f"{where}.target {succ.get('target')!r} must name a proposed object for a "
                             f"{succ['type']!r} condition; allowed: {targets}")
     if succ["type"] == "wiped" and "wipe_area" not in assets[objects[names.index(succ["target"])].asset]["tags"]:
@@ -141,6 +163,13 @@ def _condition(succ: Any, where: str, names: list[str], objects: list[ProposedOb
     if succ["type"] == "hung" and "hang_on" not in assets[objects[names.index(succ["target"])].asset]["tags"]:
         raise ProposalError(f"{where}.target {succ['target']!r} has no pegs to hang on: a hung condition's target is a "
                             "stand tagged hang_on (a mug hook, tree or rack)")
+    if succ["type"] == "poured" and objects[names.index(succ["object"])].fill is None:
+        raise ProposalError(f"{where}.object {succ['object']!r} holds nothing to pour: a poured condition's object "
+                            "is a vessel with a fill ({\"asset\": \"bead\", \"count\": 12})")
+    if succ["type"] == "poured" and ("container" not in assets[objects[names.index(succ["target"])].asset]["tags"]
+                                     or succ["target"] == succ["object"]):
+        raise ProposalError(f"{where}.target {succ['target']!r} is no container to pour into: a poured condition's "
+                            "target is another container (a bowl)")
     if succ["type"] == "placed":
         from gendex_envs.conditions import RELATIONS
 
@@ -175,7 +204,7 @@ def with_reading(proposal: Proposal, reading: Reading) -> Proposal:
     person named by colour gets that colour (the first proposed object of the mention's assets, in order), whatever
     the backend wrote: the scene paints it so (:func:`generator.steps.scene.parse_scene`)."""
     subs = dict(reading.substitutions)
-    used = [o.asset for o in proposal.objects]
+    used = [o.asset for o in proposal.objects] + [o.fill["asset"] for o in proposal.objects if o.fill]
     named = reading.all_objects  # every step's
     for m in named:
         if not m.substituted and m.asset and not set(m.options or (m.asset,)) & set(used):

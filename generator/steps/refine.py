@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 
+from gendex_envs.errors import TaskSpecError
 from gendex_envs.spec import TaskSpec, dump_task_spec
 from generator.backends.base import Backend, ImagePart
 from generator.errors import DirectiveError
@@ -41,7 +42,9 @@ def _vision_directives(backend: Backend, spec: TaskSpec, findings: str,
 
 
 def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpec, list[str], list[str]]:
-    """Apply the measured fixes, then the critic's directives, one at a time; returns (spec, applied, rejected)."""
+    """Apply the measured fixes, then the critic's directives, one at a time; returns (spec, applied, rejected). A
+    vessel moved, turned or scaled carries the pieces it holds (:func:`gendex_envs.pouring.refill`)."""
+    from gendex_envs.pouring import refill, spec_fills
     from generator.critic.directives import apply_directives
     from generator.critic.joints import apply_joint_fix
 
@@ -50,10 +53,15 @@ def apply_fixes(spec: TaskSpec, report, model_directives: list) -> tuple[TaskSpe
     directives = report.directives()
     directives += [d for d in model_directives if d not in directives]
     for d in directives:
+        fills = spec_fills(spec)
+        vessel = next((v for v, names in fills.items() if d.object in names), None)
+        if vessel is not None:
+            rejected.append(f"{d}: {d.object!r} is a piece GenDex lays in {vessel!r}; move, turn or scale the vessel")
+            continue
         try:
-            spec = apply_directives(spec, [d])
+            spec = refill(apply_directives(spec, [d]), fills)
             applied.append(str(d))
-        except DirectiveError as exc:
+        except (DirectiveError, TaskSpecError) as exc:  # TaskSpecError: a vessel scaled too small for its pieces
             rejected.append(f"{d}: {exc}")
     for fix in report.joint_fixes():
         try:

@@ -14,6 +14,7 @@ import logging
 
 from gendex.solve.grasp import HAND_SPAN_M, hand_fit_scale
 from gendex_envs.errors import TaskSpecError
+from gendex_envs.pouring import lay_pieces, refill, spec_fills
 from gendex_envs.spec import (
     GOAL_TARGET,
     SCALE_RANGE,
@@ -48,6 +49,8 @@ CONTAINER_MARGIN = 1 / 0.7
 """A container's smallest horizontal extent must be this many times the held object's largest one."""
 LIFT_HOLD_FINGERS = 1
 """Fingers besides the thumb that must touch an object a task's success needs lifted (:func:`hold_lifted`)."""
+POURED_TILT_DEG = 45.0
+"""A vessel poured from stands this near its start's upright again (the side grasp holds it leant 20-30 degrees)."""
 SETTLED_STEPS = 10
 """Consecutive control steps (0.5 s at 20 Hz) a set-down success must hold (:func:`let_go`): a dropped ball passes
 through a board's ``near`` in two or three."""
@@ -58,7 +61,9 @@ def _clamp_scale(s: float) -> float:
 
 
 def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
-    """Scale objects to the hand by arithmetic on catalog metric sizes (see the module constants)."""
+    """Scale objects to the hand by arithmetic on catalog metric sizes (see the module constants); a vessel's pieces
+    are laid again in it at its new size."""
+    fills = spec_fills(spec)
     roles = {o.name: o.role for o in proposal.objects}
     scales = {o.name: o.scale for o in spec.objects}
     size = {o.name: asset_dict(o.asset)["size_m"] for o in spec.objects}
@@ -77,7 +82,7 @@ def adjust_sizes(spec: TaskSpec, proposal: Proposal) -> TaskSpec:
             if have < need:
                 scales[o.name] = _clamp_scale(scales[o.name] * need / have)
     objects = tuple(dataclasses.replace(o, scale=scales[o.name]) for o in spec.objects)
-    return dataclasses.replace(spec, objects=objects)
+    return refill(dataclasses.replace(spec, objects=objects), fills)
 
 
 def hold_lifted(spec: TaskSpec) -> TaskSpec:
@@ -194,6 +199,20 @@ def hung_lets_go(spec: TaskSpec) -> TaskSpec:
     return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
 
 
+def poured_stands_up(spec: TaskSpec) -> TaskSpec:
+    """Give every vessel the success pours from (``poured``) an ``upright`` condition (within
+    :data:`POURED_TILT_DEG`): a pour ends with the vessel stood up again, not left tipped over the bowl (where the
+    last pieces still roll out of it)."""
+    conds = spec.success.conditions
+    have = {c.object for c in conds if c.type == "upright" and not c.negate}
+    tipped = [c.object for c in conds if c.type == "poured" and not c.negate and c.object not in have]
+    if not tipped:
+        return spec
+    log.info("success of %s: %s must stand up again after the pour", spec.name, ", ".join(tipped))
+    extra = tuple(ConditionSpec(type="upright", object=o, max_tilt_deg=POURED_TILT_DEG) for o in dict.fromkeys(tipped))
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
+
+
 def twist_holds_cap(spec: TaskSpec) -> TaskSpec:
     """Give a success that a ``twist`` stage's cap be turned (``joint_open`` on the stage's target) a ``grasped``
     condition on that cap: unscrewing ends with the cap in the hand (the plan step gives the stage the same,
@@ -235,8 +254,10 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     want = {(o.name, o.asset) for o in proposal.objects}
     got = {(o.name, o.asset) for o in spec.objects if not o.distractor}
     if want != got:
+        filled = " (the pieces a vessel is filled with are laid by GenDex: leave them out)" if any(
+            o.fill for o in proposal.objects) else ""
         raise SceneError(f"the scene must use exactly the proposal's objects {sorted(want)} (plus at most "
-                         f"{MAX_DISTRACTORS} with distractor: true); it has {sorted(got)}")
+                         f"{MAX_DISTRACTORS} with distractor: true){filled}; it has {sorted(got)}")
     extra = [o.name for o in spec.objects if o.distractor]
     if len(extra) > MAX_DISTRACTORS:
         raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
@@ -247,8 +268,14 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
         spec = dataclasses.replace(spec, objects=tuple(
             dataclasses.replace(o, color=colors[o.name], color_rgba=None) if o.name in colors and not o.distractor
             else o for o in spec.objects))
+    for o in proposal.objects:
+        if o.fill is not None:  # the pieces a vessel holds, laid in it where it stands
+            try:
+                spec = lay_pieces(spec, o.name, o.fill["asset"], o.fill["count"])
+            except TaskSpecError as exc:
+                raise SceneError(str(exc)) from None
     settled = hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))
-    return hung_lets_go(inserted_upright(twist_holds_cap(settled)))
+    return poured_stands_up(hung_lets_go(inserted_upright(twist_holds_cap(settled))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:

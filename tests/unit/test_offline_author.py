@@ -44,8 +44,8 @@ def test_a_batch_can_be_held_to_some_kinds_of_task():
     assert all(p.success["type"] == "placed" or (p.success["type"] == "joint_open" and p.success.get("negate"))
                for p in got)
     assert {p.success["type"] for p in got} == {"placed", "joint_open"}  # both kinds are drawn
-    with pytest.raises(BackendError, match="unknown kind.*'pour'.*place_at"):
-        OfflineBackend(kinds=("pour",))
+    with pytest.raises(BackendError, match="unknown kind.*'juggle'.*place_at"):
+        OfflineBackend(kinds=("juggle",))
 
 
 def test_guided_proposal_substitutes_the_closest_catalog_object():
@@ -85,6 +85,8 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
     write_record(rows, [1, 2], tmp_path / "rec.json")
     assert measured_rates(tmp_path / "rec.json") == {"apple": 0.95, "fork": 0.15}
     assert measured_graspable(0.9, tmp_path / "rec.json") == {"apple"}
+    write_record([{"asset": "fork", "held": 20, "attempts": 20, "scale": 1.0}], [5], tmp_path / "rec.json", merge=True)
+    assert measured_graspable(0.9, tmp_path / "rec.json") == {"apple", "fork"}  # a run over some objects adds theirs
     for p in _proposals(7, 30):
         for o in p.objects:
             if o.role == "graspable":

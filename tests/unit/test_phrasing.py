@@ -3,12 +3,14 @@ reader as the task it describes."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
 from generator.catalog_view import asset_dicts
 from generator.instruction import is_surface, read_instruction
-from generator.phrasing import COMMANDS, NAMES, PURPOSES, SITUATIONS, domain, names_for, phrase
+from generator.phrasing import COMMANDS, NAMES, PIECE_NAMES, PURPOSES, SITUATIONS, domain, names_for, phrase
 
 ASSETS = {a["id"]: a for a in asset_dicts()}
 READ_AS = {"open_door": "open", "open_drawer": "open", "open_lid": "open", "close_door": "close",
@@ -27,8 +29,10 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
     "twist": ("screw_jar", None), "insert": ("peg_square", "peg_holder_square"),
-    "wipe": ("sponge_block", "spill_square"), "hang": ("mug", "mug_tree"),
+    "wipe": ("sponge_block", "spill_square"), "hang": ("mug", "mug_tree"), "pour": ("tumbler", "bowl"),
 }
+PIECES = {"pour": ("bead", "marble")}
+"""The pieces a skill's command names (a pour's beads or marbles), read back first."""
 AMOUNTS = {"open_door_part": ("halfway", "half"), "open_drawer_part": ("halfway", "half"),
            "turn_part": ("45 degrees", "45 degrees"), "put_in_drawer": ("bottom ", None),
            "take_out_drawer": ("bottom ", None)}
@@ -46,18 +50,23 @@ def test_every_command_reads_back_as_its_task(skill):
                       "wipe": ("", "square")}.get(skill, ("", ""))
     for template in COMMANDS[skill]:
         for o in names_for(ASSETS[main], q_main):
-            for d in (names_for(ASSETS[other], q_other) if other else (o,)):
-                text = template.format(o=o, d=d, s="table", a=AMOUNTS.get(skill, ("",))[0])
+            for d, (piece, p) in itertools.product(names_for(ASSETS[other], q_other) if other else (o,),
+                                                   [(x, w) for x in PIECES.get(skill, ("",))
+                                                    for w in PIECE_NAMES.get(x, ("",))]):
+                text = template.format(o=o, d=d, s="table", a=AMOUNTS.get(skill, ("",))[0], p=p)
                 r = read_instruction(text, list(ASSETS.values()))
                 assert r.amount == AMOUNTS.get(skill, ("", None))[1], text
                 assert r.skill == READ_AS.get(skill, skill), text
                 if r.skill == "turn":  # the direction the command says, read back
                     assert r.direction == ("off" if skill == "turn_off" else "on"), text
                 got = [ASSETS[m.asset]["category"] for m in r.objects]
-                want = [ASSETS[main]["category"]] + ([ASSETS[other]["category"]] if other else [])
+                want = ([ASSETS[piece]["category"]] if piece else []) + [ASSETS[main]["category"]] + (
+                    [ASSETS[other]["category"]] if other else [])
                 assert got == want, (text, got)
                 if skill in ("stack", "wipe", "hang"):
                     assert [m.asset for m in r.objects] == [main, other], text
+                if piece:
+                    assert [m.asset for m in r.objects] == [piece, main, other], text
                 assert not r.substitutions, (text, r.substitutions)
 
 
@@ -77,8 +86,17 @@ def test_every_name_the_author_uses_is_read_back_as_its_category():
                 text, k = f"wipe the {w} with the sponge", 1
             elif "hang_on" in a["tags"]:  # a stand: what a mug hangs on
                 text, k = f"hang the mug on the {w}", 1
+            elif "pourer" in a["tags"]:  # a vessel: what beads are poured from
+                text, k = f"pour the beads from the {w} into the bowl", 1
             r = read_instruction(text, list(ASSETS.values()))
             assert ASSETS[r.objects[k].asset]["category"] == cat, (w, r.objects)
+
+
+def test_every_word_for_a_pours_pieces_is_read_back_as_those_pieces():
+    for piece, words in PIECE_NAMES.items():
+        for w in words:
+            r = read_instruction(f"pour the {w} from the glass into the bowl", list(ASSETS.values()))
+            assert r.objects[0].asset == piece and not r.substitutions, (w, r.objects)
 
 
 def test_wording_is_seeded_varied_and_ends_as_a_sentence():
