@@ -8,6 +8,7 @@ solvability gate measured (success and env steps per success; "—" for a task t
 from __future__ import annotations
 
 import logging
+from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -40,7 +41,8 @@ def _row(env_id: str, version: TaskVersion, picture: str) -> str:
     measured = "—" if gate is None else f"{gate['successes']}/{gate['attempts']}"
     per = "—" if not gate or not gate.get("env_steps_per_success") else f"{gate['env_steps_per_success']:.0f}"
     skills = ", ".join(task_skills(spec)) or "—"
-    objects = ", ".join(f"`{o.asset}`" for o in spec.objects)
+    counts = Counter(o.asset for o in spec.objects)  # a dozen beads: `bead` x 12
+    objects = ", ".join(f"`{a}`" + (f" × {n}" if n > 1 else "") for a, n in counts.items())
     stages = " → ".join(s.skill for s in spec.stages)
     return (f"| ![{version.name}]({picture}) | `{env_id}` | {spec.instruction} | {skills} | {objects} | {stages} | "
             f"{measured} | {per} |")

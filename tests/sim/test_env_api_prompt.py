@@ -8,6 +8,7 @@ import re
 import pytest
 import torch
 
+from gendex_envs.pouring import spec_fills
 from gendex_envs.reward_view import RewardView, view_of
 from generator.prompts import render
 
@@ -47,22 +48,25 @@ def _check(value, shape: str, n: int, expr: str) -> None:
     ("GenDex/PushBlockToGoal-v0", "NAME", "block", None),
     ("GenDex/OpenDrawer-v1", "ARTICULATED", "drawer_chest", "drawer_0_slide"),
     ("GenDex/WipeSpillRound-v1", "NAME", "sponge", None),
+    ("GenDex/PourBeadsFromTumblerIntoBowl-v0", "NAME", "tumbler", None),
 ])
 def test_env_api_prompt_matches_the_reward_view(make_env, env_id, placeholder, name, joint):
-    """Each documented member, evaluated on a task's objects (JOINT: a drawer's, on a task that has one), has the
-    documented shape and dtype."""
+    """Each documented member, evaluated on a task's objects (JOINT: a drawer's, on a task that has one; AREA: its
+    spill; VESSEL and CONTAINER: the vessel it pours from and the bowl), has the documented shape and dtype."""
     env = make_env(env_id, control_mode="pd_joint_delta_pos")
     env.reset(seed=0)
     env.step(env.action_space.sample())
     u = env.unwrapped
     view = view_of(u)
     checked = 0
+    vessels = spec_fills(u.task_spec)
     for expr, shape in _members():
         other = "ARTICULATED" if placeholder == "NAME" else "NAME"
         if other in expr or ("goal_pos" in expr and u.goal_site is None) or ("JOINT" in expr and joint is None) \
-                or ("AREA" in expr and "spill" not in u.objects) or ("VESSEL" in expr and "glass" not in u.objects):
+                or ("AREA" in expr and "spill" not in u.objects) or ("VESSEL" in expr and name not in vessels):
             continue
-        code = expr.replace(placeholder, repr(name)).replace("JOINT", repr(joint)).replace("AREA", repr("spill"))
+        code = (expr.replace(placeholder, repr(name)).replace("JOINT", repr(joint)).replace("AREA", repr("spill"))
+                .replace("VESSEL", repr(name)).replace("CONTAINER", repr("bowl")))
         value = eval(code, {"torch": torch}, {"env": view})
         _check(value, shape, u.num_envs, expr)
         checked += 1
