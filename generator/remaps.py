@@ -95,8 +95,7 @@ def _pour_order(r: Read, plays, assets: Sequence[dict]) -> Read:
         word = m.phrase.split()[-1] if m.phrase else ""
         if m.asset and not plays(m, "pourer") and word in POUR_VESSELS and not plays(m, "pour_into"):
             vessel = POUR_VESSELS[word]
-            m = dataclasses.replace(m, asset=vessel, options=(vessel,), how="synonym", color=None,
-                                    detail=f"a {word} to pour from: the {vessel.replace('_', ' ')}")
+            m = dataclasses.replace(m, asset=vessel, options=(vessel,), how="synonym", color=None)
         mentions.append(m)
     pieces = [m for m in mentions if plays(m, "pourable")]
     vessels = [m for m in mentions if plays(m, "pourer") and m not in pieces]

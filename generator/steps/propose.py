@@ -127,7 +127,8 @@ def parse_proposal(text: str, instruction: str | None = None) -> Proposal:
 
 def _fill(fill: Any, where: str, vessel: str, assets: dict) -> dict | None:
     """A proposed object's ``fill`` (what a vessel to pour from holds), checked; None when it has none."""
-    from gendex_envs.pouring import MAX_PIECES, POURABLE_TAG
+    from gendex_envs.assets.catalog import get_asset
+    from gendex_envs.pouring import MAX_PIECES, POURABLE_TAG, fill_layout
 
     if fill is None:
         return None
@@ -143,6 +144,10 @@ def _fill(fill: Any, where: str, vessel: str, assets: dict) -> dict | None:
     count = fill["count"]
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_PIECES:
         raise ProposalError(f"{where}.fill.count {count!r} must be a whole number of pieces, 1 to {MAX_PIECES}")
+    try:
+        fill_layout(get_asset(vessel), get_asset(fill["asset"]), count)
+    except ValueError as exc:
+        raise ProposalError(f"{where}.fill: {exc} ({vessel})") from None
     return {"asset": str(fill["asset"]), "count": int(count)}
 
 

@@ -135,6 +135,7 @@ def test_a_proposals_fill_is_checked():
     for fill, vessel, target, why in [(None, "tumbler", "bowl", "holds nothing to pour"),
                                       ({"asset": "apple", "count": 8}, "tumbler", "bowl", "not a piece"),
                                       ({"asset": "bead", "count": MAX_PIECES + 1}, "tumbler", "bowl", "whole number"),
+                                      ({"asset": "bead", "count": MAX_PIECES}, "beaker", "bowl", "do not fit"),
                                       ({"asset": "bead", "count": 8}, "mug", "bowl", "no vessel to pour from"),
                                       ({"asset": "bead", "count": 8}, "tumbler", "plate", "no container")]:
         with pytest.raises(ProposalError, match=why):
