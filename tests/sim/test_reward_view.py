@@ -86,7 +86,10 @@ def _rollout(task_copy, source: str, name: str, steps: int = 25):
         env.close()
 
 
-def test_writes_through_the_view_change_nothing_the_env_keeps_or_decides(task_copy, unchecked):
+def test_writes_through_the_view_change_nothing_the_env_keeps_or_decides(task_copy, unchecked, monkeypatch):
+    # what is checked is isolation, not time: a call of 28 ms overran the 5 s per-call limit once on a 2-core
+    # machine running the whole suite in two processes (a clean-clone run, 2026-12-01)
+    monkeypatch.setenv("GENDEX_SANDBOX_TIMEOUT_S", "60")
     honest = _rollout(task_copy, HONEST, "ViewHonest")
     vandal = _rollout(task_copy, VANDAL, "ViewVandal")
     for step, (a, b) in enumerate(zip(honest, vandal, strict=True)):
