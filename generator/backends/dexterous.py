@@ -27,7 +27,8 @@ POUR_FRACTION = 0.75
 """A pour has put at least this share of the vessel's pieces in the container (9 of 12; holding the glass still, or
 knocking it over beside the bowl, puts none or a few there)."""
 POUR_PIECES = 12
-"""Pieces the offline author fills a vessel with: a third of a tumbler, two layers of beads, one of marbles."""
+"""Pieces the offline author fills a vessel with: three layers of four in a tumbler or a paper cup (8 cm of their
+13.5), beads four layers of three in the narrower beaker (10 cm of its 14; :func:`gendex_envs.pouring.fill_layout`)."""
 
 Words = Callable[[str], np.random.Generator]
 
