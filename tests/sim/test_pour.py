@@ -14,8 +14,8 @@ from gendex_envs.assets.catalog import get_asset
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.geometry import tilt
 from gendex_envs.physx import px_bodies
-from gendex_envs.pouring import fill_layout, pieces, share
-from gendex_envs.spec import parse_task_spec
+from gendex_envs.pouring import lay_pieces, pieces, share
+from gendex_envs.spec import parse_task_spec, spec_to_dict
 from gendex_envs.success import condition_holds
 from gendex_envs.task_env import TaskEnv
 
@@ -26,15 +26,12 @@ UPRIGHT = {"type": "upright", "object": "glass", "max_tilt_deg": 45.0}
 
 
 def _task(vessel: str = "tumbler", bowl: str = "bowl") -> dict:
-    at = (0.0, -0.12)
-    beads = [{"name": f"bead_{k}", "asset": "bead", "pos_m": [at[0] + dx, at[1] + dy, z]}
-             for k, (dx, dy, z) in enumerate(fill_layout(get_asset(vessel), get_asset("bead"), BEADS))]
-    return {
+    task = {
         "name": "PourCheck", "instruction": "Pour the beads from the glass into the bowl.",
-        "objects": [{"name": "glass", "asset": vessel, "pos_m": [at[0], at[1], 0.0],
+        "objects": [{"name": "glass", "asset": vessel, "pos_m": [0.0, -0.12, 0.0],
                      "randomize": {"xy_m": [0.05, 0.05], "yaw_deg": 90.0}},
                     {"name": "bowl", "asset": bowl, "pos_m": [0.1, 0.15, 0.0],
-                     "randomize": {"xy_m": [0.03, 0.03], "yaw_deg": 30.0}}, *beads],
+                     "randomize": {"xy_m": [0.03, 0.03], "yaw_deg": 30.0}}],
         "stages": [
             {"name": "reach_glass", "instruction": "Reach the glass.", "skill": "reach", "method": "motion_planning",
              "control_joint": "arm", "horizon": 60, "target": "glass"},
@@ -47,6 +44,7 @@ def _task(vessel: str = "tumbler", bowl: str = "bowl") -> dict:
                     "conditions": [POURED, UPRIGHT]},
         "max_episode_steps": 500,
     }
+    return spec_to_dict(lay_pieces(parse_task_spec(task), "glass", "bead", BEADS))  # twelve beads in the glass
 
 
 def _still(env: TaskEnv, steps: int) -> None:
