@@ -62,7 +62,7 @@ Keyframe = Literal["rest", "pregrasp_open", "palm_up"]
 StageMethod = Literal["motion_planning", "RL"]
 ControlJoint = Literal["arm", "hand", "both", "three_finger", "arm_two_finger", "lift_inspire"]
 Skill = Literal["reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn", "reorient",
-                "press", "twist", "wipe", "hang", "pour"]
+                "press", "twist", "wipe", "hang", "pour", "flip"]
 
 ROBOT_UIDS: tuple[str, ...] = get_args(RobotUid)
 KEYFRAMES: tuple[str, ...] = get_args(Keyframe)
@@ -89,6 +89,7 @@ SKILL_MEANINGS: dict[str, str] = {
             "onto the peg",
     "pour": "tip the held vessel over the target (a bowl) until the loose pieces in it (beads) fall in, then stand it "
             "up again",
+    "flip": "turn the held object upside down (about the fingers' line) and set it down on the table on its top",
 }
 """What each skill of :data:`SKILLS` does; the stage's ``target`` is the object it acts on."""
 assert set(SKILL_MEANINGS) == set(SKILLS)

@@ -112,6 +112,38 @@ def _get_obs_extra(env, info):
 holding it, the held mug raised and brought to the stand; success (hung on a peg, let go, still) pays the most."""
 
 
+_FLIP = '''REWARD_MAX = 5.0
+UP_M = 0.15
+
+
+def _up(q):
+    """[N, 3] the world direction of the object's own z axis for unit quaternions q [N, 4] (wxyz)."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return torch.stack([2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)], dim=-1)
+
+
+def evaluate(env):
+{fail}    force = env.agent.get_hand_group_obj_mean_force(env.obj({obj!r}))  # [N, 6, 1]
+    turned = (1.0 - (_up(env.obj_pose({obj!r}).q) * _up(env.init_obj_quat({obj!r}))).sum(dim=-1)) / 2.0
+    return {{"fail": fail, "contact": rt.contact(force), "height": env.obj_height({obj!r}), "turned": turned}}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose({obj!r}).p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    up = rt.lift(info["height"], UP_M) * (info["contact"] > 0.2)
+    reward = reach + info["contact"] + up + 2.0 * info["turned"]
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {{"palm_to_obj": env.obj_pose({obj!r}).p - env.palm_pose.p, "turned": info["turned"][:, None]}}
+'''
+"""Reward of a flip (format with ``fail``, ``obj``): the palm to the object, holding it, the held object raised,
+and how far it is turned over (0 as at reset, 1 upside down: half of one minus the cosine between its axis now and
+then); success (upside down, let go, still) pays the most."""
+
+
 _POUR = _SHARE.format(key="poured", near="near", to="into")
 """Reward of a pour (format with ``fail``, ``obj``: the vessel, ``into``: the container): the palm to the vessel,
 holding it, the held vessel brought to the container, then the share of its pieces that lie in the container."""
@@ -172,6 +204,8 @@ def compose_stage_module(spec: dict, stage_name: str, roles: dict[str, str]) -> 
         return src + _HANG.format(fail=fail, obj=cond["object"], stand=cond["target"])
     if cond["type"] == "poured" and kind == "pour":
         return src + _POUR.format(fail=fail, obj=cond["object"], into=cond["target"])
+    if cond["type"] == "flipped":
+        return src + _FLIP.format(fail=fail, obj=cond["object"])
     if kind in JOINT_SKILLS:
         frac = float(cond.get("min_fraction") or 0.8) if cond["type"] == "joint_open" else 0.8
         # closing progresses from fully open (0) to the allowed fraction (1); -x / f clipped to [0, 1] was always 0
@@ -413,6 +447,8 @@ def _get_obs_extra(env, info):
         return src + _HANG.format(fail=fail, obj=obj, stand=target)
     if cond["type"] == "poured":
         return src + _POUR.format(fail=fail, obj=obj, into=target)
+    if cond["type"] == "flipped":
+        return src + _FLIP.format(fail=fail, obj=obj)
     carry = _carry_term(target, placed_goal(cond, spec))
     src += f'''REWARD_MAX = 5.0
 LIFT_M = 0.1

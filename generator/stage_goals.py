@@ -73,4 +73,6 @@ def stage_goal(skill: str, target: str | None, task_conditions: list[dict], arti
         return [dict(c) for c in task_conditions if c.get("type") == "poured" and c.get("target") == target] or None
     if skill == "wipe":  # the task's wipe of this area
         return [dict(c) for c in task_conditions if c.get("type") == "wiped" and c.get("target") == target] or None
+    if skill == "flip":  # turned over, still in the hand: the release stage ends where the task does
+        return [dict(c) for c in task_conditions if c.get("type") == "flipped" and c.get("object") == target] or None
     return None

@@ -47,6 +47,7 @@ import gymnasium as gym
 import numpy as np
 
 from gendex.solve.articulated import HOOK_OPEN, HandlePrimitives
+from gendex.solve.flip import flip
 from gendex.solve.grasp import GraspPlan
 from gendex.solve.hang import hang
 from gendex.solve.motion import ArmHandMotion
@@ -75,7 +76,7 @@ log = logging.getLogger(__name__)
 
 RIGID_PRIMITIVES = {"reach": "approach", "grasp": "grasp", "lift": "lift", "carry": "carry", "place": "place",
                     "release": "release", "push": "push", "wipe": "wipe", "hang": "hang",
-                    "pour": "pour"}
+                    "pour": "pour", "flip": "flip"}
 """Skill -> primitive for a rigid target."""
 TO_A_PLACE = ("carry", "place")
 """Skills whose target is where the held object goes: the rigid primitives, also when that is an articulated object
@@ -89,7 +90,7 @@ PRESS_PRIMITIVES = {"reach": "approach_press", "open": "press", "close": "press"
 """Skill -> primitive for an articulated target that no stage grasps: the open hand pushes the moving part."""
 SKILL_STEPS = {"reach": 60, "grasp": 55, "lift": 15, "carry": 50, "place": 30, "release": 15, "push": 90,
                "open": 50, "close": 50, "turn": 40, "press": 30, "twist": 500,
-               "wipe": 200, "hang": 120, "pour": 160}
+               "wipe": 200, "hang": 120, "pour": 160, "flip": 150}
 """Steps a stage of each skill usually takes at nominal speed (measured on the committed tasks; a release that
 sets its object down first takes a place's more; a carry is estimated from how far it goes,
 :data:`CARRY_EXTRA_STEPS`): what the stages after the current one are expected to need."""
@@ -412,6 +413,10 @@ class StageExecutor:
     def _pour(self, stage) -> Iterator[np.ndarray]:
         """Tip the held vessel over the target until what it holds falls in; stand it up (:mod:`gendex.solve.pour`)."""
         yield from pour(self.rigid, stage.target)
+
+    def _flip(self, stage) -> Iterator[np.ndarray]:
+        """Turn the held target upside down and set it down on its top (:mod:`gendex.solve.flip`)."""
+        yield from flip(self.rigid, stage.target)
 
     def _release(self, stage) -> Iterator[np.ndarray]:
         """Let go; an object held over what a condition wants it in, on or by is first set down there (a dropped tall
