@@ -203,6 +203,7 @@ ROLE_TESTS = {
     "pourable": lambda a: "pourable" in a["tags"] and not a.get("joints"),
     "pourer": lambda a: "pourer" in a["tags"] and not a.get("joints"),
     "pour_into": lambda a: is_container(a) and "pourer" not in a["tags"] and min(a["size_m"][:2]) >= 0.14,
+    "flippable": lambda a: "pourer" in a["tags"] and not a.get("joints"),
 }
 """What an object must be to play each role."""
 
@@ -212,7 +213,7 @@ SKILL_ROLES: dict[str, tuple[str, ...]] = {
     "turn": ("turnable",), "reorient": ("ball",), "place_at": ("graspable", "landmark"),
     "take_out": ("graspable", "holder"), "press": ("pressable",), "hand_over": ("graspable",),
     "twist": ("screwable",), "insert": ("insertable", "socket"), "wipe": ("wiper", "wipe_area"),
-    "hang": ("hangable", "hang_on"), "pour": ("pourable", "pourer", "pour_into"),
+    "hang": ("hangable", "hang_on"), "pour": ("pourable", "pourer", "pour_into"), "flip": ("flippable",),
 }
 """The roles of a skill's objects, in order (what :attr:`Reading.objects` holds)."""
 
@@ -316,6 +317,8 @@ def _skill(words: list[str]) -> tuple[str, int] | None:
     opened = re.search(r" open (?!hand |palm |fingers )", rest)  # not 'with the open hand'
     if names[0] in ("lift", "push", "turn") and (opened or " lid off " in rest):
         return "open", end  # lift the lid open, swing the door open, take the lid off
+    if " upside down " in rest or (names[0] in ("turn", "press", "flip") and rest.endswith(" over ")):
+        return "flip", end  # turn the glass upside down, turn the cup over
     if "turn" in names and "reorient" in names:
         return "turn", end
     return names[0], end
@@ -445,7 +448,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
 
     r = object_skill(Read(skill, roles, relation, region, mentions), words, text, assets)
     skill, roles, relation, region, mentions = r.skill, r.roles, r.relation, r.region, r.mentions
-    if skill in ("push", "turn") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
+    if skill in ("push", "turn", "flip") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'
     if skill == "close" and mentions and mentions[0].asset and ROLE_TESTS["turnable"](

@@ -218,6 +218,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "pour the {p} in the {o} out into the {d} and stand the {o} upright again",
         "tip the {o} over the {d} until the {p} fall in",
     ),
+    "flip": (
+        "turn the {o} upside down",
+        "turn the {o} over and leave it upside down on the {s}",
+        "flip the {o} over so that it stands upside down",
+        "turn the {o} upside down and let go of it",
+        "upend the {o} on the {s}",
+    ),
     "hand_over": (
         "hand the {o} over to the person across the {s}",
         "pass the {o} over and leave it on the hand-over mat",

@@ -9,7 +9,7 @@ from typing import Any
 
 ROLES = ("graspable", "container", "articulated", "support")
 PROPOSAL_CONDITION_TYPES = ("lifted", "inside", "joint_open", "joint_at", "near", "over", "placed", "wiped", "hung",
-                            "poured")
+                            "poured", "flipped")
 """Success condition types a proposal may state (the task's success; stages get theirs in the plan step)."""
 
 

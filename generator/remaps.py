@@ -14,7 +14,8 @@
   first, then the vessel, then the container, and what is left unsaid is the catalog's first that can be it; a
   glass or a cup one pours from is the vessel of :data:`~generator.vocabulary.POUR_VESSELS` (a wine glass or a
   teacup is none), and pieces the catalog lacks (*the rice*) are its closest pieces, a recorded substitution; a lid
-  tipped back (*tip the bin's lid back to open it*) is an ``open``.
+  tipped back (*tip the bin's lid back to open it*) is an ``open``;
+- a glass or a cup turned over (*turn the glass upside down*) is the same vessel a pour would use.
 """
 
 from __future__ import annotations
@@ -81,22 +82,31 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
         r = Read("open", SKILL_ROLES["open"], None, None, r.mentions)  # 'tip the bin's lid back to open it'
     if r.skill == "pour":
         r = _pour_order(r, plays, assets)
+    if r.skill == "flip":  # 'turn the glass upside down': a drinking glass, as in a pour
+        r = dataclasses.replace(r, mentions=[_vessel(m, plays) for m in r.mentions])
     return r
+
+
+def _vessel(m: Mention, plays) -> Mention:
+    """``m`` as the vessel of :data:`~generator.vocabulary.POUR_VESSELS` its last word names, where it names an
+    object that is none (*the glass*: the tumbler, not the wine glass; *the cup*: the paper cup, not the teacup); a
+    phrase that says more (*the wine glass*) names what it says, and a colour stays the vessel's."""
+    from generator.vocabulary import POUR_VESSELS
+
+    words = m.phrase.split() if m.phrase else []
+    plain = len(words) == 1 or (len(words) == 2 and m.color is not None)  # 'the glass', 'the red glass'
+    if m.asset and plain and not plays(m, "pourer") and words[-1] in POUR_VESSELS and not plays(m, "pour_into"):
+        vessel = POUR_VESSELS[words[-1]]
+        return dataclasses.replace(m, asset=vessel, options=(vessel,), how="synonym")
+    return m
 
 
 def _pour_order(r: Read, plays, assets: Sequence[dict]) -> Read:
     """A pour's mentions as pieces, vessel, container, with its roles in that order and the unsaid ones last (module
     docstring)."""
     from generator.instruction import SKILL_ROLES
-    from generator.vocabulary import POUR_VESSELS
 
-    mentions = []
-    for m in r.mentions:
-        word = m.phrase.split()[-1] if m.phrase else ""
-        if m.asset and not plays(m, "pourer") and word in POUR_VESSELS and not plays(m, "pour_into"):
-            vessel = POUR_VESSELS[word]
-            m = dataclasses.replace(m, asset=vessel, options=(vessel,), how="synonym", color=None)
-        mentions.append(m)
+    mentions = [_vessel(m, plays) for m in r.mentions]
     pieces = [m for m in mentions if plays(m, "pourable")]
     vessels = [m for m in mentions if plays(m, "pourer") and m not in pieces]
     rest = [m for m in mentions if m not in pieces and m not in vessels]

@@ -35,7 +35,8 @@ from generator.stats import latest_versions, task_skills
 
 log = logging.getLogger(__name__)
 
-RIGID_CONDITIONS = ("lifted", "inside", "over", "near", "rotated", "placed", "wiped", "hung", "poured")
+RIGID_CONDITIONS = ("lifted", "inside", "over", "near", "rotated", "placed", "wiped", "hung", "poured",
+                    "flipped")
 """Success conditions whose ``object`` is the object a rigid part of the task moves."""
 MAX_REUSE = 2
 """A situation or purpose frames at most this many of the reworded library's instructions (the embedding alone

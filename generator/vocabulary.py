@@ -43,7 +43,7 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
               "a faucet or valve lever, on or off", "turn on the faucet"),
     TaskSkill("press", ("press", "push down", "hit", "click", "depress", "flip", "toggle", "punch", "smash"),
               "a button pressed all the way down, or a lever switch flipped on", "press the emergency stop button"),
-    TaskSkill("reorient", ("rotate", "spin", "reorient", "roll", "turn over"),
+    TaskSkill("reorient", ("rotate", "spin", "reorient", "roll"),
               "a ball held in the hand (a trained in-hand policy)", "rotate the tennis ball in the hand"),
     TaskSkill("take_out", ("take out", "get out", "lift out", "pull out", "fish out", "remove"),
               "a graspable object taken out of a container (bowl, pot) or a drawer and set down on the table beside it",
@@ -66,6 +66,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
     TaskSkill("pour", ("pour out", "pour", "tip out", "tip", "empty out", "empty"),
               "the beads or marbles in a glass, beaker or paper cup poured into a bowl (at least 75 % of them), and "
               "the vessel stood up again", "pour the beads from the glass into the bowl"),
+    TaskSkill("flip", ("turn upside down", "turn over", "flip over", "flip", "upend", "invert", "overturn"),
+              "a glass, beaker or paper cup turned upside down on the table (standing on its rim), let go and still",
+              "turn the glass upside down"),
     TaskSkill("hand_over", ("hand over", "hand me", "hand it", "hand off", "pass me", "pass over", "pass it", "pass",
                             "give me", "bring me", "deliver"),
               "a graspable object left on the hand-over mat for a person to take: let go, still, upright if it stood",

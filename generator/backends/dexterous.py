@@ -1,6 +1,7 @@
 """The offline author's tasks of dexterous skills that need an exact fit, a press or a tip of the wrist: a peg put
 into the hole it fits (``insert``), a spill wiped with a sponge pressed down on it (``wipe``), a mug hung by its
-handle on a peg (``hang``), and the beads in a glass poured into a bowl (``pour``). Each returns a proposal (a dict,
+handle on a peg (``hang``), the beads in a glass poured into a bowl (``pour``) and a glass turned upside down on the
+table (``flip``). Each returns a proposal (a dict,
 as :mod:`generator.backends.offline` writes them); ``words(name)`` is the author's generator that words a task."""
 
 from __future__ import annotations
@@ -29,6 +30,10 @@ actions met it on none of 150 episodes each: benchmarks/results/skills.md)."""
 POUR_PIECES = 12
 """Pieces the offline author fills a vessel with: three layers of four in a tumbler or a paper cup (8 cm of their
 13.5), beads four layers of three in the narrower beaker (10 cm of its 14; :func:`gendex_envs.pouring.fill_layout`)."""
+
+FLIP_TILT_DEG = 150.0
+"""A flipped object's axis is at least this far from where it pointed at reset (upside down on its rim: 175-180; on
+its side: 90)."""
 
 Words = Callable[[str], np.random.Generator]
 
@@ -119,5 +124,24 @@ def pour_task(piece: dict, vessel: dict, target: dict, words: Words, colors: tup
     }
 
 
-__all__ = ["HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "POUR_FRACTION", "POUR_PIECES", "WIPE_FRACTION", "hang_task",
-           "insert_task", "pour_task", "wipe_task"]
+def flip_task(a: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dict:
+    """Turn vessel ``a`` upside down on the table: grasp it by its side, turn it over and let it go on its rim
+    (:mod:`gendex.solve.flip`); the scene step adds that it is let go and still
+    (:func:`generator.steps.scene.hung_lets_go`)."""
+    n = a["category"]
+    name = camel("flip", *painted(a, colors, 0))
+    flipped = {"type": "flipped", "object": n, "min_tilt_deg": FLIP_TILT_DEG}
+    return {
+        "name": name,
+        "description": phrase("flip", a, words(name), **qualifiers(a, None, colors)),
+        "objects": [{"name": n, "asset": a["id"], "role": "graspable"}],
+        "steps": [*carry_steps(n, n, "over")[:2],
+                  step("flip", n, "arm", f"Turn the {word(n)} upside down and lower it to the table."),
+                  step("release", n, "hand", f"Let go of the {word(n)}: it stands on its rim.")],
+        "success": flipped,
+        "success_text": f"The {word(n)} stands upside down on the table, let go and still.",
+    }
+
+
+__all__ = ["FLIP_TILT_DEG", "HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "POUR_FRACTION", "POUR_PIECES",
+           "WIPE_FRACTION", "flip_task", "hang_task", "insert_task", "pour_task", "wipe_task"]

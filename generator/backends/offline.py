@@ -39,7 +39,7 @@ from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
-from generator.backends.dexterous import hang_task, insert_task, pour_task, wipe_task
+from generator.backends.dexterous import flip_task, hang_task, insert_task, pour_task, wipe_task
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
@@ -55,6 +55,7 @@ from generator.backends.roles import (
     drawer_words,
     fits_hole,
     fits_in,
+    flippable,
     graspable,
     handed,
     handover_zone,
@@ -97,7 +98,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "twist", "insert", "wipe", "hang", "pour",
+              "press", "hand_over", "twist", "insert", "wipe", "hang", "pour", "flip",
               "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
@@ -199,6 +200,7 @@ class OfflineBackend:
         out += [("hang", hang_task(a, b, self._words)) for a in assets if hangable(a) for b in assets if hook_stand(b)]
         out += [("pour", pour_task(p, a, b, self._words)) for p in assets if pourable(p) for a in assets if pourer(a)
                 for b in assets if pour_into(b)]
+        out += [("flip", flip_task(a, self._words)) for a in assets if flippable(a)]
         for (skill, i) in ARTICULATED_LAYOUTS:
             if i in by_id:
                 out.append((_kind(skill, by_id[i]), self._articulated_task(skill, by_id[i])))
@@ -544,6 +546,9 @@ class OfflineBackend:
                                        f"{mentions[0]['phrase']}'); ask for them without a colour")
             proposal = pour_task(pick(0, pourable, "pieces to pour"), pick(1, pourer, "glass, beaker or cup to pour "
                                  "from"), pick(2, pour_into, "bowl to pour into"), self._words, colors)
+        elif skill == "flip":
+            proposal = flip_task(pick(0, flippable, "glass, beaker or paper cup to turn upside down"), self._words,
+                                 colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
                                             "block to push"))
@@ -566,7 +571,7 @@ class OfflineBackend:
             raise InstructionError(
                 f"the offline author writes no '{skill}' task: in-hand reorientation needs a trained stage policy "
                 "(see GenDex/RotateTennisBall-v0 and `gendex train`). It writes: lift, put_in, place_on, stack, "
-                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe, hang, pour.")
+                "push, open, close, turn, press, take_out, place_at, hand_over, twist, insert, wipe, hang, pour, flip.")
         name, k = proposal["name"], 2
         while proposal["name"] in existing:
             proposal["name"] = f"{name}{k}"

@@ -29,7 +29,7 @@ from generator.backends.roles import (
 from generator.backends.wording import fence as _fence
 from generator.critic.physical import CONTAINER_FLOOR_M
 
-STAGE_HORIZONS = {"twist": 700, "wipe": 250, "hang": 250, "pour": 250}
+STAGE_HORIZONS = {"twist": 700, "wipe": 250, "hang": 250, "pour": 250, "flip": 200}
 """Stage horizons (control steps) of skills that take longer than a stage's usual 40 (a twist: 5-6 grasps a turn,
 about 90 steps each; hand-written trials 525-741 steps with the reach)."""
 PUSH_M = 0.22
@@ -73,6 +73,10 @@ POUR_BOWL_X_M = (0.06, 0.14)
 POUR_SPREAD_M = 0.04
 POUR_RANDOMIZE = ({"xy_m": [0.05, 0.05], "yaw_deg": 90.0}, {"xy_m": [0.03, 0.03], "yaw_deg": 30.0})
 """How far they move at reset: the vessel +-5 cm, turned either way up to 90 deg; the bowl +-3 cm and 30 deg."""
+FLIP_REGION_M = ((-0.02, 0.1), (-0.12, 0.12))
+"""Where a glass to turn over is put: the middle of the table ahead of the robot, where it is raised 32 cm, turned
+about the hand's fingers and lowered again (the flip primitive's measured layout: (0.02, 0), +-8 x +-12 cm)."""
+FLIP_RANDOMIZE = {"xy_m": [0.08, 0.08], "yaw_deg": 180.0}
 HOLDER_YAW_DEG = 20.0
 """How far a peg and its (fixed) holder move at reset: +-5 cm each (a hole 3 mm wider than its peg; their footprints
 stay 5 cm apart, :data:`generator.critic.skill_checks.INSERT_APART_M`), the holder turned up to 20°, the peg any way
@@ -123,6 +127,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
     hung = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "hung"}
     poured = {c["object"]: c["target"] for c in (proposal["success"], *(proposal.get("also") or ()))
               if c["type"] == "poured"}
+    flipped = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "flipped"}
     pour_at = _pour_layout(poured, {o["name"]: assets[o["asset"]] for o in proposal["objects"]}, rng)
     for box in (o for o in proposal["objects"] if o["name"] in inside.values()):  # taken out of a drawer
         if drawer_joint(assets[box["asset"]]):
@@ -175,6 +180,10 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(y, 3), 0.0]
             entry["fixed"] = hook_stand(a)
             entry["randomize"] = dict(STAND_RANDOMIZE if hook_stand(a) else HANG_RANDOMIZE)
+        elif o["name"] in flipped:  # a glass to turn over: ahead of the robot, in the middle
+            (x0, x1), (y0, y1) = FLIP_REGION_M
+            entry["pos_m"] = [round(float(rng.uniform(x0, x1)), 3), round(float(rng.uniform(y0, y1)), 3), 0.0]
+            entry["randomize"] = dict(FLIP_RANDOMIZE)
         elif o["name"] in pour_at:  # a vessel on one side, the bowl it pours into on the other
             entry["pos_m"] = pour_at[o["name"]]
             entry["randomize"] = dict(POUR_RANDOMIZE[int(o["name"] not in poured)])
@@ -199,7 +208,8 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
                 gy = y - np.sign(y or 1.0) * PUSH_M
                 goal = {"pos_m": [round(x, 3), round(float(gy), 3), 0.0], "radius_m": 0.03}
         objects.append(entry)
-    if any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P and not spots:
+    if (any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P and not spots
+            and not flipped):  # a glass turned over is lowered onto its rim where it stood: nothing beside it
         objects.append(_distractor(proposal, assets, rng, movable))
     stages = []
     for i, s in enumerate(proposal["steps"]):

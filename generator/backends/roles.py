@@ -107,6 +107,13 @@ def pourer(a: dict) -> bool:
     return "pourer" in a["tags"] and not a.get("joints")
 
 
+def flippable(a: dict) -> bool:
+    """Something the offline author turns upside down on the table: the vessels it pours from (held by their side,
+    they drop 3-4 cm onto their rim and stand there; a narrow box or a bottle on its cap topples,
+    ``benchmarks/results/skills.md``)."""
+    return pourer(a)
+
+
 def pourable(a: dict) -> bool:
     """Loose pieces a vessel holds and pours (an asset tagged ``pourable``: a bead, a marble)."""
     return "pourable" in a["tags"] and not a.get("joints")

@@ -69,7 +69,7 @@ How each check is measured (the thresholds are the module constants below):
     fraction is (q - closed) / (open - closed) of the joint the conditions name, else the asset's main joint.
     Fix: ``joint_fix`` = {object, joint, value} setting the joint to its closed (resp. open) value; the directive
     grammar has no joint edit.
-``handover``, ``insert``, ``wipe``, ``hang``, ``pour`` (static)
+``handover``, ``insert``, ``wipe``, ``hang``, ``pour``, ``flip`` (static)
     What a skill needs of the scene: :mod:`generator.critic.skill_checks` (an object to hand over starts clear of
     its hand-over zone, a peg of its holder, a sponge of its spill). No check measures the pieces laid in a vessel to
     pour (:mod:`gendex_envs.pouring`): they move with it.
@@ -99,7 +99,7 @@ from generator.critic.skill_checks import skill_checks
 log = logging.getLogger(__name__)
 
 CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "in_front", "scale",
-                  "joint_state", "handover", "insert", "wipe", "hang", "pour"]
+                  "joint_state", "handover", "insert", "wipe", "hang", "pour", "flip"]
 CHECKS: tuple[str, ...] = get_args(CheckId)
 
 # ----------------------------------------------------------------------------------------------- thresholds

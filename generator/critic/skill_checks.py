@@ -20,6 +20,11 @@ calls them among its static checks, with the same :class:`~generator.critic.phys
     The same for a vessel and the container it pours into (a ``poured`` condition): a vessel that starts against the
     bowl leaves the hand no room to grasp it, and tipped where it stands it pours half its pieces in. Gap
     :data:`POUR_APART_M`, the same fix.
+``flip``
+    Every other object must start at least :data:`FLIP_ROOM_M` from an object the success turns over (``flipped``),
+    footprints widened by their randomization: the glass is raised, turned about the hand and let go onto its rim
+    where it stood, and the hand sweeps round it. Fix: the other object moves away along the axis it is already most
+    apart on.
 """
 
 from __future__ import annotations
@@ -54,6 +59,9 @@ HANG_APART_M = 0.05
 POUR_APART_M = 0.05
 """Least gap (m) between a vessel's footprint and the container it pours into, both widened by their
 randomization."""
+FLIP_ROOM_M = 0.1
+"""Least gap (m) between an object to turn over and any other object, both footprints widened by their
+randomization."""
 _CARRIED = (*SET_DOWN_CONDITIONS, "placed", "wiped", "hung")
 APART: dict[str, tuple[str, float, str, tuple[str, ...]]] = {
     "handover": ("handover", HANDOVER_APART_M, "hand-over zone", _CARRIED),
@@ -70,6 +78,38 @@ def skill_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict[str, dict
     that starts too near the target its success takes it to."""
     for check in APART:
         _apart_checks(check, spec, placed, meas[check], violations)
+    _room_checks(spec, placed, meas["flip"], violations)
+
+
+def _room_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violations: list[Violation]) -> None:
+    """The ``flip`` check (module docstring)."""
+    from generator.critic.physical import Violation, moves, rounded
+
+    for c in spec.success.conditions:
+        if c.negate or c.type != "flipped" or c.object not in placed:
+            continue
+        obj = placed[c.object]
+        wo = np.asarray(obj.spec.randomize.xy_m)
+        o_lo, o_hi = obj.lo[:2] - wo, obj.hi[:2] + wo
+        for name, other in placed.items():
+            if name == c.object:
+                continue
+            w = np.asarray(other.spec.randomize.xy_m)
+            gaps = _gaps(o_lo, o_hi, other.lo[:2] - w, other.hi[:2] + w)
+            gap = float(np.linalg.norm(gaps))
+            meas[f"{c.object}/{name}"] = {"gap_m": rounded(gap), "limit_m": FLIP_ROOM_M}
+            if gap >= FLIP_ROOM_M:
+                continue
+            d = other.centre_xy - obj.centre_xy
+            axis = int(np.argmax(np.abs(d))) if np.abs(d).max() > 0.01 else 0
+            sign = 1.0 if d[axis] > 0.01 else -1.0
+            step = np.zeros(2)
+            step[axis] = (o_hi[axis] + FLIP_ROOM_M - (other.lo[axis] - w[axis]) if sign > 0
+                          else o_lo[axis] - FLIP_ROOM_M - (other.hi[axis] + w[axis])) + sign * 1e-3
+            violations.append(Violation(
+                "flip", name, f"{name!r} starts {gap:.3f} m from {c.object!r}, which is turned over where it stands "
+                f"(footprints widened by their randomization); it must be at least {FLIP_ROOM_M} m away",
+                measured=gap, limit=FLIP_ROOM_M, fix=moves(name, step), other=c.object))
 
 
 def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: dict,
@@ -102,5 +142,5 @@ def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: d
             measured=gap, limit=apart, fix=moves(c.object, step), other=c.target))
 
 
-__all__ = ["APART", "HANDOVER_APART_M", "HANG_APART_M", "INSERT_APART_M", "POUR_APART_M", "WIPE_APART_M",
+__all__ = ["APART", "FLIP_ROOM_M", "HANDOVER_APART_M", "HANG_APART_M", "INSERT_APART_M", "POUR_APART_M", "WIPE_APART_M",
            "skill_checks"]

@@ -40,7 +40,7 @@ MAX_STEPS = 4 * MAX_PARTS
 """Steps of a proposal: up to 4 for a part (reach, grasp, carry, release)."""
 SUCCESS_KEYS = ("type", "object", "target", "negate", "min_height_m", "min_fraction", "max_dist_m", "max_xy_m",
                 "min_dz_m", "max_dz_m", "fraction", "max_error", "relation", "other", "region", "min_gap_m",
-                "max_gap_m", "max_offset_m", "joint")
+                "max_gap_m", "max_offset_m", "joint", "min_tilt_deg")
 """Keys a proposal's success condition may carry (``negate`` with ``joint_open``: the joint is shut; ``fraction``
 and ``max_error`` with ``joint_at``: the joint set part way; ``relation``, ``other``, ``region`` and the gaps with
 ``placed``: where the object is set down, seen from the robot; ``joint`` with ``inside``: the drawer of a chest it

@@ -187,16 +187,20 @@ def inserted_upright(spec: TaskSpec) -> TaskSpec:
 
 
 def hung_lets_go(spec: TaskSpec) -> TaskSpec:
-    """Give every object the success hangs on something (``hung``) a ``released`` and an ``at_rest`` condition: a
-    mug still held up by the hand, its handle touching the peg, or one swinging there, is not hung yet."""
+    """Give every object the success hangs on something (``hung``) or turns over (``flipped``) a ``released`` and an
+    ``at_rest`` condition: a mug still held up by the hand, its handle touching the peg, or one swinging there, is not
+    hung yet; a glass still in the hand, or rolling off its rim, is not left upside down. A flip holds
+    :data:`SETTLED_STEPS` too (the glass drops 3-4 cm onto its rim when let go)."""
     conds = spec.success.conditions
     have = {(c.type, c.object) for c in conds if not c.negate}
-    hung = dict.fromkeys(c.object for c in conds if c.type == "hung" and not c.negate)
+    hung = dict.fromkeys(c.object for c in conds if c.type in ("hung", "flipped") and not c.negate)
     extra = tuple(ConditionSpec(type=t, object=o) for o in hung for t in ("released", "at_rest") if (t, o) not in have)
     if not extra:
         return spec
-    log.info("success of %s: %s must be let go and hang still", spec.name, ", ".join(hung))
-    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra))
+    log.info("success of %s: %s must be let go and lie still", spec.name, ", ".join(hung))
+    hold = SETTLED_STEPS if any(c.type == "flipped" and not c.negate for c in conds) else spec.success.hold_steps
+    return dataclasses.replace(spec, success=dataclasses.replace(spec.success, conditions=conds + extra,
+                                                                 hold_steps=max(spec.success.hold_steps, hold)))
 
 
 def poured_stands_up(spec: TaskSpec) -> TaskSpec:

@@ -30,6 +30,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
     "twist": ("screw_jar", None), "insert": ("peg_square", "peg_holder_square"),
     "wipe": ("sponge_block", "spill_square"), "hang": ("mug", "mug_tree"), "pour": ("tumbler", "bowl"),
+    "flip": ("paper_cup", None),
 }
 PIECES = {"pour": ("bead", "marble")}
 """The pieces a skill's command names (a pour's beads or marbles), read back first."""
