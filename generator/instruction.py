@@ -331,6 +331,11 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if not text:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
+    why = re.search(r",? so (?:that )?(?:it|they|the|there|we|i|you|nothing|no) .*$", text)
+    if why is not None and why.start() > 0:  # 'flip the cup over so it can dry': a purpose, nothing to do
+        reading = read_instruction(text[:why.start()], assets)
+        note = f"'{why.group(0).lstrip(', ')}' is read as the reason, not as something to do"
+        return dataclasses.replace(reading, instruction=text, notes=(*reading.notes, note))
     compound = read_compound(text, assets, lambda step: read_instruction(step, assets), _starts_with_verb,
                              lambda step: _skill(_words(step)))
     if compound is not None:  # steps in order, 'and' and a verb, several objects to one place
