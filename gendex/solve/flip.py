@@ -13,8 +13,9 @@ its lean and is let go low instead. :func:`flip`
 3. lowers it straight down until its lowest point is :data:`DROP_M` over the table or the next
    :data:`LOWER_STEP_M` would bring the arm (the planner's collision model) within its margin of the table.
 
-A release stage lets go afterwards: from 3-4 cm the object drops onto its top and stays there (a cup or glass; a
-narrow box or a bottle on its cap topples). Measured rates on unseen seeds: ``benchmarks/results/skills.md``.
+A release stage lets go afterwards: from 3-4 cm the object drops onto its top and stays there, leaning 22-29 deg as
+the grasp held it (a tumbler or a paper cup; a beaker lands on its side about half the time, a narrow box or a bottle
+on its cap topples). Measured rates on unseen seeds: ``benchmarks/results/skills.md``.
 """
 
 from __future__ import annotations
@@ -63,6 +64,9 @@ def flip(rigid: RigidPrimitives, name: str) -> Iterator[np.ndarray]:
     if done < MIN_TURN:
         raise ExecutionError(f"the arm turned {name!r} only {done:.0%} of half a turn", cause="no_ik")
     yield from m.hold(rigid.config.motion.settle_steps)
+    up = sapien.Pose(q=env.obj(name).pose.q[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
+    was = sapien.Pose(q=env.init_obj_quat(name)[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
+    lean = float(np.degrees(np.arccos(np.clip(-(up @ was), -1.0, 1.0))))
     m.collision.set_obstacles([])
     q = m.target()
     while (step := min(LOWER_STEP_M, float(m.world_aabb(name)[0][2]) - env.table_height - DROP_M)) > 1e-4:
@@ -72,8 +76,8 @@ def flip(rigid: RigidPrimitives, name: str) -> Iterator[np.ndarray]:
             break
         yield from m.cartesian(np.array([0.0, 0.0, -step]), rigid.config.motion.lift_m_per_step, guard=True)
         q = m.target()
-    log.info("turned %r over (%.0f%% of half a turn); its lowest point %.3f m over the table", name, 100 * done,
-             float(m.world_aabb(name)[0][2]) - env.table_height)
+    log.info("turned %r over (%.0f%% of half a turn, %.0f deg off upside down); its lowest point %.3f m over the "
+             "table", name, 100 * done, lean, float(m.world_aabb(name)[0][2]) - env.table_height)
     yield from m.hold(rigid.config.motion.settle_steps)
 
 

@@ -547,7 +547,7 @@ class OfflineBackend:
             proposal = pour_task(pick(0, pourable, "pieces to pour"), pick(1, pourer, "glass, beaker or cup to pour "
                                  "from"), pick(2, pour_into, "bowl to pour into"), self._words, colors)
         elif skill == "flip":
-            proposal = flip_task(pick(0, flippable, "glass, beaker or paper cup to turn upside down"), self._words,
+            proposal = flip_task(pick(0, flippable, "glass or paper cup to turn upside down"), self._words,
                                  colors)
         elif skill == "push":
             proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",

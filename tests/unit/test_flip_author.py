@@ -13,6 +13,7 @@ from gendex_envs.spec import spec_to_dict
 from generator.backends.dexterous import FLIP_TILT_DEG
 from generator.backends.offline import OfflineBackend
 from generator.backends.offline_scene import FLIP_RANDOMIZE, FLIP_REGION_M
+from generator.backends.roles import FLIPPABLE
 from generator.catalog_view import asset_dicts
 from generator.critic.directives import Directive
 from generator.critic.physical import check_scene_static
@@ -56,7 +57,7 @@ def test_a_colour_stays_a_wine_glass_is_refused_and_flipping_a_switch_is_a_press
 
 
 @pytest.mark.parametrize("text, asset", [("turn the glass upside down", "tumbler"),
-                                         ("flip the beaker over", "beaker")])
+                                         ("flip the paper cup over", "paper_cup")])
 def test_a_flip_grasps_turns_over_and_lets_go_and_ends_flipped_let_go_and_still(text, asset, guided):
     p, spec = guided(text)
     assert [o.asset for o in p.objects] == [asset]
@@ -78,6 +79,12 @@ def test_a_flip_grasps_turns_over_and_lets_go_and_ends_flipped_let_go_and_still(
     assert "turned" in task and "init_obj_quat" in task
     check_reward_source(compose_stage_module(raw, flip.name, roles))
     assert check_scene_static(spec).ok
+
+
+def test_the_author_refuses_a_beaker_it_cannot_stand_on_its_rim(guided):
+    assert read_instruction("turn the beaker over", asset_dicts()).skill == "flip"  # read, then refused saying why
+    with pytest.raises(InstructionError, match="glass or paper cup to turn upside down"):
+        guided("turn the beaker over")
 
 
 def test_the_critic_keeps_other_objects_clear_of_a_glass_to_turn_over():
@@ -105,10 +112,10 @@ def test_the_grammar_writes_a_flip_of_each_vessel_and_stats_know_them():
     from generator.steps.propose import propose
 
     b, existing, out = OfflineBackend(seed=11, kinds=("flip",)), (), []
-    for i in range(3):
+    for i in range(len(FLIPPABLE)):
         p, _ = propose(b, index=i, existing=existing)
         existing += (p.name,)
         out.append(p)
     assert all(p.success["type"] == "flipped" for p in out)
-    assert {p.objects[0].asset for p in out} == {"tumbler", "beaker", "paper_cup"}
+    assert {p.objects[0].asset for p in out} == set(FLIPPABLE)  # then it has no more flips to write
     assert condition_skill("flipped") == "flip" and condition_skill("flipped", negate=True) is None
