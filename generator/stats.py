@@ -32,13 +32,13 @@ from generator.phrasing import split
 
 TASK_SKILLS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "close_door", "open_drawer",
                "close_drawer", "open_lid", "close_lid", "turn", "reorient", "place_at", "take_out", "press",
-               "hand_over", "twist", "insert", "wipe", "hang", "pour")
+               "hand_over", "twist", "insert", "wipe", "hang", "pour", "flip")
 """The task skills: the solver issue's thirteen in its order, then the task language's places (``place_at``: set
 down beside, between or in a region), taking an object out of a container (``take_out``), then the dexterous
 skills' (``press``: a button or switch pushed past its detent; ``hand_over``: an object left still on the hand-over
 mat; ``twist``: a cap unscrewed, regrasped between turns of the hand; ``insert``: a peg put into its holder's
 hole; ``wipe``: a spill's marks passed over by a sponge pressed on it; ``hang``: a mug hung by its handle on a
-peg; ``pour``: the beads in a glass tipped into a bowl)."""
+peg; ``pour``: the beads in a glass tipped into a bowl; ``flip``: a glass turned upside down on the table)."""
 PUBLISHED_DIVERSITY = {"GenDexHand": 0.288, "RoboGen": 0.191}
 """Mean pairwise cosine similarity of task descriptions (all-MiniLM-L6-v2) as the papers report them."""
 DIVERSITY_GOAL = 0.19
@@ -98,10 +98,12 @@ def condition_skill(kind: str, *, target_category: str | None = None, target_is_
         return None if negate else "hang"
     if kind == "poured":
         return None if negate else "pour"
+    if kind == "flipped":
+        return None if negate else "flip"
     return None
 
 
-STAGE_TASK_SKILLS = ("reorient", "push", "turn", "press", "twist", "wipe", "hang", "pour")
+STAGE_TASK_SKILLS = ("reorient", "push", "turn", "press", "twist", "wipe", "hang", "pour", "flip")
 """Stage skills that are task skills by themselves, whatever the success condition."""
 
 
