@@ -4,8 +4,8 @@ table and let go there. They are the spec of ``tests/sim/test_flip.py`` under th
 the generator writes for a flip (:mod:`generator.reward_library`); they are not library tasks.
 
     .venv/bin/python benchmarks/flip_tasks.py /tmp/fliptasks
-    GENDEX_TASKS_PATH=/tmp/fliptasks .venv/bin/python benchmarks/skill.py --tasks GenDex/FlipTumbler-v0 \\
-        GenDex/FlipPaperCup-v0 GenDex/FlipBeaker-v0 --seeds 50 --seed 77000 --workers 2
+    GENDEX_TASKS_PATH=/tmp/fliptasks .venv/bin/python benchmarks/skill.py --tasks GenDex/FlipHandTumbler-v0 \\
+        GenDex/FlipHandPaperCup-v0 GenDex/FlipHandBeaker-v0 --seeds 50 --seed 77000 --workers 2
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from gendex_envs.task_version import TaskLayout
 from generator.reward_library import compose_task_module
 from tests.sim.test_flip import _task  # the spec the tests check
 
-TASKS = (("FlipTumbler", "tumbler"), ("FlipPaperCup", "paper_cup"), ("FlipBeaker", "beaker"))
+TASKS = (("FlipHandTumbler", "tumbler"), ("FlipHandPaperCup", "paper_cup"), ("FlipHandBeaker", "beaker"))
 
 
 def main() -> None:

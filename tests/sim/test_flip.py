@@ -22,8 +22,8 @@ FLIPPED = {"type": "flipped", "object": "glass", "min_tilt_deg": 150.0}
 def _task(vessel: str = "tumbler") -> dict:
     return {
         "name": "FlipCheck", "instruction": "Turn the glass upside down.",
-        "objects": [{"name": "glass", "asset": vessel, "pos_m": [0.02, 0.0, 0.0],
-                     "randomize": {"xy_m": [0.08, 0.12], "yaw_deg": 180.0}}],
+        "objects": [{"name": "glass", "asset": vessel, "pos_m": [0.04, 0.0, 0.0],
+                     "randomize": {"xy_m": [0.12, 0.2], "yaw_deg": 180.0}}],
         "stages": [
             {"name": "reach_glass", "instruction": "Reach the glass.", "skill": "reach", "method": "motion_planning",
              "control_joint": "arm", "horizon": 60, "target": "glass"},
