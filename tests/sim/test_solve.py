@@ -199,7 +199,8 @@ def test_stage_executor_solves_put_apple_bowl(apple_env):
 @pytest.mark.parametrize(("edit", "message"), [
     ({"target": None}, "no target object"),
     ({"skill": "turn"}, r"no primitive for skill 'turn' on a rigid target \('apple'\); skills it runs there: "
-                        r"\['carry', 'grasp', 'hang', 'lift', 'place', 'pour', 'push', 'reach', 'release', 'wipe'\]"),
+                        r"\['carry', 'flip', 'grasp', 'hang', 'lift', 'place', 'pour', 'push', 'reach', 'release', "
+                        r"'wipe'\]"),
 ])
 def test_stage_executor_refuses_a_stage_it_cannot_script(task_version, edit, message):
     """A stage without a target, or whose skill has no primitive for its target, ends the attempt with the named

@@ -163,7 +163,7 @@ def test_allowed_value_constants() -> None:
                                "hand_at", "fingertips_near", "hand_open", "placed", "joint_at", "upright", "flipped",
                                "at_rest", "wiped", "hung", "poured")
     assert SKILLS == ("reach", "grasp", "lift", "carry", "place", "release", "open", "close", "push", "turn",
-                      "reorient", "press", "twist", "wipe", "hang", "pour")
+                      "reorient", "press", "twist", "wipe", "hang", "pour", "flip")
     assert KEYFRAMES == ("rest", "pregrasp_open", "palm_up")
     assert ROBOT_UIDS == ("ur10e_shadow",)
 
