@@ -332,7 +332,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
     why = re.search(r",? so (?:that )?(?:it|they|the|there|we|i|you|nothing|no) .*$", text)
-    if why is not None and why.start() > 0:  # 'flip the cup over so it can dry': a purpose, nothing to do
+    if why is not None and why.start() > 0 and not re.search(r"\bthen\b|;", why.group(0)):
+        # 'flip the cup over so it can dry': a purpose, nothing to do (not when a step follows it)
         reading = read_instruction(text[:why.start()], assets)
         note = f"'{why.group(0).lstrip(', ')}' is read as the reason, not as something to do"
         return dataclasses.replace(reading, instruction=text, notes=(*reading.notes, note))

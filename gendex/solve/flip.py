@@ -11,7 +11,8 @@ its lean and is let go low instead. :func:`flip`
 2. turns the palm half a turn about the fingers' line through the object's centre (:meth:`ArmHandMotion.turn_about`:
    the object stays where it is, the palm goes round it), at :data:`TURN_RAD_PER_STEP`,
 3. lowers it straight down until its lowest point is :data:`DROP_M` over the table or the next
-   :data:`LOWER_STEP_M` would bring the arm (the planner's collision model) within its margin of the table.
+   :data:`LOWER_STEP_M` would bring the arm (the planner's collision model) within its margin of the table or of
+   another object.
 
 A release stage lets go afterwards: from 3-4 cm the object drops onto its top and stays there, leaning 22-29 deg as
 the grasp held it (a tumbler or a paper cup; a beaker lands on its side about half the time, a narrow box or a bottle
@@ -67,7 +68,7 @@ def flip(rigid: RigidPrimitives, name: str) -> Iterator[np.ndarray]:
     up = sapien.Pose(q=env.obj(name).pose.q[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
     was = sapien.Pose(q=env.init_obj_quat(name)[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
     lean = float(np.degrees(np.arccos(np.clip(-(up @ was), -1.0, 1.0))))
-    m.collision.set_obstacles([])
+    m.collision.set_obstacles(m.object_boxes(exclude=(name,)))
     q = m.target()
     while (step := min(LOWER_STEP_M, float(m.world_aabb(name)[0][2]) - env.table_height - DROP_M)) > 1e-4:
         palm = m.ik.fk(q)

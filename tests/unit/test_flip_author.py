@@ -119,3 +119,10 @@ def test_the_grammar_writes_a_flip_of_each_vessel_and_stats_know_them():
     assert all(p.success["type"] == "flipped" for p in out)
     assert {p.objects[0].asset for p in out} == set(FLIPPABLE)  # then it has no more flips to write
     assert condition_skill("flipped") == "flip" and condition_skill("flipped", negate=True) is None
+
+
+def test_a_reason_after_the_command_is_noted_and_never_swallows_a_step():
+    r = read_instruction("flip the paper cup over so it can dry", asset_dicts())
+    assert [m.asset for m in r.objects] == ["paper_cup"] and any("reason" in n for n in r.notes)
+    two = read_instruction("open the drawer so the apple fits, then put the apple in the drawer", asset_dicts())
+    assert two.skill == "open" and [t.skill for t in two.then] == ["put_in"]
