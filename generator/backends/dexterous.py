@@ -1,8 +1,8 @@
 """The offline author's tasks of dexterous skills that need an exact fit, a press or a tip of the wrist: a peg put
 into the hole it fits (``insert``), a spill wiped with a sponge pressed down on it (``wipe``), a mug hung by its
 handle on a peg (``hang``), the beads in a glass poured into a bowl (``pour``) and a glass turned upside down on the
-table (``flip``). Each returns a proposal (a dict,
-as :mod:`generator.backends.offline` writes them); ``words(name)`` is the author's generator that words a task."""
+table (``flip``). Each returns a proposal (a dict, as :mod:`generator.backends.offline` writes them);
+``words(name)`` is the author's generator that words a task."""
 
 from __future__ import annotations
 
