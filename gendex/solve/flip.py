@@ -30,6 +30,7 @@ import sapien
 
 from gendex.solve.pour import pour_axis
 from gendex_envs.errors import ExecutionError
+from gendex_envs.geometry import tilt
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex.solve.rigid import RigidPrimitives
@@ -65,9 +66,7 @@ def flip(rigid: RigidPrimitives, name: str) -> Iterator[np.ndarray]:
     if done < MIN_TURN:
         raise ExecutionError(f"the arm turned {name!r} only {done:.0%} of half a turn", cause="no_ik")
     yield from m.hold(rigid.config.motion.settle_steps)
-    up = sapien.Pose(q=env.obj(name).pose.q[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
-    was = sapien.Pose(q=env.init_obj_quat(name)[0].cpu().numpy()).to_transformation_matrix()[:3, 2]
-    lean = float(np.degrees(np.arccos(np.clip(-(up @ was), -1.0, 1.0))))
+    lean = 180.0 - float(np.degrees(tilt(env.obj_pose(name).q, env.init_obj_quat(name))[0]))
     m.collision.set_obstacles(m.object_boxes(exclude=(name,)))
     q = m.target()
     while (step := min(LOWER_STEP_M, float(m.world_aabb(name)[0][2]) - env.table_height - DROP_M)) > 1e-4:

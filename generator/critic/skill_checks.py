@@ -49,6 +49,16 @@ def _gaps(a_lo, a_hi, b_lo, b_hi) -> np.ndarray:
     return np.maximum(0.0, np.maximum(b_lo - a_hi, a_lo - b_hi))
 
 
+def _clear_step(m_lo, m_hi, f_lo, f_hi, d: np.ndarray, gap_m: float) -> np.ndarray:
+    """The xy move that takes the rectangle ``m_lo..m_hi`` ``gap_m`` clear of ``f_lo..f_hi`` along the axis its centre
+    is already most apart on (``d``: its centre minus the other's; where they share a centre, towards the robot)."""
+    axis = int(np.argmax(np.abs(d))) if np.abs(d).max() > 0.01 else 0
+    sign = 1.0 if d[axis] > 0.01 else -1.0
+    step = np.zeros(2)
+    step[axis] = (f_hi[axis] + gap_m - m_lo[axis] if sign > 0 else f_lo[axis] - gap_m - m_hi[axis]) + sign * 1e-3
+    return step
+
+
 INSERT_APART_M = 0.05
 """Least gap (m) between a peg's footprint and its holder's, both widened by their randomization (a peg must be
 lifted over the holder's 5 cm wall: a nudge inserts nothing)."""
@@ -95,17 +105,12 @@ def _room_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violatio
             if name == c.object:
                 continue
             w = np.asarray(other.spec.randomize.xy_m)
-            gaps = _gaps(o_lo, o_hi, other.lo[:2] - w, other.hi[:2] + w)
-            gap = float(np.linalg.norm(gaps))
+            n_lo, n_hi = other.lo[:2] - w, other.hi[:2] + w
+            gap = float(np.linalg.norm(_gaps(o_lo, o_hi, n_lo, n_hi)))
             meas[f"{c.object}/{name}"] = {"gap_m": rounded(gap), "limit_m": FLIP_ROOM_M}
             if gap >= FLIP_ROOM_M:
                 continue
-            d = other.centre_xy - obj.centre_xy
-            axis = int(np.argmax(np.abs(d))) if np.abs(d).max() > 0.01 else 0
-            sign = 1.0 if d[axis] > 0.01 else -1.0
-            step = np.zeros(2)
-            step[axis] = (o_hi[axis] + FLIP_ROOM_M - (other.lo[axis] - w[axis]) if sign > 0
-                          else o_lo[axis] - FLIP_ROOM_M - (other.hi[axis] + w[axis])) + sign * 1e-3
+            step = _clear_step(n_lo, n_hi, o_lo, o_hi, other.centre_xy - obj.centre_xy, FLIP_ROOM_M)
             violations.append(Violation(
                 "flip", name, f"{name!r} starts {gap:.3f} m from {c.object!r}, which is turned over where it stands "
                 f"(footprints widened by their randomization); it must be at least {FLIP_ROOM_M} m away",
@@ -130,12 +135,7 @@ def _apart_checks(check: str, spec: TaskSpec, placed: dict[str, Placed], meas: d
         meas[c.object] = {"zone": c.target, "gap_m": rounded(gap), "limit_m": apart}
         if gap >= apart:
             continue
-        d = obj.centre_xy - zone.centre_xy
-        axis = int(np.argmax(np.abs(d))) if np.abs(d).max() > 0.01 else 0
-        sign = 1.0 if d[axis] > 0.01 else -1.0  # on the mat: towards the robot
-        step = np.zeros(2)
-        step[axis] = (z_hi[axis] + apart - o_lo[axis] if sign > 0
-                      else z_lo[axis] - apart - o_hi[axis]) + sign * 1e-3
+        step = _clear_step(o_lo, o_hi, z_lo, z_hi, obj.centre_xy - zone.centre_xy, apart)
         violations.append(Violation(
             check, c.object, f"{c.object!r} starts {gap:.3f} m from the {called} {c.target!r} (footprints widened by "
             f"their randomization); it must be carried at least {apart} m",
