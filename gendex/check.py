@@ -20,6 +20,8 @@ For one version :func:`check_version` runs, in order, and stops at the first fai
 
 :func:`select` turns the command's selection options into ids: explicit ids, the versions whose folders differ
 from a git revision (:func:`changed_since`), the newest version of each reference task and a fixed random sample.
+A version folder the registry does not hold (a download, a draft; the library may hold another folder under its
+id) stays a path and is checked as it is, made from its own spec without registering it.
 """
 
 from __future__ import annotations
@@ -99,7 +101,8 @@ def check_env_target(env_id: str, version) -> str:
     return version.provenance().get("reword", {}).get("source", env_id)
 
 
-def _check_env(env_id: str) -> None:
+def _check_env(env_id) -> None:
+    """``check_env`` on ``gym.make(env_id)`` (a registered id, or the EnvSpec of a folder)."""
     import gymnasium as gym
     from gymnasium.utils.env_checker import check_env
 
@@ -114,7 +117,7 @@ def _check_env(env_id: str) -> None:
         env.close()
 
 
-def _steps(env_id: str) -> None:
+def _steps(env_id) -> None:
     import gymnasium as gym
     import numpy as np
 
@@ -141,16 +144,23 @@ def _failure(exc: BaseException) -> str:
     return text
 
 
-def check_version(env_id: str, root: str | None = None, source_in_run: bool = False) -> CheckResult:
+def check_version(env_id: str, root: str | None = None, source_in_run: bool = False, folder: bool = False
+                  ) -> CheckResult:
     """Run every check on the registered version ``env_id`` (see the module doc); never raises. ``root``: its
     folder, registered here first when this process does not know the id (a worker process, a scratch folder).
     ``source_in_run``: a rewording's source is checked in the same run, so its ``check_env`` is not run twice.
-    Warnings raised by the checks are recorded in the result (each message once), not printed."""
+    ``folder``: ``env_id`` is the path of a version folder that is checked as it is, without registering it (the
+    registry may hold another folder under its id: a library version a downloaded copy claims to be); its time
+    limit is its spec's own, so that check does not apply. Warnings raised by the checks are recorded in the result
+    (each message once), not printed."""
     start = time.perf_counter()
     result = CheckResult(env_id, "passed")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        _run_checks(result, env_id, root, source_in_run)
+        if folder:
+            _run_folder_checks(result, env_id)
+        else:
+            _run_checks(result, env_id, root, source_in_run)
     result.warnings = list(dict.fromkeys(str(w.message)[:300] for w in caught
                                          if not any(re.match(p, str(w.message)) for p in _IGNORED_WARNINGS)))
     result.seconds = round(time.perf_counter() - start, 3)
@@ -186,6 +196,27 @@ def _run_checks(result: CheckResult, env_id: str, root: str | None, source_in_ru
         result.status, result.message = "failed", f"{step}: {_failure(exc)}"
 
 
+def _run_folder_checks(result: CheckResult, folder: str) -> None:
+    from gendex_envs.registry import env_spec
+    from gendex_envs.task_version import TaskVersion
+
+    step = "folder"
+    try:
+        version = TaskVersion.at(folder)
+        step = "static"
+        result.checks.append(f"static ({_static(version)} modules)")
+        result.checks.append("time_limit (not registered: the spec's own)")
+        step = "check_env"
+        spec = env_spec(version)
+        _check_env(spec)
+        result.checks.append(f"{step} (the folder)")
+        step = "steps"
+        _steps(spec)
+        result.checks.append(step)
+    except Exception as exc:  # a failed check is a result, not a crash
+        result.status, result.message = "failed", f"{step}: {_failure(exc)}"
+
+
 def _check_env_or_known(result: CheckResult, env_id: str, target: str) -> None:
     """check_env on ``target``; a failure of a known defect is recorded as xfail, a pass of one raises."""
     try:
@@ -208,20 +239,21 @@ def _worker():
     return _check_job
 
 
-def _check_job(job: tuple[str, str | None, bool]) -> CheckResult:
+def _check_job(job: tuple[str, str | None, bool, bool]) -> CheckResult:
     return check_version(*job)
 
 
 def run_checks(ids: Iterable[str], workers: int = 1) -> Iterator[CheckResult]:
-    """:func:`check_version` for each id, in order, on ``workers`` local processes (1: this process)."""
+    """:func:`check_version` for each id (or version folder :func:`select` kept as a path), in order, on
+    ``workers`` local processes (1: this process)."""
     from gendex.fanout import Backend, ordered_map
     from gendex_envs.registry import registered_tasks
 
     versions = registered_tasks()
     ids = list(ids)
     chosen = set(ids)
-    jobs = [(i, str(versions[i].root), check_env_target(i, versions[i]) in chosen - {i}) if i in versions
-            else (i, None, False) for i in ids]
+    jobs = [(i, str(versions[i].root), check_env_target(i, versions[i]) in chosen - {i}, False) if i in versions
+            else (i, i, False, True) if Path(i).is_dir() else (i, None, False, False) for i in ids]
     yield from ordered_map(_worker, jobs, Backend.from_options(workers))
 
 
@@ -287,7 +319,8 @@ def select(ids: Iterable[str] = (), *, changed_since_rev: str | None = None, ref
     """The ids to check, in order: ``ids`` (registered ids, names or version folders), the versions changed since
     ``changed_since_rev``, the newest reference versions, then ``sample`` more drawn with ``seed`` from the
     registered ids not already chosen (sorted first, so the same library and seed give the same sample). With no
-    option at all: every registered id."""
+    option at all: every registered id. A version folder is its id where the registry holds that very folder, else
+    its path: it is checked as it is (a downloaded copy of a library task is the copy, not the library's version)."""
     from gendex_envs.errors import TaskNotFoundError
     from gendex_envs.registry import registered_tasks, resolve_task
 
@@ -298,10 +331,15 @@ def select(ids: Iterable[str] = (), *, changed_since_rev: str | None = None, ref
     chosen: list[str] = []
     for task in ids:
         try:
-            chosen.append(resolve_task(task).env_id)
+            version = resolve_task(task)
         except TaskNotFoundError as exc:
             raise CheckSelectionError(str(exc)) from exc
-    unknown = [i for i in chosen if i not in versions]
+        held = versions.get(version.env_id)
+        if Path(str(task)).is_dir() and (held is None or held.root.resolve() != version.root.resolve()):
+            chosen.append(str(version.root))
+        else:
+            chosen.append(version.env_id)
+    unknown = [i for i in chosen if i not in versions and not Path(i).is_dir()]
     if unknown:
         raise CheckSelectionError(f"not registered in this process: {unknown}")
     if changed_since_rev:

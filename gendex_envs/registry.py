@@ -142,6 +142,16 @@ def discover_tasks(roots: list[Path] | None = None, override: bool | None = None
 _REGISTERED: dict[str, TaskVersion] = {}
 
 
+def env_spec(version: TaskVersion, max_episode_steps: int | None = None) -> EnvSpec:
+    """The Gymnasium spec ``version`` is registered under (``max_episode_steps``: the spec's own when None);
+    ``gym.make`` takes it directly, so a folder that is not registered (or one whose id the library holds) can be
+    made without replacing anything in the registry."""
+    steps = version.load_spec_unchecked().max_episode_steps if max_episode_steps is None else max_episode_steps
+    return EnvSpec(id=version.env_id, entry_point="gendex_envs.registry:make_task_env", max_episode_steps=steps,
+                   kwargs={"task": str(version.root)}, disable_env_checker=True,
+                   additional_wrappers=(GYM_API_WRAPPER,))
+
+
 def register_tasks(roots: list[Path] | None = None, override: bool = False) -> list[str]:
     """Register every discovered task version with Gymnasium; returns the new ids.
 
@@ -171,9 +181,7 @@ def register_tasks(roots: list[Path] | None = None, override: bool = False) -> l
                                                   f"{version.name} is registered")
             # what gym.register does for a versioned id, without its scan of the whole registry per call (quadratic
             # in the library: 1.5 s of registering 2 000 versions); the one conflict it checks is checked above
-            gym.registry[env_id] = EnvSpec(id=env_id, entry_point="gendex_envs.registry:make_task_env",
-                                           max_episode_steps=steps, kwargs={"task": str(version.root)},
-                                           disable_env_checker=True, additional_wrappers=(GYM_API_WRAPPER,))
+            gym.registry[env_id] = env_spec(version, steps)
         except TaskSpecError as exc:
             log.error("not registering %s: %s", env_id, exc)
             continue

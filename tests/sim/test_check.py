@@ -123,3 +123,26 @@ def test_a_failing_version_is_reported_and_the_command_exits_1(tmp_path, task_co
     assert first["status"] == "failed" and first["message"].startswith("static: ") and "os" in first["message"]
     assert second["status"] == "passed" and data["workers"] == 2
     assert f"failed {bad.env_id}" in out.output and "1/2 versions passed" in out.output
+
+
+def test_a_version_folder_is_checked_as_it_is_even_where_the_library_holds_its_id(tmp_path, task_version):
+    """``gendex check FOLDER`` on a copy of a library version (same name and version: an id the library holds)
+    checks the copy, not the library's version, and replaces nothing in the registry: a copy whose reward fails the
+    static check fails, naming it; an unchanged copy passes (its own spec's time limit); the library's own folder
+    is its id."""
+    lib = task_version("PutAppleBowl", 1)
+    bad, good = tmp_path / "a" / "PutAppleBowl" / "v1", tmp_path / "b" / "PutAppleBowl" / "v1"
+    lib.copy_to(bad)
+    lib.copy_to(good)
+    reward = TaskVersion.at(bad).files.reward
+    reward.write_text("import os\n" + reward.read_text())
+    assert select([str(bad), str(lib.root)]) == [str(bad), lib.env_id]
+    report = tmp_path / "report.json"
+    out = run([str(bad), str(good), "--report", str(report)])
+    data = json.loads(report.read_text())
+    assert out.exit_code == 1 and data["failed"] == [str(bad)], out.output
+    failed, passed = data["results"]
+    assert failed["message"].startswith("static: ") and "os" in failed["message"]
+    assert passed["status"] == "passed" and passed["checks"][1:] == [
+        "time_limit (not registered: the spec's own)", "check_env (the folder)", "steps"], passed
+    assert registered_tasks()[lib.env_id].root == lib.root
