@@ -33,11 +33,11 @@ def _dropped(plan: GraspPlan) -> TrialResult:
 
 
 class _Synth:
-    def __init__(self, *args, plans=()):
-        self.plans = plans
+    def __init__(self, *args, plans=(), families=("top",)):
+        self.plans, self._families = plans, families
 
     def families(self):
-        return ("top",)
+        return self._families
 
     def candidates(self):
         return iter(self.plans)
@@ -52,15 +52,15 @@ class _Trials:
         return self.outcomes[len(self.tried) - 1](plan)
 
 
-def _choose(monkeypatch, outcomes, set_on=None, fits=None):
+def _choose(monkeypatch, outcomes, set_on=None, fits=None, families=("top",), config=None):
     """``outcomes[i](plan)``: the trial result of candidate i. Returns (chosen plan, plans tried)."""
     plans = tuple(_plan(i) for i in range(len(outcomes)))
-    monkeypatch.setattr(rigid, "GraspSynthesizer", lambda *a, **kw: _Synth(plans=plans))
+    monkeypatch.setattr(rigid, "GraspSynthesizer", lambda *a, **kw: _Synth(plans=plans, families=families))
     monkeypatch.setattr(rigid, "object_heading", lambda *a: 0.0)
     monkeypatch.setattr(rigid, "px_bodies", lambda obj: [types.SimpleNamespace(mass=0.1)])
     monkeypatch.setattr(rigid, "fits_on", lambda shape, target: fits)
     prims = RigidPrimitives.__new__(RigidPrimitives)
-    prims.config = RigidConfig(max_trials=len(outcomes))
+    prims.config = config or RigidConfig(max_trials=len(outcomes))
     ik = types.SimpleNamespace(base=sapien.Pose(), solve=lambda pose, q, restarts=0, valid=None: np.zeros(3))
     prims.m = types.SimpleNamespace(ik=ik, collision=types.SimpleNamespace(is_free=None), target=lambda: np.zeros(3),
                                     with_hand=lambda q, hand: q, avoid_objects=lambda exclude: None)
@@ -71,7 +71,11 @@ def _choose(monkeypatch, outcomes, set_on=None, fits=None):
     shape = types.SimpleNamespace(footprint=lambda: types.SimpleNamespace(center=np.zeros(2)))
     prims._shapes = {"cube": shape, "bowl": shape}
     prims.shape = lambda name: prims._shapes[name]
-    plan, _ = prims.choose_grasp("cube", set_on=set_on)
+    try:
+        plan, _ = prims.choose_grasp("cube", set_on=set_on)
+    except ExecutionError as err:
+        err.tried = prims._trials.tried
+        raise
     return plan, prims._trials.tried
 
 
@@ -108,3 +112,13 @@ def test_a_shoved_trial_says_so():
     assert "pushed 0.050 m while closing" in str(_held(plan, pushed_m=0.05))
     assert "pushed" not in str(_held(plan, pushed_m=0.01))
     assert _held(plan, pushed_m=SHOVED_M + 1e-4).shoved and not _held(plan, pushed_m=SHOVED_M).shoved
+
+
+@pytest.mark.parametrize("families, budget", [(("top", "pinch"), 10), (("pinch",), 30), (("pinch", "tip"), 48)])
+def test_a_ball_only_a_pinch_holds_gets_more_trials(monkeypatch, families, budget):
+    """Budgets: 10 trials; 30 where a precision pinch is the only grasp (a golf ball's near misses push it while
+    closing); 48 where fingertip pinches at the table join in."""
+    config = RigidConfig(max_trials=10, pinch_trials=30, thin_trials=48)
+    with pytest.raises(ExecutionError) as err:
+        _choose(monkeypatch, [_dropped] * 60, families=families, config=config)
+    assert err.value.cause == "grasp_failed" and len(err.value.tried) == budget
