@@ -497,8 +497,9 @@ def phrase(skill: str, main: dict, rng: np.random.Generator, *, other: dict | No
 
 
 def direction(skill: str) -> str | None:
-    """``"open"`` for a skill that opens or turns something on, ``"close"`` for one that closes, else None."""
-    if skill.startswith(("open_", "press_")) or skill in ("turn", "turn_part"):
+    """``"open"`` for a skill that opens or turns something on, ``"close"`` for one that closes, else None. A press
+    switches on and a twist unscrews: both open."""
+    if skill.startswith(("open_", "press_")) or skill in ("turn", "turn_part", "press", "twist"):
         return "open"
     if skill.startswith("close_") or skill == "turn_off":
         return "close"

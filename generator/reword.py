@@ -86,16 +86,11 @@ def _least_alike(sims: np.ndarray, allowed: np.ndarray) -> int:
     return int(allowed[int(np.argmin(rows.max(axis=1)))])
 
 
-JOINT_DIRECTIONS = {"press": "open", "twist": "open"}
-"""Task skills that move a joint one way without saying so in their name: a press switches on, a twist unscrews."""
-
-
 def _frames(name: str, skills: Iterable[str], assets: Mapping[str, dict], moved: Iterable[str]) -> tuple[Frame, Frame]:
-    art_skill = next((k for k in skills if direction(k) or k in JOINT_DIRECTIONS), None)
+    art_skill = next((k for k in skills if direction(k)), None)
     art = next((a for a in assets.values() if a.get("joints")), None)
     obj = next((assets[m] for m in moved if m in assets), None)
-    art_frame = (Frame(domain(art), direction(art_skill) or JOINT_DIRECTIONS.get(art_skill))
-                 if art is not None and art_skill else None)
+    art_frame = Frame(domain(art), direction(art_skill)) if art is not None and art_skill else None
     rigid_frame = Frame(domain(obj)) if obj is not None else None
     first, last = art_frame or rigid_frame, rigid_frame or art_frame
     if first is None or last is None:

@@ -254,8 +254,9 @@ def test_every_task_of_the_library_has_frames_to_be_reworded_by(committed_tasks)
     """``gendex reword`` frames every task by what it acts on: a press switches its button on and a twist
     unscrews its cap, as an open does (before: 'PressButtonArcade: no object the task acts on', and the command
     stopped for the whole library)."""
-    from generator.reword import JOINT_DIRECTIONS, spec_frames
+    from generator.phrasing import direction
+    from generator.reword import spec_frames
 
     frames = {v.name: spec_frames(v.spec) for v in latest_versions(committed_tasks).values()}
     press = [f for n, f in frames.items() if n.startswith(("Press", "Unscrew"))]
-    assert press and all(first.direction == JOINT_DIRECTIONS["press"] == "open" for first, _ in press)
+    assert press and all(first.direction == direction("press") == direction("twist") == "open" for first, _ in press)
