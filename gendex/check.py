@@ -157,61 +157,49 @@ def check_version(env_id: str, root: str | None = None, source_in_run: bool = Fa
     result = CheckResult(env_id, "passed")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if folder:
-            _run_folder_checks(result, env_id)
-        else:
-            _run_checks(result, env_id, root, source_in_run)
+        _run_checks(result, env_id, root, source_in_run, folder)
     result.warnings = list(dict.fromkeys(str(w.message)[:300] for w in caught
                                          if not any(re.match(p, str(w.message)) for p in _IGNORED_WARNINGS)))
     result.seconds = round(time.perf_counter() - start, 3)
     return result
 
 
-def _run_checks(result: CheckResult, env_id: str, root: str | None, source_in_run: bool) -> None:
-    from gendex_envs.registry import register_tasks, registered_tasks
+def _run_checks(result: CheckResult, env_id: str, root: str | None, source_in_run: bool, folder: bool = False
+                ) -> None:
+    from gendex_envs.registry import env_spec, register_tasks, registered_tasks
+    from gendex_envs.task_version import TaskVersion
 
-    step = "registered"
+    step = "folder" if folder else "registered"
     try:
-        if env_id not in registered_tasks() and root is not None:
-            register_tasks([Path(root).parent.parent])
-        version = registered_tasks()[env_id]
+        if folder:  # made from its own spec, nothing registered
+            version = TaskVersion.at(env_id)
+            make = env_spec(version)
+        else:
+            if env_id not in registered_tasks() and root is not None:
+                register_tasks([Path(root).parent.parent])
+            version, make = registered_tasks()[env_id], env_id
         step = "static"
         n = _static(version)
         result.checks.append(f"static ({n} modules)")
         step = "time_limit"
-        _time_limit(env_id, version)
-        result.checks.append(step)
+        if folder:
+            result.checks.append(f"{step} (not registered: the spec's own)")
+        else:
+            _time_limit(env_id, version)
+            result.checks.append(step)
         step = "check_env"
-        target = check_env_target(env_id, version)
-        if target != env_id and source_in_run:
+        target = None if folder else check_env_target(env_id, version)
+        if target is None:
+            _check_env(make)
+            result.checks.append(f"{step} (the folder)")
+        elif target != env_id and source_in_run:
             if target in KNOWN_DEFECTS:
                 result.status, result.message = "xfail", f"check_env on {target}: a known defect (see its result)"
             result.checks.append(f"{step} (through {target}, checked in this run)")
         else:
             _check_env_or_known(result, env_id, target)
         step = "steps"
-        _steps(env_id)
-        result.checks.append(step)
-    except Exception as exc:  # a failed check is a result, not a crash
-        result.status, result.message = "failed", f"{step}: {_failure(exc)}"
-
-
-def _run_folder_checks(result: CheckResult, folder: str) -> None:
-    from gendex_envs.registry import env_spec
-    from gendex_envs.task_version import TaskVersion
-
-    step = "folder"
-    try:
-        version = TaskVersion.at(folder)
-        step = "static"
-        result.checks.append(f"static ({_static(version)} modules)")
-        result.checks.append("time_limit (not registered: the spec's own)")
-        step = "check_env"
-        spec = env_spec(version)
-        _check_env(spec)
-        result.checks.append(f"{step} (the folder)")
-        step = "steps"
-        _steps(spec)
+        _steps(make)
         result.checks.append(step)
     except Exception as exc:  # a failed check is a result, not a crash
         result.status, result.message = "failed", f"{step}: {_failure(exc)}"
@@ -252,8 +240,13 @@ def run_checks(ids: Iterable[str], workers: int = 1) -> Iterator[CheckResult]:
     versions = registered_tasks()
     ids = list(ids)
     chosen = set(ids)
-    jobs = [(i, str(versions[i].root), check_env_target(i, versions[i]) in chosen - {i}, False) if i in versions
-            else (i, i, False, True) if Path(i).is_dir() else (i, None, False, False) for i in ids]
+
+    def job(i: str) -> tuple[str, str | None, bool, bool]:  # check_version's arguments
+        if i in versions:
+            return i, str(versions[i].root), check_env_target(i, versions[i]) in chosen - {i}, False
+        return (i, i, False, True) if Path(i).is_dir() else (i, None, False, False)
+
+    jobs = [job(i) for i in ids]
     yield from ordered_map(_worker, jobs, Backend.from_options(workers))
 
 
