@@ -427,7 +427,7 @@ class StageExecutor:
         if point is not None and self.rigid.placed_on != POINT:
             yield from self.rigid.place(held, point, floor=self._floor(stage, held))
         elif held is not None and onto is not None and self.rigid.placed_on != onto:
-            inside = any(c.type == "inside" and c.object == held and c.target == onto
+            inside = any(c.type in ("inside", "near") and c.object == held and c.target == onto
                          for c in (*(stage.success or ()), *self._env.task_spec.success.conditions))
             yield from self.rigid.place(onto, at=free_spot(self._env, onto, held) if inside else None)
         yield from self.rigid.release()

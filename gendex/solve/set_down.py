@@ -110,12 +110,33 @@ def set_down_point(env, c: ConditionSpec) -> np.ndarray:
     return a + gap * axis
 
 
+SLOT_NEAR_SHARE = 0.6
+"""On a plate, tray or board that is to hold several objects (``near`` conditions), the slots lie this share of the
+conditions' ``max_dist_m`` from its middle (well within what they accept: the rest point may sit off the slot)."""
+
+
 def free_spot(env, container: str, held: str) -> np.ndarray | None:
-    """[2] where in ``container`` to set ``held`` down when other objects already lie in it (*put the lemon and the
-    plum in the bowl*: the plum beside the lemon, not on it): across the container's middle from them, as far as
-    ``held`` stays within the space an ``inside`` condition checks; None when the container holds nothing else."""
-    radius = env.container_extent(container)[0]
+    """[2] where on or in ``container`` to set ``held`` down when it is to hold several objects (*put all the fruit
+    in the pot*, *set the two blocks on the tray*: every ``inside`` or ``near`` condition of the task on it) or, a
+    container, others already lie in it. Several to hold: each at its own slot, evenly round the middle (the
+    conditions' objects in order, the first to the robot's left), as far out as ``held`` stays within what an
+    ``inside`` condition checks (on a surface: :data:`SLOT_NEAR_SHARE` of ``max_dist_m``); others lying in it:
+    across the middle from them. None when ``container`` is to hold only ``held`` and holds nothing else."""
+    conds = [x for x in env.task_spec.success.conditions if x.target == container and not x.negate
+             and ((x.type == "inside" and x.joint is None) or x.type == "near")]
+    near = next((x for x in conds if x.object == held and x.type == "near"), None)
+    radius = SLOT_NEAR_SHARE * float(near.max_dist_m) if near else env.container_extent(container)[0]
     c = rest_point(env, container)[0, :2].double().cpu().numpy()
+    size = np.asarray(env.asset_record(held).size_m[:2]) * env.task_spec.object(held).scale
+    room = max(0.0, radius - (0.0 if near else 0.5 * float(np.max(size))))
+    peers = list(dict.fromkeys(x.object for x in conds))
+    if held in peers and len(peers) > 1:
+        left = robot_axes(env, rest_point(env, container))[2].double().cpu().numpy()
+        turn = 2.0 * np.pi * peers.index(held) / len(peers)
+        return c + room * np.array([left[0] * np.cos(turn) - left[1] * np.sin(turn),
+                                    left[0] * np.sin(turn) + left[1] * np.cos(turn)])
+    if near is not None:
+        return None
     inside = []
     for name in env.objects:
         if name in (container, held) or name in env.articulations:
@@ -128,10 +149,8 @@ def free_spot(env, container: str, held: str) -> np.ndarray | None:
     d = np.mean(inside, axis=0) - c
     n = float(np.linalg.norm(d))
     d = d / n if n > 1e-3 else np.array([1.0, 0.0])
-    size = np.asarray(env.asset_record(held).size_m[:2]) * env.task_spec.object(held).scale
-    room = max(0.0, radius - 0.5 * float(np.max(size)))
     return c - room * d
 
 
-__all__ = ["DRAWER_SIDE_M", "POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "drawer_of", "drawer_side", "free_spot",
-           "holds_condition", "holds_height", "holds_spot", "placed_condition", "set_down_point"]
+__all__ = ["DRAWER_SIDE_M", "POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "SLOT_NEAR_SHARE", "drawer_of", "drawer_side",
+           "free_spot", "holds_condition", "holds_height", "holds_spot", "placed_condition", "set_down_point"]

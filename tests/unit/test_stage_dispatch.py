@@ -40,7 +40,8 @@ def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
     class Env:
         objects = {n: None for n in poses}
         articulations: dict = {}
-        task_spec = NS(object=lambda n: NS(scale=1.0))
+        task_spec = NS(object=lambda n: NS(scale=1.0), success=NS(conditions=()),
+                       robot=NS(base_yaw_deg=0.0, base_pos_m=(-0.6, 0.0, 0.0)))
 
         @staticmethod
         def container_extent(name):
@@ -58,3 +59,13 @@ def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
     del poses["lemon"]
     Env.objects = {n: None for n in poses}
     assert free_spot(Env, "bowl", "plum") is None  # nothing in it yet: its middle
+    # a bowl that is to hold three (every 'inside' condition on it): each its own slot, 120 degrees apart, the
+    # first to the robot's left, whatever lies in it already
+    inside = lambda o: NS(type="inside", object=o, target="bowl", joint=None, negate=False)  # noqa: E731
+    Env.task_spec.success.conditions = (inside("lemon"), inside("plum"), inside("apple"))
+    spots = [free_spot(Env, "bowl", o) for o in ("lemon", "plum", "apple")]
+    room = 0.08 - 0.025
+    assert np.allclose(spots[0], (0.1, room))
+    assert all(np.isclose(np.linalg.norm(p - (0.1, 0.0)), room) for p in spots)
+    gaps = [np.linalg.norm(spots[i] - spots[j]) for i, j in ((0, 1), (1, 2), (0, 2))]
+    assert np.allclose(gaps, room * np.sqrt(3))  # evenly round the middle
