@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from generator.constructs import split_steps
 from generator.errors import InstructionError
+from generator.groups import read_group
 
 if TYPE_CHECKING:
     from generator.instruction import Reading
@@ -24,6 +25,8 @@ GROUP_SKILLS = ("put_in", "place_on")
 """Skills whose request may name several objects for one place (*put the lemon and the plum in the bowl*)."""
 PLACE_WORDS = ("into", "in", "inside", "onto", "on", "on top of")
 """Words that start the place of a put or a set-down (where a list of objects ends)."""
+PARTICLES = ("down", "away", "back", "over", "up")
+"""Words between the objects and the place that belong to the verb (*set the blocks down on the tray*)."""
 TOWER_OF = {"blocks": "block", "cubes": "block"}
 """Plurals a tower is built of, and the catalog category they name."""
 GROUP_WORD = re.compile(r"\b(\w+)\s+(\w+\s+)?(blocks|cubes)\b")
@@ -50,14 +53,24 @@ def and_steps(text: str, starts_with_verb: Callable[[str], bool]) -> list[str]:
     return out
 
 
-def group_steps(text: str, verb_end: int) -> list[str]:
-    """One step per object of a list before the place (*put the apple, the lemon and the plum in the bowl* -> three
-    puts into the bowl); ``[text]`` when the request names one object. ``verb_end``: where the verb's words end."""
+def split_at_place(text: str, verb_end: int) -> tuple[list[str], list[str], list[str]] | None:
+    """The words of ``text`` as (verb, objects, place): the place starts at the first of :data:`PLACE_WORDS` after
+    an object; None when there is none. ``verb_end``: where the verb's words end."""
     words = text.split()
     verb, rest = words[:verb_end], words[verb_end:]
     at = next((i for i, w in enumerate(rest) if w.lower() in PLACE_WORDS and i > 0), None)
-    if at is None or "and" not in (w.lower() for w in rest[:at]):
+    return None if at is None else (verb, rest[:at], rest[at:])
+
+
+def group_steps(text: str, verb_end: int) -> list[str]:
+    """One step per object of a list before the place (*put the apple, the lemon and the plum in the bowl* -> three
+    puts into the bowl); ``[text]`` when the request names one object. ``verb_end``: where the verb's words end."""
+    parts = split_at_place(text, verb_end)
+    if parts is None or "and" not in (w.lower() for w in parts[1]):
         return [text]
+    verb, rest, after = parts
+    at = len(rest)
+    rest = rest + after
     items = [i.strip() for i in re.split(r"\s*,\s*(?:and\s+)?|\s+and\s+", " ".join(rest[:at])) if i.strip()]
     place = " ".join(rest[at:])
     return [" ".join([*verb, item, place]) for item in items] if len(items) > 1 else [text]
@@ -130,24 +143,24 @@ def read_compound(text: str, assets: Sequence[dict], read_one: Callable[[str], R
     steps = [s for part in ordered for s in and_steps(part, starts_with_verb)]
     if len(steps) > len(ordered):  # split at 'and' + verb; where a part does not read ('grip the handle and pull
         try:                       # the door open'), the words around 'and' are one step
-            return _read_steps(text, steps, read_one, group_of)
+            return _read_steps(text, steps, read_one, group_of, assets)
         except InstructionError:
             if len(ordered) == 1:
                 return None
     if len(ordered) == 1:
-        readings = _group(text, read_one, group_of)
+        readings = _group(text, read_one, group_of, assets)
         return None if readings is None else dataclasses.replace(readings[0], instruction=text,
                                                                  then=tuple(readings[1:]))
-    return _read_steps(text, ordered, read_one, group_of)
+    return _read_steps(text, ordered, read_one, group_of, assets)
 
 
 def _read_steps(text: str, steps: list[str], read_one: Callable[[str], Reading],
-                group_of: Callable[[str], tuple[str, int] | None]) -> Reading:
+                group_of: Callable[[str], tuple[str, int] | None], assets: Sequence[dict]) -> Reading:
     """The reading of ``steps`` in order: a step of several objects is one step per object, each with its own
     words; a step said again in other words is one step."""
     readings: list[Reading] = []
     for step in steps:
-        parts = _group(step, read_one, group_of) or [
+        parts = _group(step, read_one, group_of, assets) or [
             _with_previous(step, readings[-1], read_one) if readings else read_one(step)]
         for part in parts:
             if readings and _same_step(readings[-1], part):
@@ -156,12 +169,21 @@ def _read_steps(text: str, steps: list[str], read_one: Callable[[str], Reading],
     return dataclasses.replace(readings[0], instruction=text, then=tuple(readings[1:]))
 
 
-def _group(text: str, read_one: Callable[[str], Reading], group_of: Callable[[str], tuple[str, int] | None]
-           ) -> list[Reading] | None:
-    """One reading per object of a step that moves several objects to one place, or None (not such a step)."""
+def _group(text: str, read_one: Callable[[str], Reading], group_of: Callable[[str], tuple[str, int] | None],
+           assets: Sequence[dict]) -> list[Reading] | None:
+    """One reading per object of a step that moves several objects to one place (a list of them, or a group:
+    :mod:`generator.groups`), or None (not such a step)."""
     found = group_of(text)
     if found is None or found[0] not in GROUP_SKILLS:
         return None
+    parts = split_at_place(text, found[1])
+    if parts is not None:
+        verb, objects, place = parts
+        while objects and objects[-1].lower() in PARTICLES:  # 'set the two blocks down on the tray'
+            place = [objects.pop(), *place]
+        grouped = read_group(text, verb, " ".join(objects), place, read_one, {a["id"]: a for a in assets})
+        if grouped is not None:
+            return grouped
     steps = group_steps(text, found[1])
     if len(steps) == 1:
         return None
@@ -170,4 +192,6 @@ def _group(text: str, read_one: Callable[[str], Reading], group_of: Callable[[st
         return None  # not one place for all of them: read as one step (and refused there, saying why)
     return readings
 
-__all__ = ["GROUP_SKILLS", "PLACE_WORDS", "TOWER_OF", "and_steps", "group_steps", "read_compound", "read_tower"]
+
+__all__ = ["GROUP_SKILLS", "PARTICLES", "PLACE_WORDS", "TOWER_OF", "and_steps", "group_steps", "read_compound",
+           "read_tower", "split_at_place"]

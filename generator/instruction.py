@@ -21,7 +21,6 @@ goes into the language-model backend's proposal prompt (:func:`skill_vocabulary`
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -39,8 +38,9 @@ from generator.constructs import (
     read_place,
 )
 from generator.errors import InstructionError
+from generator.nearest import nearest
+from generator.vocabulary import COURTESY_WORDS, KINDS, ORDINALS, PARTS, SYNONYMS, TASK_SKILLS, TaskSkill
 from generator.vocabulary import FILLER_WORDS as _FILLER
-from generator.vocabulary import KINDS, ORDINALS, PARTS, SYNONYMS, TASK_SKILLS, TaskSkill
 from generator.vocabulary import STOP_WORDS as _STOP
 
 _VERB_WORDS = frozenset(w for s in TASK_SKILLS.values() for v in s.verbs for w in v.split())
@@ -71,6 +71,8 @@ class Mention:
     ``three drawer chest``): they choose among the name's models where they match a model's id."""
     color: str | None = None
     """The colour the person named it by (a key of :data:`gendex_envs.attributes.COLORS`): the task paints it so."""
+    group: str = ""
+    """The group it was drawn for (*all the fruit*: :mod:`generator.groups`), if any."""
 
     @property
     def substituted(self) -> bool:
@@ -379,16 +381,24 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     relation, region, at_place = read_place(words)
     no_object = amount_words(words) | at_place  # the words of an amount or a place
     unknown = []
+    unread = []  # words no part of the reading takes: said in a note
     for k, w in enumerate(words):
         if (used[k] or k < verb_end or w in _STOP or w in PARTS or w in ORDINALS or k in no_object
                 or (len(w) < 3 and not w.isdigit())):
+            if k < verb_end and not (used[k] or w in _VERB_WORDS or w in _STOP or w in COURTESY_WORDS or w in PARTS
+                                     or w in _FILLER or k in no_object or w in ORDINALS):
+                unread.append(w)  # 'gently put ...'
             continue
         named_next = k > 0 and words[k - 1] in DETERMINERS and any(i == k + 1 for i, _, _ in spans)
         if (w in _VERB_WORDS and not named_next) or w in _FILLER:  # 'the empty bowl': a word about the bowl
             continue
+        if mentions and at[-1] == k - 1 and mentions[-1].how == "kind" and w not in KINDS:
+            mentions.pop()  # a kind word before an unknown one: one object the catalog lacks ('toy car': a toy)
+            unknown.append((at.pop(), words[k - 1]))
         in_phrase = k > 0 and (words[k - 1] in DETERMINERS or (unknown and unknown[-1][0] == k - 1)
                                or used[k - 1] or (k + 1 < len(words) and used[k + 1]))
         if not in_phrase:  # not in a noun phrase: 'keep hold of it', 'without lifting it'
+            unread += [w] if w not in COURTESY_WORDS else []
             continue
         after = next((mentions[n] for n, (i, _, _) in enumerate(spans) if i == k + 1), None)
         if w in KINDS and after is not None and (KINDS[w] in _by_id(assets, after.asset)["tags"]
@@ -439,10 +449,17 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         at[n] = min(at[n], run[0][0])
         if note:
             notes.append(note)
-    for run in free:
-        phrase = " ".join(w for _, w in run)
+    if unread:  # every word is read, or said to be not read
+        notes.append(f"not understood, so it shapes nothing: {', '.join(repr(w) for w in unread)}")
+    for run in free:  # a colour word in it is the colour to paint the stand-in ('the red toy car')
+        colours = sorted({COLOR_WORDS[w] for _, w in run[:-1] if w in COLOR_WORDS})
+        if len(colours) > 1:
+            raise InstructionError(f"'{' '.join(w for _, w in run)}' names {len(colours)} colours "
+                                   f"({', '.join(colours)}); an object is painted one colour")
+        phrase = " ".join(w for _, w in run if w not in COLOR_WORDS or (_, w) == run[-1])
         kind = KINDS.get(run[-1][1])
-        mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", ()))
+        mentions.append(Mention(phrase, "", "substitute", None, f"a {kind}" if kind else "", (),
+                                color=colours[0] if len(colours) == 1 else None))
         at.append(run[0][0])
     mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
     direction = None
@@ -497,7 +514,8 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
             plural = nxt.endswith("s") and not nxt.endswith("ss") and nxt != "drawers"
             if w in GROUP_WORDS and nxt and nxt not in ("way", "time", "degrees") and (
                     plural or w in ("all", "both", "every")):
-                found.append((f"several objects ('{w} {nxt}')", "groups and towers of objects"))
+                found.append((f"several objects ('{w} {nxt}')", "groups of objects but two or three put in or set "
+                              "on one place ('put all the fruit in the pot'), nor towers but of the blocks"))
     else:
         chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
         last = words[-1]
@@ -598,15 +616,21 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
             out.append(dataclasses.replace(m, asset=ids[0], options=ids, detail=f"a {m.phrase}: chose from "
                                                                                  f"{len(ids)}"))
             continue
-        if m.how == "substitute":
-            kind = KINDS.get(m.phrase.split()[-1])
+        if m.how == "substitute":  # the kind a word says ('toy car': a toy), then the nearest in meaning
+            kind = next((KINDS[w] for w in reversed(m.phrase.split()) if w in KINDS), None)
             pool = [a for a in able if kind in a["tags"]] or able
+            if role == "graspable":  # a stand-in the solver holds, so the author builds the object said here
+                from generator.backends.roles import graspable
+
+                pool = [a for a in pool if graspable(a)] or pool
             if not pool:
                 raise InstructionError(f"nothing in the catalog can be the {role} object of '{skill}'")
-            best = _closest(m.phrase, pool)
+            best, cosine = nearest(m.phrase, pool, role)
             out.append(dataclasses.replace(m, asset=best["id"], options=(best["id"],),
-                                           detail=f"not in the catalog; the closest {role} object"
-                                                  + (f" among the {kind} objects" if pool is not able else "")))
+                                           detail=f"not in the catalog; the {role} object nearest in meaning"
+                                                  + (f" among the {kind} objects" if kind and kind in best["tags"]
+                                                     else "")
+                                                  + f", cosine {cosine:.2f}"))
             continue
         kind = _by_id(assets, m.asset)["category"]
         named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and a["category"] == kind)]
@@ -634,16 +658,6 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
         raise InstructionError(f"'{m.phrase}' ({m.asset}) in \"{text}\" has no part in a '{skill}' task, which acts "
                                f"on {TASK_SKILLS[skill].objects}; ask for one task at a time")
     return out
-
-
-def _closest(phrase: str, able: Sequence[dict]) -> dict:
-    """The asset whose id, category or tags read most like ``phrase`` (string similarity; ties by id)."""
-    keys: dict[str, dict] = {}
-    for a in sorted(able, key=lambda a: a["id"]):
-        for k in (a["id"].replace("_", " "), a["category"].replace("_", " ")):
-            keys.setdefault(k, a)
-    match = difflib.get_close_matches(phrase, list(keys), n=1, cutoff=0.0)
-    return keys[match[0]] if match else sorted(able, key=lambda a: a["id"])[0]
 
 
 __all__ = ["KINDS", "SKILL_ROLES", "SYNONYMS", "TASK_SKILLS", "InstructionError", "Mention", "Reading", "TaskSkill",

@@ -150,7 +150,11 @@ FILLER_WORDS = frozenset(
     "friend guest customer"
     .split())
 """Words after the verb that name no object (places on the table among them)."""
+COURTESY_WORDS = frozenset(
+    "please could can would will you kindly now just go ahead i we want need like let lets us me thanks thank"
+    .split())
+"""Words of how a request is asked that shape no task (*could you please ...*): read, and dropped."""
 
 
-__all__ = ["FILLER_WORDS", "KINDS", "ORDINALS", "PARTS", "POUR_VESSELS", "STOP_WORDS", "SYNONYMS", "TASK_SKILLS",
-           "TaskSkill"]
+__all__ = ["COURTESY_WORDS", "FILLER_WORDS", "KINDS", "ORDINALS", "PARTS", "POUR_VESSELS", "STOP_WORDS", "SYNONYMS",
+           "TASK_SKILLS", "TaskSkill"]

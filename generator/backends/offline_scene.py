@@ -212,7 +212,8 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
         objects.append(entry)
     if (any(o["role"] != "articulated" for o in proposal["objects"]) and rng.random() < DISTRACTOR_P and not spots
             and not flipped):  # a glass turned over is lowered onto its rim where it stood: nothing beside it
-        objects.append(_distractor(proposal, assets, rng, movable))
+        clutter = _distractor(proposal, assets, rng, movable)
+        objects += [clutter] if clutter else []
     stages = []
     for i, s in enumerate(proposal["steps"]):
         method = "motion_planning" if s["skill"] in ("reach", "carry", "place") else "RL"
@@ -251,15 +252,20 @@ def _pour_layout(poured: dict[str, str], assets: dict[str, dict], rng: np.random
     return out
 
 
-def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict:
-    """One object of clutter: a graspable catalog object the task does not use, in ``region``: where the task's
-    movable objects go, clear of a door the hand works first (the critic moves it if it overlaps)."""
+def _distractor(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, region: tuple) -> dict | None:
+    """One object of clutter: a graspable catalog object the task does not use, of no group the request names
+    (:mod:`generator.groups`), in ``region``: where the task's movable objects go, clear of a door the hand works
+    first (the critic moves it if it overlaps); None when no object is left."""
     from generator.catalog_view import asset_dicts
+    from generator.groups import covered, group_kinds
 
     used = {o["asset"] for o in proposal["objects"]}
-    pool = sorted((a for a in asset_dicts() if graspable(a) and a["id"] not in used
+    kinds = group_kinds(proposal.get("reading"))  # 'all the fruit': no other fruit on the table
+    pool = sorted((a for a in asset_dicts() if graspable(a) and a["id"] not in used and not covered(a, kinds)
                    and a["category"] not in {assets[i]["category"] for i in used if i in assets}),
                   key=lambda a: a["id"])
+    if not pool:
+        return None
     a = pool[int(rng.integers(len(pool)))]
     (x0, x1), (y0, y1) = region
     return {"name": f"distractor_{a['category']}", "asset": a["id"], "distractor": True,

@@ -120,10 +120,10 @@ def join_steps(steps: list[dict], acts: Callable[[dict], dict[str, str]], existi
         raise InstructionError("a step moves the object whose door or lid the first step works; the offline author "
                                "joins steps on different objects only")
     commands = _one_word_each([split(s["description"])[1].rstrip(".") for s in kept], kept, names_of)
-    text = ", then ".join(commands)
+    text = ", then ".join(c for c in commands if c)  # a group's later steps are said by its first (_said_as_group)
     texts = [s["success_text"].rstrip(".") for s in kept]
     return _unique({
-        "name": "Then".join(s["name"] for s in kept), "description": text[:1].upper() + text[1:] + ".",
+        "name": "Then".join(s["name"] for s in kept if s["name"]), "description": text[:1].upper() + text[1:] + ".",
         "objects": list(objects.values()), "steps": [st for s in kept for st in s["steps"]],
         "success": kept[0]["success"], "also": [s["success"] for s in kept[1:]],
         "success_text": ", and ".join([texts[0]] + [t[:1].lower() + t[1:] for t in texts[1:]]) + ".",
@@ -150,8 +150,55 @@ def sequence_task(propose_step: Callable[[dict], dict], reading: dict, acts: Cal
         used = {o["asset"] for s in steps for o in s["objects"]}
         objects = [m | {"asset": a, "options": [a]} if (a := next((x for x in m.get("options") or () if x in used),
                                                                     None)) else m for m in r["objects"]]
-        steps.append(propose_step(r | {"objects": objects}))
-    return join_steps(steps, acts, existing, names_of)
+        steps.append(_named_apart(propose_step(r | {"objects": objects}), steps))
+    return join_steps(_said_as_group(steps, readings, names_of), acts, existing, names_of)
+
+
+def _named_apart(step: dict, before: list[dict]) -> dict:
+    """``step`` with an object named as an object of a step ``before`` but another model (*the two blocks*: the
+    medium and the large block) renamed by its id, everywhere the step names it."""
+    seen = {o["name"]: o["asset"] for s in before for o in s["objects"]}
+    for o in step["objects"]:
+        if seen.get(o["name"], o["asset"]) != o["asset"]:
+            old, new = o["name"], o["asset"]
+            said = " ".join(reversed(new.split("_", 1)))  # block_large -> 'large block'
+
+            def swap(x, old=old, new=new, said=said):
+                if isinstance(x, dict):
+                    return {k: (new if k in ("name", "object", "target", "other") and v == old else swap(v))
+                            for k, v in x.items()}
+                if isinstance(x, list):
+                    return [swap(v) for v in x]
+                return re.sub(rf"\bthe {re.escape(old)}\b", f"the {said}", x) if isinstance(x, str) else x
+
+            step = swap(step)
+    return step
+
+
+def _said_as_group(steps: list[dict], readings: list[dict], names_of: Callable[[str], tuple[str, ...]]) -> list[dict]:
+    """``steps`` with the steps of a group (*put all the fruit in the pot*: one step per fruit) said as the person
+    said them: the first step's command with its object called by the group's words, the others said by it."""
+    out = list(steps)
+    for k, r in enumerate(readings):
+        group = (r["objects"][0].get("group") or "") if r["objects"] else ""
+        if not group or (k and (readings[k - 1]["objects"][0].get("group") or "") == group):
+            continue
+        members = [j for j in range(k, len(readings)) if (readings[j]["objects"][0].get("group") or "") == group]
+        command = split(out[k]["description"])[1].rstrip(".")
+        words = sorted(names_of(out[k]["objects"][0]["asset"]) or (out[k]["objects"][0]["name"],), key=len,
+                       reverse=True)
+        said = re.sub(rf"\b(the|a|an) ({'|'.join(re.escape(w) for w in words)})\b", group, command, count=1)
+        if said == command:
+            continue  # not said by a word of its object: each step keeps its own command
+        camel = "".join(w.capitalize() for w in group.split() if w not in ("the", "of"))  # 'AllFruit'
+        names = sorted(({"".join(p.capitalize() for p in re.split(r"[_\s]+", w)) for w in words}
+                        | {"".join(p.capitalize() for p in out[k]["objects"][0]["asset"].split("_"))}), key=len,
+                       reverse=True)
+        name = re.sub("|".join(re.escape(n) for n in names), camel, out[k]["name"], count=1)
+        out[k] = out[k] | {"description": said[:1].upper() + said[1:] + ".", "name": name}
+        for j in members[1:]:
+            out[j] = out[j] | {"description": "", "name": ""}
+    return out
 
 
 def parse_step(text: str) -> dict:

@@ -30,6 +30,7 @@ from generator.backends.base import Backend
 from generator.catalog_view import asset_dict, asset_dicts, guidance
 from generator.critic.physical import REACH_MAX_M
 from generator.errors import RetriesExhaustedError, SceneError
+from generator.groups import covered, group_kinds
 from generator.prompts import PROMPTS_DIR
 from generator.records import Proposal, SceneCandidate
 from generator.steps.common import ask, parse_yaml_block
@@ -265,6 +266,11 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
     extra = [o.name for o in spec.objects if o.distractor]
     if len(extra) > MAX_DISTRACTORS:
         raise SceneError(f"the scene has {len(extra)} distractors {extra}; at most {MAX_DISTRACTORS}")
+    kinds = group_kinds(proposal.reading)
+    grouped = [o.name for o in spec.objects if o.distractor and covered(asset_dict(o.asset), kinds)]
+    if grouped:  # 'put all the fruit in the pot': a fruit left as clutter would be one the task does not move
+        raise SceneError(f"distractors {grouped} are of a group the request moves whole "
+                         f"({', '.join(sorted(kinds[0] | kinds[1]))}); leave them out or use objects of another kind")
     if spec.name != proposal.name:
         spec = dataclasses.replace(spec, name=proposal.name)
     colors = {o.name: o.color for o in proposal.objects if o.color is not None}

@@ -4,6 +4,7 @@ refused; none is read as something else (a silent misread). How many are read as
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
@@ -17,11 +18,37 @@ ASSETS = {a["id"]: a for a in asset_dicts()}
 CATEGORIES = {a["category"] for a in ASSETS.values()}
 STEP_KEYS = {"skill", "objects", "direction", "amount", "relation", "region"}
 OBJECT_KEYS = {"id", "category", "color", "kind", "count"}
+"""An object of a step: ``kind`` (a tag or category) and ``count`` (a number, or ``all``) say a group."""
+
+
+def _expand(steps: list[dict], readings: list[Reading]) -> list[dict]:
+    """``steps`` with a step of a group (an object ``{kind: fruit, count: all}``) written once per object: ``count``
+    times, or for ``all`` as many times as the readings from there are steps of one group."""
+    out: list[dict] = []
+    for step in steps:
+        at = next((k for k, o in enumerate(step["objects"]) if isinstance(o, dict) and "count" in o), None)
+        if at is None:
+            out.append(step)
+            continue
+        want = step["objects"][at]
+        n = want["count"]
+        if n == "all":
+            first = readings[len(out)].objects[at].group if len(out) < len(readings) else ""
+            n = sum(1 for _ in itertools.takewhile(lambda r, g=first, k=at: g and r.objects[k].group == g,
+                                                    readings[len(out):]))
+        each = {k: v for k, v in want.items() if k != "count"} | {"member": True}
+        out += [step | {"objects": [*step["objects"][:at], each, *step["objects"][at + 1:]]}] * max(n, 1)
+    return out
 
 
 def _misread(reading: Reading, steps: list[dict]) -> str | None:
     """Why ``reading`` is not the expected reading, step by step, and does not say so (None: it is, or it says so)."""
     readings = [reading, *reading.then]
+    steps = _expand(steps, readings)
+    members = [r.objects[0].asset for r, s in zip(readings, steps, strict=False)
+               if isinstance(s["objects"][0], dict) and s["objects"][0].get("member")]
+    if len(set(members)) != len(members):
+        return f"a group read as the same object twice: {members}"
     if len(steps) != len(readings):
         return f"{len(steps)} steps read as {len(readings)} ({[r.skill for r in readings]})"
     for step, r in zip(steps, readings, strict=True):
@@ -48,6 +75,10 @@ def _misread_step(reading: Reading, step: dict) -> str | None:
     for want, m in zip(step["objects"], reading.objects, strict=True):
         want = {"category" if want in CATEGORIES else "id": want} if isinstance(want, str) else want
         got = ASSETS[m.asset]
+        if "kind" in want and not (want["kind"] in got["tags"] or want["kind"] == got["category"]):
+            return f"a {want['kind']} read as {m.asset}"
+        if want.get("member") and not m.group:
+            return f"{m.asset} read as one object, not one of a group"
         if ("id" in want and got["id"] != want["id"]) or ("category" in want and got["category"] != want["category"]):
             return f"{want} read as {m.asset}"
         if want.get("color") != m.color:

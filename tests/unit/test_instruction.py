@@ -174,7 +174,8 @@ def test_a_qualifier_that_chooses_nothing_is_said_and_a_second_object_is_refused
     ("open the fridge on the left", "a place (in region, left)"),
     ("lift the apple halfway", "an amount ('half')"),
     ("put the apple in the bowl before closing the microwave", "steps out of order ('before')"),
-    ("put all the fruit in the pot", "several objects ('all fruit')"),
+    ("lift all the fruit", "several objects ('all fruit')"),
+    ("put the five balls in the pot", "several objects ('five balls')"),
 ])
 def test_constructs_not_built_yet_are_refused_never_built_without_them(text, asks):
     """A request whose direction, place, amount, order or retrieval the author cannot build is refused saying what
