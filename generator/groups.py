@@ -80,16 +80,20 @@ def find_group(object_words: str) -> Group | None:
 
 
 PACK = 0.75
-"""Objects put in one container lie in slots evenly round its middle (``gendex.solve.set_down.free_spot``); they
-fit side by side when neighbouring slots are at least this share of the largest one's width apart (they may lean on
-each other: *put the lemon and the plum in the bowl*, 0.85 of it, went in 9 times of 10)."""
+"""Objects put in one container lie in slots evenly round its middle (``gendex.solve.set_down.free_spot``); a
+number of them the person asked for fits side by side when neighbouring slots are at least this share of the
+largest one's width apart (they may lean on each other: *put the lemon and the plum in the bowl*, 0.85 of it, went
+in 9 times of 10; a peach and a pear in the pot, 0.73, 8 of 10 and 2 of 5 in two gates)..."""
+PACK_ALL = 0.85
+"""...and when the reader chooses how many (*all the fruit*), this share: fewer objects, each with room (a pear and
+a plum in the pot, 0.86: 10 of 10; a lemon and a plum in the bowl, 0.85: 9 of 10)."""
 INSIDE_SHARE = 0.8
 """Share of a container's half footprint an ``inside`` condition checks (``TaskEnv.container_extent``)."""
 
 
-def side_by_side(objects: Sequence[dict], container: dict, slots: int | None = None) -> bool:
+def side_by_side(objects: Sequence[dict], container: dict, slots: int | None = None, pack: float = PACK) -> bool:
     """Whether ``objects``, fitted to the hand, lie side by side in ``container`` in ``slots`` slots (default: one
-    each; see :data:`PACK`)."""
+    each), their slots ``pack`` of the largest one's width apart (:data:`PACK`)."""
     from gendex.solve.grasp import hand_fit_scale
 
     slots = len(objects) if slots is None else slots
@@ -97,7 +101,7 @@ def side_by_side(objects: Sequence[dict], container: dict, slots: int | None = N
         return True
     widths = [float(max(a["size_m"][:2])) * hand_fit_scale(a["size_m"][:2]) for a in objects]
     room = INSIDE_SHARE * float(min(container["size_m"][:2])) / 2 - max(widths) / 2
-    return room > 0 and 2 * room * np.sin(np.pi / slots) >= PACK * max(widths)
+    return room > 0 and 2 * room * np.sin(np.pi / slots) >= pack * max(widths)
 
 
 def choose(text: str, group: Group, candidates: Sequence[dict], by_kind: bool,
@@ -115,7 +119,8 @@ def choose(text: str, group: Group, candidates: Sequence[dict], by_kind: bool,
         picked = []
         for a in pool:
             if len(picked) < n and not (by_kind and a["category"] in {p["category"] for p in picked}) and (
-                    container is None or side_by_side([*picked, a], container, slots=n)):
+                    container is None or side_by_side([*picked, a], container, n,
+                                                      PACK if group.count is not None else PACK_ALL)):
                 picked.append(a)
         if len(picked) == n:
             return picked
@@ -181,4 +186,5 @@ def covered(asset: dict, kinds: tuple[frozenset[str], frozenset[str]]) -> bool:
     return bool(set(asset["tags"]) & tags) or asset["category"] in categories
 
 
-__all__ = ["ALL_COUNT", "COUNTS", "Group", "choose", "covered", "find_group", "group_kinds", "read_group", "singular"]
+__all__ = ["ALL_COUNT", "COUNTS", "PACK", "PACK_ALL", "Group", "choose", "covered", "find_group", "group_kinds",
+           "read_group", "side_by_side", "singular"]

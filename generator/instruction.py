@@ -2,21 +2,14 @@
 
 ``gendex generate --instruction "..."`` starts here, before any backend is asked anything. :func:`read_instruction`
 finds the skill from the verb (and its preposition: *put X in Y* is not *put X on Y*) and resolves every object
-phrase against the catalog — multi-word names (*tuna can*, *trash can*), plurals, synonyms (*fridge*, *cupboard*,
-*bin*, *tap*), parts (*the top drawer*) and kinds (*a fruit*, *a ball*). Nothing is silent:
-
-- a phrase resolved to a catalog object is recorded with how it was resolved (:class:`Mention`);
-- a named object the catalog lacks is replaced by the closest one that can play its role, and the replacement is a
-  *substitution*: the CLI prints it and the task's proposal record keeps it;
-- a verb GenDex has no skill for, or an object that cannot play the part the verb needs (*open the apple*), raises
-  :class:`InstructionError` listing what is possible; ``gendex generate`` exits non-zero with that message.
-- a construct the author and solver do not build yet (a sequence, a direction, a place relative to something, an
-  amount, taking out: :data:`NOT_BUILT`) raises :class:`InstructionError` saying what was asked, so no task is built
-  without it.
-
-The skills are those of the solver (:data:`TASK_SKILLS`, the thirteen of ``docs/solving.md``); the same vocabulary
-goes into the language-model backend's proposal prompt (:func:`skill_vocabulary`).
-"""
+phrase against the catalog — multi-word names (*tuna can*), plurals, synonyms (*fridge*, *tap*), parts (*the top
+drawer*), kinds (*a fruit*), colours; steps, lists, towers and groups go through :mod:`generator.compound`. Nothing
+is silent: each object is recorded with how it was resolved (:class:`Mention`); one the catalog lacks stands in by
+the object nearest in meaning (:mod:`generator.nearest`), a *substitution* the CLI prints and the proposal keeps; a
+word no part of the reading takes is said in a note; a verb with no skill, an object that cannot play its part or
+a construct not built yet (:data:`NOT_BUILT`) raises :class:`InstructionError` listing what is possible, and
+``gendex generate`` exits 2. The skills are :data:`TASK_SKILLS`; the same vocabulary goes into the language-model
+backend's proposal prompt (:func:`skill_vocabulary`)."""
 
 from __future__ import annotations
 
@@ -38,7 +31,7 @@ from generator.constructs import (
     read_place,
 )
 from generator.errors import InstructionError
-from generator.nearest import nearest
+from generator.nearest import stand_in
 from generator.vocabulary import COURTESY_WORDS, KINDS, ORDINALS, PARTS, SYNONYMS, TASK_SKILLS, TaskSkill
 from generator.vocabulary import FILLER_WORDS as _FILLER
 from generator.vocabulary import STOP_WORDS as _STOP
@@ -617,20 +610,8 @@ def _assign(skill: str, roles: tuple[str, ...], mentions: list[Mention], assets:
                                                                                  f"{len(ids)}"))
             continue
         if m.how == "substitute":  # the kind a word says ('toy car': a toy), then the nearest in meaning
-            kind = next((KINDS[w] for w in reversed(m.phrase.split()) if w in KINDS), None)
-            pool = [a for a in able if kind in a["tags"]] or able
-            if role == "graspable":  # a stand-in the solver holds, so the author builds the object said here
-                from generator.backends.roles import graspable
-
-                pool = [a for a in pool if graspable(a)] or pool
-            if not pool:
-                raise InstructionError(f"nothing in the catalog can be the {role} object of '{skill}'")
-            best, cosine = nearest(m.phrase, pool, role)
-            out.append(dataclasses.replace(m, asset=best["id"], options=(best["id"],),
-                                           detail=f"not in the catalog; the {role} object nearest in meaning"
-                                                  + (f" among the {kind} objects" if kind and kind in best["tags"]
-                                                     else "")
-                                                  + f", cosine {cosine:.2f}"))
+            into = mentions[1].asset if skill == "put_in" and len(mentions) > 1 and mentions[1].asset else None
+            out.append(stand_in(m, able, role, skill, None if into is None else _by_id(assets, into)))
             continue
         kind = _by_id(assets, m.asset)["category"]
         named = [a for a in assets if a["id"] == m.asset or (m.how != "id" and a["category"] == kind)]

@@ -10,9 +10,15 @@ were, so nothing is built that the person did not ask for."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from generator.errors import InstructionError
+from generator.vocabulary import KINDS
+
+if TYPE_CHECKING:
+    from generator.instruction import Mention
 
 MIN_SIMILARITY = 0.45
 """Cosine a category's name needs with the phrase to stand in for it. Measured on names the catalog lacks:
@@ -53,4 +59,25 @@ def nearest(phrase: str, able: Sequence[dict], role: str) -> tuple[dict, float]:
     return models[0], float(sims[best])
 
 
-__all__ = ["MIN_SIMILARITY", "nearest"]
+def stand_in(m: Mention, able: Sequence[dict], role: str, skill: str, into: dict | None = None) -> Mention:
+    """``m`` (an object the catalog lacks) resolved to its stand-in among the ``able`` objects of its ``role``: of the
+    kind a word of it says where one does (*toy car*: a toy), one the solver holds for a grasp, one that fits in
+    ``into`` (the container of a put-in) where one does, then :func:`nearest` in meaning."""
+    from generator.backends.roles import fits_in, graspable
+
+    kind = next((KINDS[w] for w in reversed(m.phrase.split()) if w in KINDS), None)
+    pool = [a for a in able if kind in a["tags"]] or list(able)
+    if role == "graspable":  # a stand-in the solver holds, so the author builds the object said here
+        pool = [a for a in pool if graspable(a)] or pool
+        if into is not None:  # 'put the pineapple in the bowl': a fruit that goes in it
+            pool = [a for a in pool if fits_in(a, into)] or pool
+    if not pool:
+        raise InstructionError(f"nothing in the catalog can be the {role} object of '{skill}'")
+    best, cosine = nearest(m.phrase, pool, role)
+    among = f" among the {kind} objects" if kind and kind in best["tags"] else ""
+    return dataclasses.replace(m, asset=best["id"], options=(best["id"],),
+                               detail=f"not in the catalog; the {role} object nearest in meaning{among}, "
+                                      f"cosine {cosine:.2f}")
+
+
+__all__ = ["MIN_SIMILARITY", "nearest", "stand_in"]

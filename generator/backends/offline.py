@@ -482,13 +482,13 @@ class OfflineBackend:
         colors = tuple(m.get("color") for m in mentions)
         amount = reading.get("amount")
         if skill == "lift":
-            proposal = self._lift_task(pick(0, graspable, "object to lift"), colors)
+            proposal = self._lift_task(pick(0, handed, "object to lift"), colors)
         elif skill == "put_in":
             g = pick(0, graspable, "object to put in")
             proposal = self._put_task(g, pick(1, lambda x: (container(x) or receptacle(x)) and fits_in(g, x),
                                               "container it fits in"), colors)
         elif skill == "place_on":
-            proposal = self._plate_task(pick(0, graspable, "object to set down"),
+            proposal = self._plate_task(pick(0, handed, "object to set down"),
                                         pick(1, is_surface, "plate, tray or board"), colors)
         elif skill == "stack":  # blocks named by colour alone: the smallest on top, the next size under it
             a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack", smallest=True)
@@ -497,7 +497,7 @@ class OfflineBackend:
         elif skill == "place_at":
             rel = reading.get("relation") or "in_region"
             refs = [pick(k, lambda x: not x.get("joints"), "object to set it by") for k in range(1, len(mentions))]
-            a = pick(0, graspable, "object to set down")
+            a = pick(0, handed, "object to set down")
             proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
         elif skill == "take_out":
             g = pick(0, graspable, "object to take out")

@@ -190,6 +190,8 @@ def _said_as_group(steps: list[dict], readings: list[dict], names_of: Callable[[
         said = re.sub(rf"\b(the|a|an) ({'|'.join(re.escape(w) for w in words)})\b", group, command, count=1)
         if said == command:
             continue  # not said by a word of its object: each step keeps its own command
+        if not group.startswith(("every ", "each ")):  # several things: 'let them go', not 'let it go'
+            said = re.sub(r"\bit\b", "them", re.sub(r"\bits\b", "their", said))
         camel = "".join(w.capitalize() for w in group.split() if w not in ("the", "of"))  # 'AllFruit'
         names = sorted(({"".join(p.capitalize() for p in re.split(r"[_\s]+", w)) for w in words}
                         | {"".join(p.capitalize() for p in out[k]["objects"][0]["asset"].split("_"))}), key=len,
