@@ -4,7 +4,8 @@ both balls in the bowl*, *set the two blocks on the tray*, *drop every toy into 
 A group is read as one put-in (or set-down) per object, in the order :func:`choose` draws them. Which objects make the
 group is the reader's choice, recorded: each of them is a :class:`~generator.instruction.Mention` of ``how="kind"``
 whose ``group`` is the person's phrase, and a note names them all. *All* (and *every*, *each*, a bare plural)
-means the objects of that kind the scene holds: the reader draws :data:`ALL_COUNT` of them. A number (*the two
+means the objects of that kind the scene holds: the reader draws :data:`ALL_COUNT` of them (:data:`ALL_ON_SURFACE`
+on a plate, tray or board). A number (*the two
 balls*, *both*) is that many. A definite group (*all*, *both*, *the two*) is every object of its kind on the table:
 the scene holds no clutter of it (:func:`group_kinds`, checked by the scene step); *two balls* is any two.
 
@@ -31,7 +32,10 @@ if TYPE_CHECKING:
     from generator.instruction import Reading
 
 ALL_COUNT = 3
-"""Objects *all the ...* draws: as many rigid steps as one task joins (``sequence.MAX_RIGID_STEPS``)."""
+"""Objects *all the ...* draws: as many rigid steps as one task joins (``sequence.MAX_RIGID_STEPS``)..."""
+ALL_ON_SURFACE = 2
+"""...on a plate, tray or board, two: set down round its middle, the third of three toys on the cutting board
+missed it in 3 of 6, 3 of 7 and 3 of 8 gate attempts (two blocks, two balls on the tray: 10 of 10 each)."""
 COUNTS = {"both": 2, "two": 2, "three": 3, "2": 2, "3": 3}
 """Words that say how many objects a group has."""
 _FORM = re.compile(r"^(?:(all|every|each|both)(?: of)?(?: the)?|(?:the )?(two|three|2|3)|(the))\s+([a-z']+)$")
@@ -105,13 +109,13 @@ def side_by_side(objects: Sequence[dict], container: dict, slots: int | None = N
 
 
 def choose(text: str, group: Group, candidates: Sequence[dict], by_kind: bool,
-           container: dict | None = None) -> list[dict]:
+           container: dict | None = None, most: int = ALL_COUNT) -> list[dict]:
     """The objects of ``group``, drawn from ``candidates`` (assets that can play the part) by a generator seeded with
     ``text``: of distinct categories when ``by_kind``, and side by side in ``container`` when one is given (a put
     in: :func:`side_by_side`). :class:`InstructionError` when the catalog has too few."""
     rng = np.random.default_rng(int.from_bytes(hashlib.sha256(text.encode()).digest()[:8], "little"))
     pool = [candidates[i] for i in rng.permutation(len(candidates))]
-    want = group.count if group.count is not None else ALL_COUNT
+    want = group.count if group.count is not None else most
     if want > ALL_COUNT:
         raise InstructionError(f"'{group.phrase}': a task moves at most {ALL_COUNT} objects one after another")
     picked: list[dict] = []
@@ -147,7 +151,8 @@ def read_group(text: str, verb: list[str], objects: str, place: list[str], read_
     into = assets[where.asset]
     able = [assets[i] for i in m.options if graspable(assets[i])
             and (probe.skill != "put_in" or fits_in(assets[i], into))]
-    picked = choose(text, group, able, by_kind=m.how == "kind", container=into if probe.skill == "put_in" else None)
+    put = probe.skill == "put_in"
+    picked = choose(text, group, able, m.how == "kind", into if put else None, ALL_COUNT if put else ALL_ON_SURFACE)
     n = len(picked)
     out = []
     for k, a in enumerate(picked, 1):
@@ -186,5 +191,5 @@ def covered(asset: dict, kinds: tuple[frozenset[str], frozenset[str]]) -> bool:
     return bool(set(asset["tags"]) & tags) or asset["category"] in categories
 
 
-__all__ = ["ALL_COUNT", "COUNTS", "PACK", "PACK_ALL", "Group", "choose", "covered", "find_group", "group_kinds",
-           "read_group", "side_by_side", "singular"]
+__all__ = ["ALL_COUNT", "ALL_ON_SURFACE", "COUNTS", "PACK", "PACK_ALL", "Group", "choose", "covered", "find_group",
+           "group_kinds", "read_group", "side_by_side", "singular"]
