@@ -20,6 +20,7 @@ from gendex.cli_bc import bc_app
 from gendex.cli_check import check_command
 from gendex.cli_common import backend_of, ray_address_option, ray_option
 from gendex.cli_common import die as _die
+from gendex.cli_common import refuse_request as _refuse
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
 from gendex.cli_store import store_app
@@ -435,7 +436,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
         try:
             reading = read_instruction(instruction, asset_dicts())
         except GenDexError as exc:
-            _die(exc)
+            _refuse(exc, instruction, out)
         for line in reading.lines():
             typer.secho(line, fg=typer.colors.YELLOW if "SUBSTITUTED" in line or " chose " in line else None,
                         err=True)
@@ -453,7 +454,7 @@ def generate(n: int = typer.Option(1, "--n", min=1, help="Number of tasks to gen
                          reading=reading, failed=failed, gate_workers=workers if tasks_on is None else 1,
                          tasks_on=tasks_on)
     except GenDexError as exc:
-        _die(exc)
+        _refuse(exc, instruction, out)
     typer.echo("\nGenerated tasks (physical-check violations before -> after refinement)")
     for s in rows:
         dropped = f" ({s.proposals_tried - 1} earlier proposal(s) dropped)" if s.proposals_tried > 1 else ""

@@ -160,5 +160,31 @@ class Novelty:
         return None
 
 
-__all__ = ["ExistingTask", "NEAR_DUPLICATE_COSINE", "Novelty", "existing_tasks", "kind", "proposal_signature",
-           "spec_signature"]
+MATCH_COSINE = 0.6
+"""A library task whose command reads at least this like a refused request (MiniLM cosine) is pointed to: *shut
+the oven door* and CloseOvenCompact-v1 0.86, *spin the tennis ball in the hand* and RotateTennisBall-v1 0.77, *put
+the apple in the microwave* and PutAppleBowl-v1 0.77; below it, *throw the ball across the room* and a put of a
+tennis ball 0.53, *lift the hairbrush* and UnscrewBottle-v1 0.43."""
+
+
+def closest_tasks(request: str, tasks: Iterable[ExistingTask], k: int = 3,
+                  min_cosine: float = MATCH_COSINE) -> list[tuple[str, str, float]]:
+    """The (env id, command, cosine) of at most ``k`` of ``tasks`` whose commands (situation and purpose taken off)
+    read most like ``request``, at least ``min_cosine``; none without the ``stats`` extra."""
+    from generator.phrasing import split
+
+    tasks = list(tasks)
+    commands = [split(t.instruction)[1] for t in tasks]
+    if not tasks:
+        return []
+    try:
+        emb, _ = embed_each([request, *commands])
+    except ImportError:
+        return []
+    sims = emb[1:] @ emb[0]
+    order = sorted(range(len(tasks)), key=lambda i: (-float(sims[i]), tasks[i].env_id))[:k]
+    return [(tasks[i].env_id, commands[i], float(sims[i])) for i in order if sims[i] >= min_cosine]
+
+
+__all__ = ["ExistingTask", "MATCH_COSINE", "NEAR_DUPLICATE_COSINE", "Novelty", "closest_tasks", "existing_tasks",
+           "kind", "proposal_signature", "spec_signature"]

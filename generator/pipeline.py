@@ -114,7 +114,7 @@ def _write(path: Path, data: str | bytes) -> None:
         path.write_text(data)
 
 
-def _task_roots(root: Path) -> list[Path]:
+def task_roots(root: Path) -> list[Path]:
     """The output folder and the repository's task folder: where existing tasks live."""
     from gendex_envs.registry import REPO_TASKS_DIR
 
@@ -123,7 +123,7 @@ def _task_roots(root: Path) -> list[Path]:
 
 def _existing_names(root: Path) -> tuple[str, ...]:
     names = set()
-    for r in _task_roots(root):
+    for r in task_roots(root):
         if r.is_dir():
             names |= {p.name for p in r.iterdir() if p.is_dir() and not p.name.startswith(".")}
     return tuple(sorted(names))
@@ -275,7 +275,7 @@ def _generate(backend_factory: Callable[[], Backend], root: Path, *, n: int, see
                                      gate_attempts=gate_attempts, reading=reading, failed=failed, backend=tasks_on)
     out: list[TaskSummary] = []
     existing = _existing_names(root)
-    novelty = Novelty(existing_tasks(_task_roots(root))) if instruction is None else None
+    novelty = Novelty(existing_tasks(task_roots(root))) if instruction is None else None
     dropped_names: set[str] = set()  # a proposal dropped in this batch is not proposed again in it
     for i in range(n):
         try:
@@ -414,7 +414,7 @@ def _generate_in_parallel(backend_factory, root: Path, *, n: int, seed: int, ins
     published out of order or from a wrong state, so the committed folders equal a single process's."""
     from gendex.fanout import ordered_map, session
 
-    library = existing_tasks(_task_roots(root)) if instruction is None else None
+    library = existing_tasks(task_roots(root)) if instruction is None else None
     novelty = Novelty(library) if library is not None else None
     make_worker = functools.partial(_TaskWorker, backend_factory, seed=seed, instruction=instruction,
                                     command=command, candidates=candidates, gate_attempts=gate_attempts,

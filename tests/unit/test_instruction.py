@@ -134,6 +134,19 @@ def test_cli_refuses_an_impossible_request_non_zero_and_writes_nothing(tmp_path)
     assert r.exit_code == 2 and out.is_dir() and not any(out.iterdir())
 
 
+def test_a_refused_request_points_to_the_library_tasks_that_read_like_it(tmp_path):
+    """Closing an oven has no layout in the offline author, but the library holds CloseOvenCompact: the refusal
+    says so (an issue finding: a close request whose task exists was refused without pointing to it)."""
+    out = tmp_path / "tasks"
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "shut the oven door",
+                                 "--out", str(out)])
+    assert r.exit_code == 2 and "no layout to close 'oven'" in r.output, r.output
+    assert "GenDex/CloseOvenCompact-v" in r.output.split("error:")[0] and not out.exists()
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "throw the ball across the "
+                                 "room", "--out", str(out)])
+    assert r.exit_code == 2 and "Library tasks that read like" not in r.output  # nothing near: nothing named
+
+
 def test_reading_is_json_able():
     assert json.loads(json.dumps(read("put the lemon in the bowl").to_dict()))["skill"] == "put_in"
 
