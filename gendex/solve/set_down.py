@@ -118,10 +118,11 @@ conditions' ``max_dist_m`` from its middle (well within what they accept: the re
 def free_spot(env, container: str, held: str) -> np.ndarray | None:
     """[2] where on or in ``container`` to set ``held`` down when it is to hold several objects (*put all the fruit
     in the pot*, *set the two blocks on the tray*: every ``inside`` or ``near`` condition of the task on it) or, a
-    container, others already lie in it. Several to hold: each at its own slot, evenly round the middle (the
-    conditions' objects in order, the first to the robot's left), as far out as ``held`` stays within what an
-    ``inside`` condition checks (on a surface: :data:`SLOT_NEAR_SHARE` of ``max_dist_m``); others lying in it:
-    across the middle from them. None when ``container`` is to hold only ``held`` and holds nothing else."""
+    container, others already lie in it: of the points as far from its middle as ``held`` stays within what an
+    ``inside`` condition checks (on a surface: :data:`SLOT_NEAR_SHARE` of ``max_dist_m``), half as far, and the
+    middle, the one farthest from what lies there now (round objects roll: where they came to rest counts, not
+    where they were set down); the first of several to the robot's left, so the next have room. None when
+    ``container`` is to hold only ``held`` and holds nothing else."""
     conds = [x for x in env.task_spec.success.conditions if x.target == container and not x.negate
              and ((x.type == "inside" and x.joint is None) or x.type == "near")]
     near = next((x for x in conds if x.object == held and x.type == "near"), None)
@@ -129,27 +130,24 @@ def free_spot(env, container: str, held: str) -> np.ndarray | None:
     c = rest_point(env, container)[0, :2].double().cpu().numpy()
     size = np.asarray(env.asset_record(held).size_m[:2]) * env.task_spec.object(held).scale
     room = max(0.0, radius - (0.0 if near else 0.5 * float(np.max(size))))
-    peers = list(dict.fromkeys(x.object for x in conds))
-    if held in peers and len(peers) > 1:
-        left = robot_axes(env, rest_point(env, container))[2].double().cpu().numpy()
-        turn = 2.0 * np.pi * peers.index(held) / len(peers)
-        return c + room * np.array([left[0] * np.cos(turn) - left[1] * np.sin(turn),
-                                    left[0] * np.sin(turn) + left[1] * np.cos(turn)])
-    if near is not None:
-        return None
-    inside = []
+    peers = [x.object for x in conds]
+    lying = []
     for name in env.objects:
         if name in (container, held) or name in env.articulations:
             continue
         xy = rest_point(env, name)[0, :2].double().cpu().numpy()
-        if float(np.linalg.norm(xy - c)) < radius:
-            inside.append(xy)
-    if not inside:
+        if float(np.linalg.norm(xy - c)) < radius + (0.0 if near else 0.5 * float(np.max(size))):
+            lying.append(xy)
+    several = held in peers and len(set(peers)) > 1
+    if not lying:
+        if not several:
+            return None
+        return c + room * robot_axes(env, rest_point(env, container))[2].double().cpu().numpy()
+    if near is not None and not several:
         return None
-    d = np.mean(inside, axis=0) - c
-    n = float(np.linalg.norm(d))
-    d = d / n if n > 1e-3 else np.array([1.0, 0.0])
-    return c - room * d
+    turns = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)
+    points = [c + r * np.array([np.cos(t), np.sin(t)]) for r in (room, 0.5 * room) for t in turns] + [c]
+    return max(points, key=lambda p: min(float(np.linalg.norm(p - q)) for q in lying))
 
 
 __all__ = ["DRAWER_SIDE_M", "POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "SLOT_NEAR_SHARE", "drawer_of", "drawer_side",

@@ -59,13 +59,14 @@ def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
     del poses["lemon"]
     Env.objects = {n: None for n in poses}
     assert free_spot(Env, "bowl", "plum") is None  # nothing in it yet: its middle
-    # a bowl that is to hold three (every 'inside' condition on it): each its own slot, 120 degrees apart, the
-    # first to the robot's left, whatever lies in it already
+    # a bowl that is to hold three (every 'inside' condition on it): the first goes to the robot's left, as far out
+    # as it stays within the checked space, so the next have room; each next one where it is farthest from what
+    # lies there (where it came to rest)
     inside = lambda o: NS(type="inside", object=o, target="bowl", joint=None, negate=False)  # noqa: E731
     Env.task_spec.success.conditions = (inside("lemon"), inside("plum"), inside("apple"))
-    spots = [free_spot(Env, "bowl", o) for o in ("lemon", "plum", "apple")]
     room = 0.08 - 0.025
-    assert np.allclose(spots[0], (0.1, room))
-    assert all(np.isclose(np.linalg.norm(p - (0.1, 0.0)), room) for p in spots)
-    gaps = [np.linalg.norm(spots[i] - spots[j]) for i, j in ((0, 1), (1, 2), (0, 2))]
-    assert np.allclose(gaps, room * np.sqrt(3))  # evenly round the middle
+    assert np.allclose(free_spot(Env, "bowl", "lemon"), (0.1, room))  # nothing in it yet
+    poses["lemon"] = (0.1, 0.02)  # it rolled towards the middle
+    Env.objects = {n: None for n in poses}
+    spot = free_spot(Env, "bowl", "plum")
+    assert np.isclose(np.linalg.norm(spot - (0.1, 0.0)), room) and spot[1] < -0.05  # across the middle from it
