@@ -118,11 +118,12 @@ conditions' ``max_dist_m`` from its middle (well within what they accept: the re
 def free_spot(env, container: str, held: str) -> np.ndarray | None:
     """[2] where on or in ``container`` to set ``held`` down when it is to hold several objects (*put all the fruit
     in the pot*, *set the two blocks on the tray*: every ``inside`` or ``near`` condition of the task on it) or, a
-    container, others already lie in it: of the points as far from its middle as ``held`` stays within what an
-    ``inside`` condition checks (on a surface: :data:`SLOT_NEAR_SHARE` of ``max_dist_m``), half as far, and the
-    middle, the one farthest from what lies there now (round objects roll: where they came to rest counts, not
-    where they were set down); the first of several to the robot's left, so the next have room. None when
-    ``container`` is to hold only ``held`` and holds nothing else."""
+    container, others already lie in it. The first of several goes to the robot's left, as far from the middle as
+    it stays within what an ``inside`` condition checks (on a surface: :data:`SLOT_NEAR_SHARE` of
+    ``max_dist_m``), so the next have room; each next one to the free slot of as many evenly round the middle,
+    turned to where the first came to rest (round objects roll: where they lie counts, not where they were set
+    down), farthest from what lies there. None when ``container`` is to hold only ``held`` and holds nothing
+    else."""
     conds = [x for x in env.task_spec.success.conditions if x.target == container and not x.negate
              and ((x.type == "inside" and x.joint is None) or x.type == "near")]
     near = next((x for x in conds if x.object == held and x.type == "near"), None)
@@ -131,12 +132,13 @@ def free_spot(env, container: str, held: str) -> np.ndarray | None:
     size = np.asarray(env.asset_record(held).size_m[:2]) * env.task_spec.object(held).scale
     room = max(0.0, radius - (0.0 if near else 0.5 * float(np.max(size))))
     peers = [x.object for x in conds]
-    lying = []
+    reach = 0.5 * float(np.max(env.asset_record(container).size_m[:2])) * env.task_spec.object(container).scale
+    lying = []  # what lies anywhere on or in it (a ball set down on a tray may roll to its edge)
     for name in env.objects:
         if name in (container, held) or name in env.articulations:
             continue
         xy = rest_point(env, name)[0, :2].double().cpu().numpy()
-        if float(np.linalg.norm(xy - c)) < radius + (0.0 if near else 0.5 * float(np.max(size))):
+        if float(np.linalg.norm(xy - c)) < reach:
             lying.append(xy)
     several = held in peers and len(set(peers)) > 1
     if not lying:
@@ -145,9 +147,14 @@ def free_spot(env, container: str, held: str) -> np.ndarray | None:
         return c + room * robot_axes(env, rest_point(env, container))[2].double().cpu().numpy()
     if near is not None and not several:
         return None
-    turns = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)
-    points = [c + r * np.array([np.cos(t), np.sin(t)]) for r in (room, 0.5 * room) for t in turns] + [c]
-    return max(points, key=lambda p: min(float(np.linalg.norm(p - q)) for q in lying))
+    # the slots evenly round the middle, turned to where the first object came to rest: the free one farthest
+    # from what lies there (two: across from it, three: 120 degrees on)
+    n = max(len(set(peers)) if several else 0, len(lying) + 1)
+    d = lying[0] - c
+    start = float(np.arctan2(d[1], d[0])) if float(np.linalg.norm(d)) > 1e-3 else 0.0
+    turns = start + 2.0 * np.pi * np.arange(n) / n
+    slots = [c + room * np.array([np.cos(t), np.sin(t)]) for t in turns]
+    return max(slots, key=lambda p: min(float(np.linalg.norm(p - q)) for q in lying))
 
 
 __all__ = ["DRAWER_SIDE_M", "POINT", "POINT_CARRY_M", "REGION_DEPTH_M", "SLOT_NEAR_SHARE", "drawer_of", "drawer_side",

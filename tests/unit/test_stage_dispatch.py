@@ -49,7 +49,7 @@ def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
 
         @staticmethod
         def asset_record(name):
-            return NS(size_m=(0.05, 0.05, 0.05))
+            return NS(size_m=(0.2, 0.2, 0.08) if name == "bowl" else (0.05, 0.05, 0.05))
 
     from gendex.solve import set_down
 
@@ -68,5 +68,14 @@ def test_a_second_object_put_in_a_container_goes_beside_the_first(monkeypatch):
     assert np.allclose(free_spot(Env, "bowl", "lemon"), (0.1, room))  # nothing in it yet
     poses["lemon"] = (0.1, 0.02)  # it rolled towards the middle
     Env.objects = {n: None for n in poses}
-    spot = free_spot(Env, "bowl", "plum")
-    assert np.isclose(np.linalg.norm(spot - (0.1, 0.0)), room) and spot[1] < -0.05  # across the middle from it
+
+    def turned(spot):  # degrees from the lemon's direction, seen from the bowl's middle
+        a, b = np.asarray(spot) - (0.1, 0.0), np.asarray(poses["lemon"]) - (0.1, 0.0)
+        return np.degrees(np.arccos(a @ b / np.linalg.norm(a) / np.linalg.norm(b)))
+
+    spot = free_spot(Env, "bowl", "plum")  # three to hold: 120 degrees on from where the lemon lies
+    assert np.isclose(np.linalg.norm(spot - (0.1, 0.0)), room) and np.isclose(turned(spot), 120.0)
+    Env.task_spec.success.conditions = (inside("lemon"), inside("plum"))
+    assert np.isclose(turned(free_spot(Env, "bowl", "plum")), 180.0)  # two: across the middle from it
+    poses["lemon"] = (0.1, 0.085)  # rolled to the rim, beyond the slots: it still counts
+    assert np.isclose(turned(free_spot(Env, "bowl", "plum")), 180.0)
