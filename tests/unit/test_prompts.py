@@ -83,3 +83,20 @@ def test_the_prompts_describe_a_drawer_as_a_receptacle_with_its_joint():
     free = render("propose", asset_guidance="-", existing_tasks="- (none)", skills="-", condition_types="inside",
                   control_joints="arm, hand")
     assert '"joint": "drawer_1_slide"' in " ".join(free.split())
+
+
+def test_the_guided_prompt_describes_a_group_of_objects():
+    """*Put all the fruit in the pot*: the Claude backend sees the objects the reader drew (each marked with the
+    group) and is told to use them, say the command as the person did and keep other fruit off the table."""
+    from generator.catalog_view import asset_dicts
+    from generator.instruction import read_instruction, skill_vocabulary
+
+    request = "put all the fruit in the large bowl"
+    reading = read_instruction(request, asset_dicts())
+    drawn = [r.objects[0].asset for r in (reading, *reading.then)]
+    text = render("propose_guided", instruction=request, asset_guidance="-", existing_tasks="- (none)",
+                  skills="-", condition_types="inside", control_joints="arm, hand",
+                  task_skills=skill_vocabulary(), reading="\n".join(reading.lines()))
+    flat = " ".join(text.split())
+    assert all(f"chose {a}" in text for a in drawn) and "'all the fruit' is read as" in text
+    assert "use exactly the objects the reading drew" in flat and "no other object of that kind" in flat
