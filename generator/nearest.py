@@ -6,7 +6,8 @@ does (*dragon fruit*: a fruit); :func:`nearest` then takes the category whose na
 all-MiniLM-L6-v2 sentence embeddings (the model of the ``stats`` extra; :mod:`generator.embedding`, each text
 embedded once and cached), and within it the model whose id is nearest. A phrase no category is near
 (:data:`MIN_SIMILARITY`) is not substituted: the request is refused, naming the nearest objects and how near they
-were, so nothing is built that the person did not ask for."""
+were, so nothing is built that the person did not ask for; where one category alone can play the part (the beads
+and marbles poured), it stands in, with its cosine said."""
 
 from __future__ import annotations
 
@@ -47,7 +48,8 @@ def nearest(phrase: str, able: Sequence[dict], role: str) -> tuple[dict, float]:
     sims = vectors[1:] @ vectors[0]
     order = sorted(range(len(categories)), key=lambda k: (-float(sims[k]), categories[k]))
     best = order[0]
-    if float(sims[best]) < MIN_SIMILARITY:
+    if float(sims[best]) < MIN_SIMILARITY and len(categories) > 1:  # one kind plays the part: no choice to make
+        # ('pour the rice': the catalog's only pourable things are beads and marbles)
         near = ", ".join(f"{_spoken(categories[k])} {float(sims[k]):.2f}" for k in order[:3])
         raise InstructionError(
             f"'{phrase}' is not in the catalog, and no {role} object is near it in meaning (nearest: {near}; a "

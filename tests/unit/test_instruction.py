@@ -100,8 +100,8 @@ def test_the_proposal_records_the_reading_and_the_offline_author_keeps_to_it():
     p, _ = propose(OfflineBackend(seed=0), instruction="shut the right fridge")
     assert [o.asset for o in p.objects] == ["refrigerator_left_hinge"]
     assert p.substitutions == {"right fridge": "refrigerator_left_hinge"}
-    with pytest.raises(InstructionError, match="no layout to close 'oven'"):
-        propose(OfflineBackend(seed=0), instruction="shut the oven")
+    with pytest.raises(InstructionError, match="no layout to close 'dishwasher'"):
+        propose(OfflineBackend(seed=0), instruction="shut the dishwasher")
 
 
 def test_a_backend_that_swaps_the_named_object_is_caught():
@@ -135,13 +135,13 @@ def test_cli_refuses_an_impossible_request_non_zero_and_writes_nothing(tmp_path)
 
 
 def test_a_refused_request_points_to_the_library_tasks_that_read_like_it(tmp_path):
-    """Closing an oven has no layout in the offline author, but the library holds CloseOvenCompact: the refusal
-    says so (an issue finding: a close request whose task exists was refused without pointing to it)."""
+    """The offline author writes no in-hand rotation, but the library holds RotateTennisBall (a trained policy):
+    the refusal says so (an issue finding: a request whose task exists was refused without pointing to it)."""
     out = tmp_path / "tasks"
-    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "shut the oven door",
-                                 "--out", str(out)])
-    assert r.exit_code == 2 and "no layout to close 'oven'" in r.output, r.output
-    assert "GenDex/CloseOvenCompact-v" in r.output.split("error:")[0] and not out.exists()
+    r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "spin the tennis ball in the "
+                                 "hand", "--out", str(out)])
+    assert r.exit_code == 2 and "writes no 'reorient' task" in r.output, r.output
+    assert "GenDex/RotateTennisBall-v" in r.output.split("error:")[0] and not out.exists()
     r = CliRunner().invoke(app, ["generate", "--backend", "offline", "--instruction", "throw the ball across the "
                                  "room", "--out", str(out)])
     assert r.exit_code == 2 and "Library tasks that read like" not in r.output  # nothing near: nothing named
