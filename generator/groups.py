@@ -4,10 +4,10 @@ both balls in the bowl*, *set the two blocks on the tray*, *drop every toy into 
 A group is read as one put-in (or set-down) per object, in the order :func:`choose` draws them. Which objects make the
 group is the reader's choice, recorded: each of them is a :class:`~generator.instruction.Mention` of ``how="kind"``
 whose ``group`` is the person's phrase, and a note names them all. *All* (and *every*, *each*, a bare plural)
-means the objects of that kind the scene holds: the reader draws :data:`ALL_COUNT` of them (:data:`ALL_ON_SURFACE`
-on a plate, tray or board). A number (*the two
-balls*, *both*) is that many. A definite group (*all*, *both*, *the two*) is every object of its kind on the table:
-the scene holds no clutter of it (:func:`group_kinds`, checked by the scene step); *two balls* is any two.
+means the objects of that kind the scene holds: the reader draws up to :data:`ALL_COUNT` of them
+(:data:`ALL_ON_SURFACE` on a plate, tray or board). A number (*the two balls*, *both*) is that many. A definite
+group (*all*, *both*, *the two*) is every object of its kind on the table: the scene holds no clutter of it
+(:func:`group_kinds`, checked by the scene step); *two balls* is any two.
 
 The objects drawn are ones the solver holds (``generator.backends.roles.graspable``: >= 90 % of recorded grasps)
 and, for a put-in, that fit in the container; of different categories when the group is a kind (*the fruit*: a

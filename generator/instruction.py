@@ -507,8 +507,9 @@ def _refuse_unbuilt(text: str, words: list[str], skill: str | None = None,
             plural = nxt.endswith("s") and not nxt.endswith("ss") and nxt != "drawers"
             if w in GROUP_WORDS and nxt and nxt not in ("way", "time", "degrees") and (
                     plural or w in ("all", "both", "every")):
-                found.append((f"several objects ('{w} {nxt}')", "groups of objects but two or three put in or set "
-                              "on one place ('put all the fruit in the pot'), nor towers but of the blocks"))
+                found.append((f"several objects ('{w} {nxt}')", "groups of objects other than two or three put "
+                              "in or set on one place ('put all the fruit in the pot'), or towers of anything but "
+                              "blocks,"))
     else:
         chose = {w for m in qualified for w in m.qualifier.split()}  # 'left fridge': a model, not a side
         last = words[-1]
