@@ -1,5 +1,5 @@
 """The catalog object nearest in meaning to an object a request names that the catalog lacks (*grab the grapefruit*:
-an orange, not the paper cup its letters are nearest to).
+a fruit, the pear, not the paper cup its letters are nearest to).
 
 The reader narrows the objects to those that can play the part, and to the kind a word of the phrase says where one
 does (*dragon fruit*: a fruit); :func:`nearest` then takes the category whose name is nearest to the phrase by
@@ -22,7 +22,8 @@ if TYPE_CHECKING:
     from generator.instruction import Mention
 
 MIN_SIMILARITY = 0.45
-"""Cosine a category's name needs with the phrase to stand in for it. Measured on names the catalog lacks:
+"""Cosine a category's name needs with the phrase to stand in for it. Measured on names the catalog lacks, against
+every graspable category:
 football -> baseball 0.67, soda bottle -> bottle 0.76, cereal box -> pudding box 0.69, grapefruit -> strawberry 0.57,
 teacup -> cup 0.66; below: hairbrush -> bottle 0.36, ladle -> golf ball 0.41, cookie -> sugar box 0.41."""
 
