@@ -70,6 +70,8 @@ from gendex_envs.wiping import Wipes
 log = logging.getLogger(__name__)
 
 SIM_FREQ = 120
+CONTAINER_INSIDE_SHARE = 0.8
+"""Share of a rigid container's half footprint its ``inside`` condition checks (:meth:`TaskEnv.container_extent`)."""
 CONTROL_FREQ = 20
 VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
 """The three scene views used by rendering, refinement and the docs."""
@@ -165,10 +167,8 @@ class TaskEnv(BaseEnv):
         self.articulations: dict[str, Articulation] = {}
         self._records: dict[str, AssetRecord] = {o.name: get_asset(o.asset) for o in self.task_spec.objects}
         self._container_extent: dict[str, tuple[float, float]] = {
-            o.name: (0.8 * min(self._records[o.name].size_m[:2]) / 2 * o.scale,
-                     self._records[o.name].bbox_max_m[2] * o.scale)
-            for o in self.task_spec.objects
-        }
+            o.name: (CONTAINER_INSIDE_SHARE * min(self._records[o.name].size_m[:2]) / 2 * o.scale,
+                     self._records[o.name].bbox_max_m[2] * o.scale) for o in self.task_spec.objects}
         kwargs.setdefault("robot_uids", UR10eShadowHand.uid)
         freeze_long_lived()  # ManiSkill's full collection at each scene rebuild then walks only what came after
         super().__init__(*args, **kwargs)

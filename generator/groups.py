@@ -91,20 +91,19 @@ in 9 times of 10; a peach and a pear in the pot, 0.73, 8 of 10 and 2 of 5 in two
 PACK_ALL = 0.85
 """...and when the reader chooses how many (*all the fruit*), this share: fewer objects, each with room (a pear and
 a plum in the pot, 0.86: 10 of 10; a lemon and a plum in the bowl, 0.85: 9 of 10)."""
-INSIDE_SHARE = 0.8
-"""Share of a container's half footprint an ``inside`` condition checks (``TaskEnv.container_extent``)."""
 
 
 def side_by_side(objects: Sequence[dict], container: dict, slots: int | None = None, pack: float = PACK) -> bool:
     """Whether ``objects``, fitted to the hand, lie side by side in ``container`` in ``slots`` slots (default: one
     each), their slots ``pack`` of the largest one's width apart (:data:`PACK`)."""
     from gendex.solve.grasp import hand_fit_scale
+    from gendex_envs.task_env import CONTAINER_INSIDE_SHARE
 
     slots = len(objects) if slots is None else slots
     if slots < 2 or not objects:
         return True
     widths = [float(max(a["size_m"][:2])) * hand_fit_scale(a["size_m"][:2]) for a in objects]
-    room = INSIDE_SHARE * float(min(container["size_m"][:2])) / 2 - max(widths) / 2
+    room = CONTAINER_INSIDE_SHARE * float(min(container["size_m"][:2])) / 2 - max(widths) / 2
     return room > 0 and 2 * room * np.sin(np.pi / slots) >= pack * max(widths)
 
 

@@ -179,11 +179,11 @@ def _said_as_group(steps: list[dict], readings: list[dict], names_of: Callable[[
     """``steps`` with the steps of a group (*put all the fruit in the pot*: one step per fruit) said as the person
     said them: the first step's command with its object called by the group's words, the others said by it."""
     out = list(steps)
-    for k, r in enumerate(readings):
-        group = (r["objects"][0].get("group") or "") if r["objects"] else ""
-        if not group or (k and (readings[k - 1]["objects"][0].get("group") or "") == group):
+    groups = [(r["objects"][0].get("group") or "") if r["objects"] else "" for r in readings]
+    for k, group in enumerate(groups):
+        if not group or (k and groups[k - 1] == group):
             continue
-        members = [j for j in range(k, len(readings)) if (readings[j]["objects"][0].get("group") or "") == group]
+        members = [j for j in range(k, len(readings)) if groups[j] == group]
         command = split(out[k]["description"])[1].rstrip(".")
         words = sorted(names_of(out[k]["objects"][0]["asset"]) or (out[k]["objects"][0]["name"],), key=len,
                        reverse=True)
