@@ -38,26 +38,23 @@ from generator.critic.physical import (
     static_findings,
 )
 
+EXTREMES = tuple((sx, sy, turn) for sx in (-1, 1) for sy in (-1, 1) for turn in (-1, 0, 1))
+"""The randomization extremes the robot at rest is measured against: (x, y) corner of the xy range, yaw end."""
+MAX_DRAW_FIX_M = 0.05
+"""Longest move (m) one fix of a randomized draw's penetration asks for (the next round measures again)."""
+
 
 def _without_randomization(spec: TaskSpec) -> TaskSpec:
     objects = tuple(dataclasses.replace(o, randomize=RandomizeSpec()) for o in spec.objects)
     return dataclasses.replace(spec, objects=objects)
 
 
-def _entity_ids(entity) -> list[int]:
-    from mani_skill.utils.structs import Articulation
-
-    if isinstance(entity, Articulation):
-        return [px_objects(link)[0].entity.per_scene_id for link in entity.get_links()]
-    return [obj.per_scene_id for obj in px_objects(entity)]
-
-
 def _contact_penetrations(env, spec: TaskSpec, placed: dict[str, Placed], boxes: dict[str, tuple],
                           start: dict[str, np.ndarray], meas: dict) -> list[Violation]:
     """Penetrations in PhysX's contact list (one per object pair; one per object for the table and the robot)."""
-    from gendex_envs.assets.bounds import body_points
+    from gendex_envs.reset_contacts import entity_ids
 
-    owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in _entity_ids(entity)}
+    owner: dict[int, str] = {i: name for name, entity in env.objects.items() for i in entity_ids(entity)}
     robot_links = {px_objects(link)[0].entity.per_scene_id: link for link in env.agent.robot.get_links()}
     table_id = px_objects(env.table)[0].per_scene_id
     pairs: dict[tuple[str, str], float] = {}  # (object, object) sorted, or (object, "table")
@@ -98,24 +95,83 @@ def _contact_penetrations(env, spec: TaskSpec, placed: dict[str, Placed], boxes:
             measured=depth, limit=PENETRATION_TOL_M, fix=fix, other=po.spec.name))
     for a, links in sorted(robot.items()):
         meas.setdefault(a, {}).update({f"robot:{k}": rounded(v) for k, v in links.items()})
-        deep = {k: v for k, v in links.items() if v > PENETRATION_TOL_M}
-        if not deep:
-            continue
-        # one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the
-        # object's top (moving away from one finger would push it into the next)
-        lo, hi = boxes[a]
-        bodies = [px_objects(link)[0] for link in robot_links.values()]
-        pts = [body_points(b.entity_pose, b.collision_shapes) for b in bodies]
-        low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
-        obstacle = np.concatenate(low)
-        fix = moves(a, separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), float(start[a][1]),
-                                         randomization_xy(placed[a])))
-        worst = max(deep, key=deep.get)
+        violation = _robot_violation(env, a, links, boxes[a], float(start[a][1]), placed[a])
+        if violation is not None:
+            violations.append(violation)
+    return violations
+
+
+def _robot_violation(env, name: str, links: dict[str, float], box: tuple, start_y: float, placed: Placed
+                     ) -> Violation | None:
+    """The penetration of ``name`` by the robot at rest (``links``: link -> depth), if deeper than tolerated, with
+    one fix for the whole robot: out of the xy footprint of every robot link that reaches down below the object's
+    top (moving away from one finger would push it into the next)."""
+    from gendex_envs.assets.bounds import body_points
+
+    deep = {k: v for k, v in links.items() if v > PENETRATION_TOL_M}
+    if not deep:
+        return None
+    lo, hi = box
+    bodies = [px_objects(link)[0] for link in env.agent.robot.get_links()]
+    pts = [body_points(b.entity_pose, b.collision_shapes) for b in bodies]
+    low = [p for p in pts if len(p) and p[:, 2].min() < hi[2] + PENETRATION_FIX_MARGIN_M]
+    obstacle = np.concatenate(low)
+    fix = moves(name, separating_move(lo, hi, obstacle.min(axis=0), obstacle.max(axis=0), start_y,
+                                      randomization_xy(placed)))
+    worst = max(deep, key=deep.get)
+    return Violation(
+        "penetration", name, f"{name!r} and the robot interpenetrate at reset, by {deep[worst]:.3f} m at its "
+        f"{worst} ({len(deep)} link{'s' if len(deep) > 1 else ''}: {', '.join(sorted(deep))}); the robot stands "
+        "at its initial keyframe", measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}")
+
+
+def _draw_checks(spec: TaskSpec, seed: int, placed: dict[str, Placed], meas: dict) -> list[Violation]:
+    """The robot at rest against the objects at the extremes of their randomization (the nominal layout can be
+    clear while a shift or yaw draw swings a peg or a door into the hand): every randomized object shifted to each
+    corner of its xy range, turned to either end of its yaw range and not turned (:data:`EXTREMES`), the others
+    nominal. One violation per object, from its deepest extreme; its fix moves the object away from the palm
+    (horizontally, from the palm to the object's origin there) by the depth plus the fix margin, at most
+    :data:`MAX_DRAW_FIX_M` (the next round measures again)."""
+    import torch
+    from mani_skill.utils.structs.pose import Pose
+
+    from gendex_envs.geometry import quat_mul, yaw_quat
+    from gendex_envs.reset_contacts import robot_penetrations
+    from gendex_envs.task_env import TaskEnv
+
+    moving = [o for o in spec.objects if o.name in placed and (any(o.randomize.xy_m) or o.randomize.yaw_deg)]
+    worst: dict[str, tuple[str, object, np.ndarray]] = {}  # object -> (extreme, deepest Penetration, away from palm)
+    env = TaskEnv(task_spec=_without_randomization(spec), render_backend="none", control_mode="pd_joint_delta_pos")
+    try:
+        for sx, sy, turn in EXTREMES:
+            env.reset(seed=seed)
+            for o in moving:
+                entity = env.objects[o.name]
+                p, q = entity.pose.p.clone(), entity.pose.q.clone()
+                p[:, 0] += sx * o.randomize.xy_m[0]
+                p[:, 1] += sy * o.randomize.xy_m[1]
+                q = quat_mul(yaw_quat(torch.full((1,), turn * math.radians(o.randomize.yaw_deg))), q)
+                entity.set_pose(Pose.create_from_pq(p, q))
+            env.scene.step()
+            palm = env.agent.palm_link.pose.p[0, :2].numpy()
+            for name, links in robot_penetrations(env).items():
+                deepest = max(links.values(), key=lambda p: p.depth)
+                if name in placed and deepest.depth > PENETRATION_TOL_M and \
+                        deepest.depth > getattr(worst.get(name, ("", None))[1], "depth", 0.0):
+                    where = f"shifted ({sx:+d}, {sy:+d}) x its xy range, turned {turn:+d} x its yaw range"
+                    worst[name] = (where, deepest, env.objects[name].pose.p[0, :2].numpy() - palm)
+    finally:
+        env.close()
+    violations = []
+    for name, (where, pen, away) in sorted(worst.items()):
+        meas.setdefault(name, {})["robot@extreme"] = rounded(pen.depth)
+        size = float(np.linalg.norm(away))
+        direction = away / size if size > 1e-6 else np.array([1.0, 0.0])
+        step = min(pen.depth + PENETRATION_FIX_MARGIN_M, MAX_DRAW_FIX_M)
         violations.append(Violation(
-            "penetration", a, f"{a!r} and the robot interpenetrate at reset, by {deep[worst]:.3f} m at its "
-            f"{worst} ({len(deep)} link{'s' if len(deep) > 1 else ''}: {', '.join(sorted(deep))}); the robot stands "
-            "at its initial keyframe",
-            measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}"))
+            "penetration", name, f"{name!r} and the robot interpenetrate by {pen.depth:.3f} m at its {pen.link} "
+            f"when {name!r} is {where} (a randomized reset can draw it); the robot stands at its initial keyframe",
+            measured=pen.depth, limit=PENETRATION_TOL_M, fix=moves(name, direction * step), other=f"robot:{pen.link}"))
     return violations
 
 
@@ -173,6 +229,9 @@ def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STE
     violations, meas, placed, unsupported_fix = static_findings(spec, overlap=False)
     off = {v.object for v in violations if v.check == "off_table"}
     violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
+    if not any(v.check == "penetration" and str(v.other).startswith("robot:") for v in violations) and \
+            any(o.randomize.xy_m[0] or o.randomize.xy_m[1] or o.randomize.yaw_deg for o in spec.objects):
+        violations += _draw_checks(spec, seed, placed, meas["penetration"])
     report = PhysicalReport(spec.name, "sim", ordered(violations), meas, time.perf_counter() - t0)
     log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
     return report

@@ -15,6 +15,7 @@ from gendex import check
 from gendex.check import KNOWN_DEFECTS, CheckSelectionError, changed_since, newest_reference_ids, select
 from gendex.cli import app
 from gendex_envs.registry import REFERENCE_TASKS, registered_tasks
+from gendex_envs.reset_contacts import START_SEEDS
 from gendex_envs.task_version import TaskVersion
 
 
@@ -32,7 +33,11 @@ def test_the_sample_and_the_changed_versions_pass_gendex_check(tmp_path, library
     for r in report["results"]:
         assert r["status"] == ("xfail" if check.check_env_target(r["id"], registered_tasks()[r["id"]])
                                in KNOWN_DEFECTS else "passed"), r
-        assert [c.split(" ")[0] for c in r["checks"]] == ["static", "time_limit", "check_env", "steps"], r
+        names = [c.split(" ")[0] for c in r["checks"]]
+        if r["status"] == "passed":
+            assert names == ["static", "time_limit", "start", "check_env", "steps"], r
+        else:  # a known defect: the check that failed as known is the last before steps
+            assert names[:3] == ["static", "time_limit", "start"] and names[-1] == "steps", r
         assert r["seconds"] > 0
 
 
@@ -43,6 +48,18 @@ def test_every_registered_version_passes_gendex_check(tmp_path):
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["checked"] == len(registered_tasks())
     assert out.exit_code == 0 and report["ok"], [r for r in report["results"] if not r["ok"]]
+
+
+def test_a_hand_resting_inside_an_object_fails_the_start_check():
+    """HangMugOnRack-v0, checked as its folder (not through the known defects): on some of the first resets the
+    rack's pegs reach into the resting fingers. Its v1, the rack moved by the critic's fix, passes every check."""
+    v0 = registered_tasks()["GenDex/HangMugOnRack-v0"]
+    r = check.check_version(str(v0.root), folder=True)
+    assert r.status == "failed" and r.message.startswith("start: ") and "'stand'" in r.message, r
+    assert f"of {START_SEEDS} resets" in r.message, r
+    assert [c.split(" ")[0] for c in r.checks] == ["static", "time_limit"], r  # failed at the start check
+    v1 = check.check_version("GenDex/HangMugOnRack-v1")
+    assert v1.status == "passed" and v1.checks[2] == f"start ({START_SEEDS} seeds)", v1
 
 
 def test_known_defects_are_registered_versions_that_are_not_rewordings():
@@ -59,11 +76,13 @@ def test_a_reworded_version_is_checked_through_its_source():
     source = versions[reworded[0]].provenance()["reword"]["source"]
     assert check.check_env_target(reworded[0], versions[reworded[0]]) == source in versions
     alone = check.check_version(reworded[0])
-    assert alone.ok and alone.checks[2] == f"check_env (through {source})", alone
+    assert alone.ok and alone.checks[2:4] == [f"start ({START_SEEDS} seeds) (through {source})",
+                                              f"check_env (through {source})"], alone
     both = list(check.run_checks([source, reworded[0]]))
     assert [r.id for r in both] == [source, reworded[0]] and all(r.ok for r in both), both
-    assert both[0].checks[2] == "check_env"
-    assert both[1].checks[2] == f"check_env (through {source}, checked in this run)"
+    assert both[0].checks[2:4] == [f"start ({START_SEEDS} seeds)", "check_env"]
+    assert both[1].checks[2:4] == [f"start (through {source}, checked in this run)",
+                                   f"check_env (through {source}, checked in this run)"]
 
 
 def test_selection_options():
@@ -144,5 +163,6 @@ def test_a_version_folder_is_checked_as_it_is_even_where_the_library_holds_its_i
     failed, passed = data["results"]
     assert failed["message"].startswith("static: ") and "os" in failed["message"]
     assert passed["status"] == "passed" and passed["checks"][1:] == [
-        "time_limit (not registered: the spec's own)", "check_env (the folder)", "steps"], passed
+        "time_limit (not registered: the spec's own)", f"start ({START_SEEDS} seeds)", "check_env (the folder)",
+        "steps"], passed
     assert registered_tasks()[lib.env_id].root == lib.root
