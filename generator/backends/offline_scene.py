@@ -88,9 +88,21 @@ ARTICULATED_REGION_M = ((0.52, 0.68), (-0.2, 0.2))
 48-50/50 at (0.55-0.6, 0-0.1) +-5 cm; a batch sampled over x 0.3..0.75, y +-0.45 lost 3/10 drawer openings to
 unreachable hook poses."""
 
+DRAWER_FRONT_REGION_M = ((-0.14, -0.06), (-0.22, 0.22))
+"""Where movable objects go when one is put into a chest's drawer: the drawer, slid out towards the robot, reaches
+x = 0.15 (its chest at 0.6), and a hand closing on an object within ~10 cm of its front or side walls meets them.
+Measured on PutBlockMediumInDrawerChest1 (batch seed 1004729, rejected by its gate at 1/4; seeds 7100-7109): the
+block at (0.083, 0.114) 3/10 (7 grasps found none that held), at (0.03, 0.22) 4/10 (4 slipped), at (-0.11, 0.12)
+and at (-0.06, 0) 9/10 each, and with the chest taken aside 3/3; the library's drawer put-ins (x about -0.13) 4-5/5."""
+
+
 def _movable_region(proposal: dict, assets: dict[str, dict], acts: dict[str, str]) -> tuple:
     """Where movable objects go: :data:`MOVABLE_REGION_M`, or in a composed task the half of it away from the
-    articulated object's measured layout (the hand works on that object first, and its door or lid swings there)."""
+    articulated object's measured layout (the hand works on that object first, and its door or lid swings there),
+    or before the chest when something is put into a drawer (:data:`DRAWER_FRONT_REGION_M`)."""
+    receivers = {c.get("target") for c in (proposal["success"], *(proposal.get("also") or ())) if c["type"] == "inside"}
+    if any(o["name"] in receivers and drawer_joint(assets[o["asset"]]) for o in proposal["objects"]):
+        return DRAWER_FRONT_REGION_M
     (x0, x1), (y0, y1) = MOVABLE_REGION_M
     for o in proposal["objects"]:
         layout = ARTICULATED_LAYOUTS.get((acts.get(o["name"], ""), o["asset"]))
