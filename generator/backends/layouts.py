@@ -1,5 +1,6 @@
 """Where the offline author lays out the articulated objects it closes, opens by pressing or turns: a measured
-layout per (skill, asset) (:data:`ARTICULATED_LAYOUTS`). Data only; :mod:`generator.backends.offline` uses it."""
+layout per (skill, asset) (:data:`ARTICULATED_LAYOUTS`). Data only; :mod:`generator.backends.offline` uses it. A
+turn's ``part_way_failed`` says why the autonomous grammar does not turn that lever part way."""
 
 from __future__ import annotations
 
@@ -17,8 +18,10 @@ seldom finds it (a palm on a 6-10 cm cap turns it from 5 cm off: at +-10 x +-15 
 unscrewed the bottle 27 and the canister 26 of 50 times, seeds 65000-65049)."""
 
 ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
-    ("close", "cabinet_left_hinge"): {"pos_m": (0.62, 0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                      "measured": "CloseCabinet 50/50"},
+    # (the three below moved where their library tasks' next versions keep the resting hand out of them at every
+    # randomization extreme: CloseCabinet-v2, CloseOvenCompact-v2, CloseDrawerChest2-v2)
+    ("close", "cabinet_left_hinge"): {"pos_m": (0.643, 0.31), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
+                                      "measured": "CloseCabinet 50/50 at (0.62, 0.3); CloseCabinet-v2 gate 10/10"},
     ("close", "microwave_compact"): {"pos_m": (0.58, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
                                      "measured": "CloseMicrowave 50/50"},
     ("close", "drawer_chest_1"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
@@ -31,17 +34,21 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
                                      "measured": "OpenBoxLid 50/50", "fixed": False, "composed_pos_m": (0.515, 0.0),
                                      "composed": False},
     ("turn", "faucet_lever_swivel"): {"pos_m": (0.42, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                      "measured": "TurnFaucet 50/50"},
+                                      "measured": "TurnFaucet 50/50",
+                                      "part_way_failed": "to 45 degrees, 0/3 in the gates of batches 742057 and "
+                                                         "1017353 (the lever slipped from the hand each time)"},
     # a bottom-hinged door lying open on its stop, lifted shut by bent fingers under its free edge
-    ("close", "oven_compact"): {"pos_m": (0.352, 0.26), "yaw_deg": 0.0, "start": 1.57, "grasp": False,
-                                "measured": "CloseOvenCompact 50/50", "composed": False},
+    ("close", "oven_compact"): {"pos_m": (0.425, 0.313), "yaw_deg": 0.0, "start": 1.57, "grasp": False,
+                                "measured": "CloseOvenCompact 50/50 at (0.352, 0.26); CloseOvenCompact-v2 gate 10/10",
+                                "composed": False},
     # the layout of a sibling model, measured by the solvability gate of a guided generation (seeds 911-9113)
     ("close", "cabinet_right_hinge"): {"pos_m": (0.62, -0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
                                        "measured": "gate 10/10 (guided generation)"},
     ("close", "microwave_standard"): {"pos_m": (0.6, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
                                       "measured": "gate 10/10 (guided generation)"},
-    ("close", "drawer_chest_2"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
-                                  "measured": "gate 9/10 (guided generation)"},
+    ("close", "drawer_chest_2"): {"pos_m": (0.637, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
+                                  "measured": "gate 9/10 (guided generation) at (0.6, 0); CloseDrawerChest2-v2 10/10",
+                                  "randomize": {"xy_m": [0.03, 0.05], "yaw_deg": 8.0}},
     ("close", "drawer_chest_3"): {"pos_m": (0.6, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
                                   "measured": "gate 10/10 (guided generation)"},
     ("open", "trash_can_tall"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,

@@ -101,7 +101,8 @@ TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_
               "press", "hand_over", "twist", "insert", "wipe", "hang", "pour", "flip",
               "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
-or drawer held part way open (``open_part``), a lever turned part way (``turn_part``), or two tasks in turn
+or drawer held part way open (``open_part``), a lever turned part way (``turn_part``: none while no lever's layout
+is measured turning part way, see :mod:`generator.backends.layouts`), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
 TWO_IN_M = 0.2
 """A container the autonomous grammar puts two objects in is at least this wide (the large bowl, the pot)."""
@@ -207,7 +208,8 @@ class OfflineBackend:
         # part way: a door or drawer held half open by its handle; a lever turned to PART_TURN of its range
         out += [("open_part", self._open_task(a, 0.5)) for a in o if _part(a) in ("door", "drawer")]
         out += [("turn_part", self._articulated_task("turn", by_id[i], PART_TURN)) for (s, i), lay
-                in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]]
+                in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]
+                and not lay.get("part_way_failed")]
         out += [("place_at", t) for t in placed_tasks.placed_options(g, c + p, self._words)]
         out += [("take_out", placed_tasks.take_out_task(a, b, (), self._words))
                 for a in g for b in c if fits_in(a, b) and sticks_out(a, b)]
