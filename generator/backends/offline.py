@@ -43,6 +43,7 @@ from generator.backends.dexterous import flip_task, hang_task, insert_task, pour
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
+    CARRY_FALLS_SHORT,
     EMPTIED_DRAWERS,
     STICK_OUT_M,
     _acts,
@@ -50,6 +51,7 @@ from generator.backends.roles import (
     _kind,
     _min_xy,
     _part,
+    carried,
     container,
     drawer_joint,
     drawer_words,
@@ -180,13 +182,14 @@ class OfflineBackend:
     def _task_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
         """Every task this grammar can write from ``assets``, each with its task skill."""
         g = [a for a in assets if graspable(a)]
+        m = [a for a in g if carried(a)]  # carried to a place; g are lifted
         c = [a for a in assets if container(a)]
         p = [a for a in assets if is_surface(a)]
         o = [a for a in assets if openable(a)]
         out = [("lift", self._lift_task(a)) for a in g]
-        out += [("put_in", self._put_task(a, b)) for a in g for b in c if fits_in(a, b)]
-        out += [("put_in", self._put_task(a, b)) for a in g for b in assets if drawer_joint(b) and fits_in(a, b)]
-        out += [("place_on", self._plate_task(a, b)) for a in g for b in p]
+        out += [("put_in", self._put_task(a, b)) for a in m for b in c if fits_in(a, b)]
+        out += [("put_in", self._put_task(a, b)) for a in m for b in assets if drawer_joint(b) and fits_in(a, b)]
+        out += [("place_on", self._plate_task(a, b)) for a in m for b in p]
         out += [("open_" + _part(a), self._open_task(a)) for a in o]
         usable = {a["id"]: a for a in g}
         out += [("stack", self._stack_task(usable[t], usable[b])) for t, b in STACK_PAIRS
@@ -194,7 +197,7 @@ class OfflineBackend:
         out += [("push", self._push_task(a)) for a in g if a["id"] in PUSHED]
         by_id = {a["id"]: a for a in assets}
         zone = next((a for a in assets if handover_zone(a)), None)
-        out += [("hand_over", self._handover_task(a, zone)) for a in assets if zone is not None and handed(a)]
+        out += [("hand_over", self._handover_task(a, zone)) for a in assets if zone is not None and carried(a)]
         out += [("insert", insert_task(a, b, self._words)) for a in assets if insertable(a) for b in assets
                 if socket(b) and fits_hole(a, b)]
         out += [("wipe", wipe_task(a, b, self._words)) for a in assets if wiper(a) for b in assets if wipe_area(b)]
@@ -210,14 +213,14 @@ class OfflineBackend:
         out += [("turn_part", self._articulated_task("turn", by_id[i], PART_TURN)) for (s, i), lay
                 in ARTICULATED_LAYOUTS.items() if s == "turn" and i in by_id and lay["measured"]
                 and not lay.get("part_way_failed")]
-        out += [("place_at", t) for t in placed_tasks.placed_options(g, c + p, self._words)]
+        out += [("place_at", t) for t in placed_tasks.placed_options(m, c + p, self._words)]
         out += [("take_out", placed_tasks.take_out_task(a, b, (), self._words))
-                for a in g for b in c if fits_in(a, b) and sticks_out(a, b)]
+                for a in m for b in c if fits_in(a, b) and sticks_out(a, b)]
         # several objects: two put in one large container (each gets 80 % of it to itself: the second lands beside
         # the first); a tower of the three blocks, the smallest on top
         names = lambda i: object_words(by_id[i])  # noqa: E731
-        for k, a in enumerate(g):
-            b, box = g[(3 * k + 5) % len(g)], [x for x in c if _min_xy(x) >= TWO_IN_M]
+        for k, a in enumerate(m):
+            b, box = m[(3 * k + 5) % len(m)], [x for x in c if _min_xy(x) >= TWO_IN_M]
             if box and a["category"] != b["category"] and all(fits_in(x, box[k % len(box)]) for x in (a, b)):
                 parts = [self._put_task(a, box[k % len(box)]), self._put_task(b, box[k % len(box)])]
                 out.append(("several", sequence.join_steps(parts, _acts, set(), names)))
@@ -231,8 +234,8 @@ class OfflineBackend:
                   if i in by_id and not lay["grasp"] and lay["measured"]
                   and skill not in ("turn", "turn_off", "press", "twist")
                   and lay.get("composed", True)]
-        seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in g for b in c if fits_in(a, b)]
-                   + [("place_on", a, b) for a in g for b in p])
+        seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in m for b in c if fits_in(a, b)]
+                   + [("place_on", a, b) for a in m for b in p])
         for k, (skill, art) in enumerate(firsts):
             for second in seconds[k % COMPOSE_STRIDE::COMPOSE_STRIDE]:
                 composed = self._composed_task(skill, art, *second)
@@ -477,20 +480,22 @@ class OfflineBackend:
             if m["how"] in ("substitute", "kind"):
                 subs[m["phrase"]] = fallback[0]["id"]
                 return fallback[0]
+            why = f" (it is lifted, not carried: {CARRY_FALLS_SHORT[m['asset']]})" if m["asset"] in CARRY_FALLS_SHORT \
+                else ""
             raise InstructionError(
-                f"'{m['phrase']}' ({m['asset']}) cannot be the {what} of a '{skill}' task this author writes; it "
-                f"writes them with: {', '.join(a['id'] for a in fallback)}")
+                f"'{m['phrase']}' ({m['asset']}) cannot be the {what} of a '{skill}' task this author writes{why}; "
+                f"it writes them with: {', '.join(a['id'] for a in fallback)}")
 
         colors = tuple(m.get("color") for m in mentions)
         amount = reading.get("amount")
         if skill == "lift":
             proposal = self._lift_task(pick(0, handed, "object to lift"), colors)
         elif skill == "put_in":
-            g = pick(0, graspable, "object to put in")
+            g = pick(0, lambda x: graspable(x) and carried(x), "object to put in")
             proposal = self._put_task(g, pick(1, lambda x: (container(x) or receptacle(x)) and fits_in(g, x),
                                               "container it fits in"), colors)
         elif skill == "place_on":
-            proposal = self._plate_task(pick(0, handed, "object to set down"),
+            proposal = self._plate_task(pick(0, carried, "object to set down"),
                                         pick(1, is_surface, "plate, tray or board"), colors)
         elif skill == "stack":  # blocks named by colour alone: the smallest on top, the next size under it
             a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack", smallest=True)
@@ -499,10 +504,10 @@ class OfflineBackend:
         elif skill == "place_at":
             rel = reading.get("relation") or "in_region"
             refs = [pick(k, lambda x: not x.get("joints"), "object to set it by") for k in range(1, len(mentions))]
-            a = pick(0, handed, "object to set down")
+            a = pick(0, carried, "object to set down")
             proposal = placed_tasks.placed_task(a, rel, refs, reading.get("region"), colors, self._words)
         elif skill == "take_out":
-            g = pick(0, graspable, "object to take out")
+            g = pick(0, lambda x: graspable(x) and carried(x), "object to take out")
             box = pick(1, lambda x: (container(x) and fits_in(g, x)) or drawer_joint(x) is not None,
                        "container or drawer it fits in")
             if drawer_joint(box) and box["id"] not in EMPTIED_DRAWERS:
@@ -524,7 +529,7 @@ class OfflineBackend:
             if zone is None:
                 raise InstructionError("the offline author needs the hand-over mat (handover_mat) in the catalog to "
                                        "hand something over")
-            proposal = self._handover_task(pick(0, handed, "object to hand over"), zone, colors)
+            proposal = self._handover_task(pick(0, carried, "object to hand over"), zone, colors)
         elif skill == "insert":
             peg = pick(0, insertable, "peg to insert")
             fits = [x for x in sorted(assets.values(), key=lambda x: x["id"]) if socket(x) and fits_hole(peg, x)]

@@ -57,6 +57,19 @@ def handed(a: dict) -> bool:
     return graspable(a) or vessel
 
 
+CARRY_FALLS_SHORT = {"cracker_box": "carried and set down at 15 of 23 gate attempts: on a tray 8/10 (batch 418093, "
+                                     "two slips), into a drawer 1/4 (962143), on a plate 6/9 (1029581, a slip, the "
+                                     "carry's task failed, not let go on it); lifted 10/10 (LiftCrackerBox)"}
+"""Objects the solver holds and lifts but does not carry to a place reliably (why, measured): the offline author lifts
+them and sets nothing of theirs down anywhere."""
+
+
+def carried(a: dict) -> bool:
+    """Objects the offline author carries to a place (puts in, sets on, beside or down, takes out, hands over): the
+    ones it holds (:func:`handed`) but those of :data:`CARRY_FALLS_SHORT`."""
+    return handed(a) and a["id"] not in CARRY_FALLS_SHORT
+
+
 def insertable(a: dict) -> bool:
     """A peg: what the offline author inserts into a holder."""
     return "peg" in a["tags"] and not a.get("joints")
