@@ -243,13 +243,22 @@ def _run_checks(result: CheckResult, env_id: str, root: str | None, source_in_ru
             result.checks += [f"start (through {target}, checked in this run)",
                               f"check_env (through {target}, checked in this run)"]
         else:
-            step = "start/check_env"
             _checks_or_known(result, env_id, target)
         step = "steps"
         _steps(make)
         result.checks.append(step)
+    except _Failed as exc:  # start or check_env, named
+        result.status, result.message = "failed", f"{exc.check}: {_failure(exc.cause)}"
     except Exception as exc:  # a failed check is a result, not a crash
         result.status, result.message = "failed", f"{step}: {_failure(exc)}"
+
+
+class _Failed(Exception):
+    """A named check failed (its exception is ``cause``)."""
+
+    def __init__(self, check: str, cause: BaseException):
+        super().__init__(check)
+        self.check, self.cause = check, cause
 
 
 def _checks_or_known(result: CheckResult, env_id: str, target: str) -> None:
@@ -261,7 +270,7 @@ def _checks_or_known(result: CheckResult, env_id: str, target: str) -> None:
             check(target)
         except Exception as exc:  # any failure of the check is the result
             if target not in KNOWN_DEFECTS:
-                raise AssertionError(f"{name}: {_failure(exc)}") from exc
+                raise _Failed(name, exc) from exc
             result.status, result.message = "xfail", f"{name} on {target}: {KNOWN_DEFECTS[target]} ({_failure(exc)})"
             result.checks.append(f"{name}{through}")
             return

@@ -62,6 +62,14 @@ def test_a_hand_resting_inside_an_object_fails_the_start_check():
     assert v1.status == "passed" and v1.checks[2] == f"start ({START_SEEDS} seeds)", v1
 
 
+def test_a_registered_version_that_fails_start_unlisted_is_a_failure_named_by_its_check(monkeypatch):
+    """Taken off the known defects, HangMugOnRack-v0 fails, its message naming the start check (not check_env)."""
+    monkeypatch.delitem(KNOWN_DEFECTS, "GenDex/HangMugOnRack-v0")
+    r = check.check_version("GenDex/HangMugOnRack-v0")
+    assert r.status == "failed" and r.message.startswith("start: AssertionError: the robot at rest"), r
+    assert [c.split(" ")[0] for c in r.checks] == ["static", "time_limit"], r
+
+
 def test_known_defects_are_registered_versions_that_are_not_rewordings():
     versions = registered_tasks()
     assert set(KNOWN_DEFECTS) <= set(versions)
