@@ -4,8 +4,9 @@ A start state whose resting hand overlaps an object (a mug rack's peg swung into
 oven's body at the arm's elbow) is not a state the simulator can hold: the first physics step pushes the two apart,
 and how it does so depends on contact data PhysX keeps from the step before the reset. The same seed and actions
 then step differently after another episode, which Gymnasium's ``check_env`` reports as non-determinism and which a
-recorded dataset cannot rebuild from. The generator's critic measures the nominal layout and its randomized draws
-with :func:`robot_penetrations`; ``gendex check`` measures every version's first :data:`START_SEEDS` resets.
+recorded dataset cannot rebuild from. The generator's critic measures the nominal layout and the extremes of its
+randomization with :func:`robot_penetrations`; ``gendex check`` measures every version's first :data:`START_SEEDS`
+resets.
 """
 
 from __future__ import annotations

@@ -4,8 +4,10 @@ It builds the scene in SAPIEN (CPU, randomization off, the robot at the spec's i
 the spec says otherwise; both keyframes share the same arm pose), replaces the bounding-box penetration estimate of
 :func:`~generator.critic.physical.check_scene_static` with PhysX's own contacts at reset, then lets the scene
 settle and measures what fell or still moves (the ``penetration`` and ``floating`` checks described in
-:mod:`generator.critic.physical`). About 0.3 s per scene once SAPIEN is loaded (the first env of a process costs
-~3 s of imports).
+:mod:`generator.critic.physical`). The robot at rest is also measured against every randomized object at the
+extremes of its randomization (:func:`_draw_checks`), where a draw can turn a peg or a door into the hand. About
+0.4 s per scene once SAPIEN is loaded, 0.4 s more with the extremes (the first env of a process costs ~3 s of
+imports).
 """
 
 from __future__ import annotations
