@@ -92,7 +92,7 @@ DRAWER_FRONT_REGION_M = ((-0.14, -0.06), (-0.22, 0.22))
 """Where movable objects go when one is put into a chest's drawer: the drawer, slid out towards the robot, reaches
 x = 0.15 (its chest at 0.6), and a hand closing on an object within ~10 cm of its front or side walls meets them.
 Measured on PutBlockMediumInDrawerChest1 (batch seed 1004729, rejected by its gate at 1/4; seeds 7100-7109): the
-block at (0.083, 0.114) 3/10 (7 grasps found none that held), at (0.03, 0.22) 4/10 (4 slipped), at (-0.11, 0.12)
+block at (0.083, 0.114) 3/10 (7 attempts found no grasp that held), at (0.03, 0.22) 4/10 (4 slipped), at (-0.11, 0.12)
 and at (-0.06, 0) 9/10 each, and with the chest taken aside 3/3; the library's drawer put-ins (x about -0.13) 4-5/5."""
 
 
