@@ -10,8 +10,9 @@ group (*all*, *both*, *the two*) is every object of its kind on the table: the s
 (:func:`group_kinds`, checked by the scene step); *two balls* is any two.
 
 The objects drawn are ones the solver holds (``generator.backends.roles.graspable``: >= 90 % of recorded grasps)
-and, for a put-in, that fit in the container; of different categories when the group is a kind (*the fruit*: a
-lemon, a plum and a peach, not two apples). The draw is seeded by the request's words, so a request always reads
+and carries to a place (``roles.carried``: not the cracker box) and, for a put-in, that fit in the container; of
+different categories when the group is a kind (*the fruit*: a lemon, a plum and a peach, not two apples). The draw
+is seeded by the request's words, so a request always reads
 the same and two requests differ."""
 
 from __future__ import annotations
@@ -136,7 +137,7 @@ def read_group(text: str, verb: list[str], objects: str, place: list[str], read_
                assets: Mapping[str, dict]) -> list[Reading] | None:
     """One reading per object of the group ``objects`` names (the words between the ``verb`` and the ``place``),
     or None when they name no group."""
-    from generator.backends.roles import fits_in, graspable
+    from generator.backends.roles import carried, fits_in, graspable
     from generator.instruction import Mention
 
     group = find_group(objects)
@@ -148,7 +149,7 @@ def read_group(text: str, verb: list[str], objects: str, place: list[str], read_
         raise InstructionError(f"'{group.phrase}': the catalog has no {group.noun}; a group is said by a kind "
                                f"({', '.join(sorted(KINDS))}) or by the plural of a catalog object")
     into = assets[where.asset]
-    able = [assets[i] for i in m.options if graspable(assets[i])
+    able = [assets[i] for i in m.options if graspable(assets[i]) and carried(assets[i])
             and (probe.skill != "put_in" or fits_in(assets[i], into))]
     put = probe.skill == "put_in"
     picked = choose(text, group, able, m.how == "kind", into if put else None, ALL_COUNT if put else ALL_ON_SURFACE)

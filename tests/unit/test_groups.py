@@ -80,6 +80,16 @@ def test_the_offline_author_builds_every_member_and_says_the_group():
     assert len(blocks) == 2 and len({o.name for o in blocks}) == 2  # two blocks, named apart
 
 
+def test_a_group_draws_only_objects_the_author_carries():
+    """*the two boxes* once drew the cracker box, which the author lifts but does not carry; the author then built the
+    first box as an apple (its alphabetical stand-in). The group draws boxes it sets down, and builds them."""
+    members, _ = _members("set the two boxes on the tray")
+    assert len(members) == 2 and "cracker_box" not in {m.asset for m in members}
+    p, _ = propose(OfflineBackend(seed=0), instruction="set the two boxes on the tray")
+    assert sorted(o.asset for o in p.objects if o.role == "graspable") == sorted(m.asset for m in members)
+    assert all(A[o.asset]["category"].endswith("box") for o in p.objects if o.role == "graspable")
+
+
 def test_no_clutter_of_the_group_and_a_scene_with_some_is_refused():
     p, _ = propose(OfflineBackend(seed=3), instruction="put all the fruit in the large bowl")
     kinds = group_kinds(p.reading)
