@@ -12,8 +12,7 @@ group (*all*, *both*, *the two*) is every object of its kind on the table: the s
 The objects drawn are ones the solver holds (``generator.backends.roles.graspable``: >= 90 % of recorded grasps)
 and carries to a place (``roles.carried``: not the cracker box) and, for a put-in, that fit in the container; of
 different categories when the group is a kind (*the fruit*: a lemon, a plum and a peach, not two apples). The draw
-is seeded by the request's words, so a request always reads
-the same and two requests differ."""
+is seeded by the request's words, so a request always reads the same and two requests differ."""
 
 from __future__ import annotations
 

@@ -5,9 +5,9 @@ the spec says otherwise; both keyframes share the same arm pose), replaces the b
 :func:`~generator.critic.physical.check_scene_static` with PhysX's own contacts at reset, then lets the scene
 settle and measures what fell or still moves (the ``penetration`` and ``floating`` checks described in
 :mod:`generator.critic.physical`). The robot at rest is also measured against every randomized object at the
-extremes of its randomization (:func:`_draw_checks`), where a draw can turn a peg or a door into the hand. About
-0.4 s per scene once SAPIEN is loaded, 0.4 s more with the extremes (the first env of a process costs ~3 s of
-imports).
+extremes of its randomization (:func:`_draw_checks`, in the same env), where a draw can turn a peg or a door into
+the hand. About 0.3 s per scene once SAPIEN is loaded, the extremes 0.08 s of it (the first env of a process costs
+~3 s of imports).
 """
 
 from __future__ import annotations
@@ -127,43 +127,39 @@ def _robot_violation(env, name: str, links: dict[str, float], box: tuple, start_
         "at its initial keyframe", measured=deep[worst], limit=PENETRATION_TOL_M, fix=fix, other=f"robot:{worst}")
 
 
-def _draw_checks(spec: TaskSpec, seed: int, placed: dict[str, Placed], meas: dict) -> list[Violation]:
+def _draw_checks(env, spec: TaskSpec, seed: int, placed: dict[str, Placed], meas: dict) -> list[Violation]:
     """The robot at rest against the objects at the extremes of their randomization (the nominal layout can be
     clear while a shift or yaw draw swings a peg or a door into the hand): every randomized object shifted to each
     corner of its xy range, turned to either end of its yaw range and not turned (:data:`EXTREMES`), the others
     nominal. One violation per object, from its deepest extreme; its fix moves the object away from the palm
     (horizontally, from the palm to the object's origin there) by the depth plus the fix margin, at most
-    :data:`MAX_DRAW_FIX_M` (the next round measures again)."""
+    :data:`MAX_DRAW_FIX_M` (the next round measures again). ``env``: the critic's env of the nominal layout, reset
+    for each extreme."""
     import torch
     from mani_skill.utils.structs.pose import Pose
 
     from gendex_envs.geometry import quat_mul, yaw_quat
     from gendex_envs.reset_contacts import robot_penetrations
-    from gendex_envs.task_env import TaskEnv
 
     moving = [o for o in spec.objects if o.name in placed and (any(o.randomize.xy_m) or o.randomize.yaw_deg)]
     worst: dict[str, tuple[str, object, np.ndarray]] = {}  # object -> (extreme, deepest Penetration, away from palm)
-    env = TaskEnv(task_spec=_without_randomization(spec), render_backend="none", control_mode="pd_joint_delta_pos")
-    try:
-        for sx, sy, turn in EXTREMES:
-            env.reset(seed=seed)
-            for o in moving:
-                entity = env.objects[o.name]
-                p, q = entity.pose.p.clone(), entity.pose.q.clone()
-                p[:, 0] += sx * o.randomize.xy_m[0]
-                p[:, 1] += sy * o.randomize.xy_m[1]
-                q = quat_mul(yaw_quat(torch.full((1,), turn * math.radians(o.randomize.yaw_deg))), q)
-                entity.set_pose(Pose.create_from_pq(p, q))
-            env.scene.step()
-            palm = env.agent.palm_link.pose.p[0, :2].numpy()
-            for name, links in robot_penetrations(env).items():
-                deepest = max(links.values(), key=lambda p: p.depth)
-                if name in placed and deepest.depth > PENETRATION_TOL_M and \
-                        deepest.depth > getattr(worst.get(name, ("", None))[1], "depth", 0.0):
-                    where = f"shifted ({sx:+d}, {sy:+d}) x its xy range, turned {turn:+d} x its yaw range"
-                    worst[name] = (where, deepest, env.objects[name].pose.p[0, :2].numpy() - palm)
-    finally:
-        env.close()
+    for sx, sy, turn in EXTREMES if moving else ():
+        env.reset(seed=seed)
+        for o in moving:
+            entity = env.objects[o.name]
+            p, q = entity.pose.p.clone(), entity.pose.q.clone()
+            p[:, 0] += sx * o.randomize.xy_m[0]
+            p[:, 1] += sy * o.randomize.xy_m[1]
+            q = quat_mul(yaw_quat(torch.full((1,), turn * math.radians(o.randomize.yaw_deg))), q)
+            entity.set_pose(Pose.create_from_pq(p, q))
+        env.scene.step()
+        palm = env.agent.palm_link.pose.p[0, :2].numpy()
+        for name, links in robot_penetrations(env).items():
+            deepest = max(links.values(), key=lambda p: p.depth)
+            if name in placed and deepest.depth > PENETRATION_TOL_M and \
+                    deepest.depth > getattr(worst.get(name, ("", None))[1], "depth", 0.0):
+                where = f"shifted ({sx:+d}, {sy:+d}) x its xy range, turned {turn:+d} x its yaw range"
+                worst[name] = (where, deepest, env.objects[name].pose.p[0, :2].numpy() - palm)
     violations = []
     for name, (where, pen, away) in sorted(worst.items()):
         meas.setdefault(name, {})["robot@extreme"] = rounded(pen.depth)
@@ -218,6 +214,8 @@ def _sim_checks(spec: TaskSpec, seed: int, settle_steps: int, placed: dict[str, 
                 violations.append(Violation(
                     "floating", name, f"{name!r} still moves at {speed:.3f} m/s after the scene settled for "
                     f"{settle_steps * dt:.2f} s: it does not rest stably", measured=speed, limit=MOVING_TOL_MPS))
+        if not any(v.check == "penetration" and str(v.other).startswith("robot:") for v in violations):
+            violations += _draw_checks(env, spec, seed, placed, meas["penetration"])
         return violations
     finally:
         env.close()
@@ -231,9 +229,6 @@ def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STE
     violations, meas, placed, unsupported_fix = static_findings(spec, overlap=False)
     off = {v.object for v in violations if v.check == "off_table"}
     violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
-    if not any(v.check == "penetration" and str(v.other).startswith("robot:") for v in violations) and \
-            any(o.randomize.xy_m[0] or o.randomize.xy_m[1] or o.randomize.yaw_deg for o in spec.objects):
-        violations += _draw_checks(spec, seed, placed, meas["penetration"])
     report = PhysicalReport(spec.name, "sim", ordered(violations), meas, time.perf_counter() - t0)
     log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
     return report
