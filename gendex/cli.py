@@ -103,7 +103,10 @@ def stats(as_json: bool = typer.Option(False, "--json", help="Print the numbers 
 
 @app.command()
 def reword(keep: list[str] = typer.Option([], "--keep", help="Task names whose instruction stays (repeatable)."),
-           dry_run: bool = typer.Option(False, "--dry-run", help="Print the new wordings; publish nothing.")) -> None:
+           dry_run: bool = typer.Option(False, "--dry-run", help="Print the new wordings; publish nothing."),
+           commands: bool = typer.Option(False, "--commands",
+                                         help="Also reword the commands: each one the wording least like the other "
+                                              "tasks' commands of those the reader reads as the same task.")) -> None:
     """Reword the library: each task's command framed by the situation and purpose least like the other tasks'
     instructions (all-MiniLM-L6-v2, the 'stats' extra), each change published as the task's next version."""
     from gendex_envs.registry import registered_tasks
@@ -113,16 +116,19 @@ def reword(keep: list[str] = typer.Option([], "--keep", help="Task names whose i
     unknown = sorted(set(keep) - {v.name for v in versions.values()})
     if unknown:
         raise typer.BadParameter(f"no registered task named {', '.join(unknown)}", param_hint="--keep")
-    changes, numbers = plan_rewording(versions, keep=keep)
+    changes, numbers = plan_rewording(versions, keep=keep, commands=commands)
     for c in changes:
         typer.echo(f"{c.env_id}\n    was: {c.old}\n    now: {c.new}")
         if not dry_run:
-            record = {"reason": "gendex reword: the library's wording", "library": numbers}
+            record = {"reason": "gendex reword" + (" --commands" if commands else "") + ": the library's wording",
+                      "library": numbers}
             published = publish_reworded(versions[c.env_id], c.new, record)
             typer.echo(f"    published {published.env_id}")
     typer.echo(f"{numbers['reworded']} of {numbers['tasks']} tasks reworded{' (dry run)' if dry_run else ''}; "
                f"mean pairwise MiniLM cosine {numbers['mean_pairwise_cosine_before']:.3f} -> "
-               f"{numbers['mean_pairwise_cosine_after']:.3f}")
+               f"{numbers['mean_pairwise_cosine_after']:.3f}; commands alone "
+               f"{numbers['commands_mean_pairwise_cosine_before']:.3f} -> "
+               f"{numbers['commands_mean_pairwise_cosine_after']:.3f} ({numbers['commands_reworded']} reworded)")
 
 
 @app.command()

@@ -82,6 +82,15 @@ def _with_previous(step: str, previous: Reading, read_one: Callable[[str], Readi
     pronoun, part = _PRONOUN.search(step), _BARE_PART.search(step)
     if pronoun is None and part is None:
         return read_one(step)
+    if pronoun is not None:  # 'raise the pear clear of the table and keep hold of it': the step's own object
+        try:
+            own = read_one(step)
+        except InstructionError:
+            own = None
+        before = step[:pronoun.start()].lower()
+        if (own is not None and any(m.phrase in before for m in own.objects)
+                and all(m.phrase in step.lower() for m in own.objects)):  # not 'put the apple in it' (a choice)
+            return own
     first_error: InstructionError | None = None
     for m in previous.objects:
         name = f"the {m.color + ' ' if m.color else ''}{m.phrase}"

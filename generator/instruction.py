@@ -32,6 +32,7 @@ from generator.constructs import (
 )
 from generator.errors import InstructionError
 from generator.nearest import stand_in
+from generator.phrasing import MODEL_WORDS
 from generator.vocabulary import COURTESY_WORDS, KINDS, ORDINALS, PARTS, SYNONYMS, TASK_SKILLS, TaskSkill
 from generator.vocabulary import FILLER_WORDS as _FILLER
 from generator.vocabulary import STOP_WORDS as _STOP
@@ -238,6 +239,9 @@ def _names(assets: Iterable[dict]) -> dict[str, tuple[str, list[dict]]]:
             for phrase, target in SYNONYMS.items():  # ... 'tall bin', 'compact microwave oven'
                 if target == cat:
                     add(f"{suffix} {phrase}", "id", [a])
+        model = MODEL_WORDS.get(aid, "").replace("-", " ")  # the author's: 'right hinged cabinet', '13 inch laptop'
+        for phrase in [cat.replace("_", " "), *(p for p, t in SYNONYMS.items() if t == cat)] if model else ():
+            add(f"{model} {phrase}", "id", [a])
     for a in assets:
         cat = a["category"]
         same = [b for b in assets if b["category"] == cat]
@@ -357,8 +361,8 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     for i, j, phrase in spans:
         used[i:j] = [True] * (j - i)
         how, match = names[phrase]
-        part = next((w for w in words[j:j + 2] if w in PARTS), None) or next(
-            (w for w in words[max(0, i - 1):i] if w in PARTS), None)
+        part = next((w for w in [*words[j:j + 2], *words[max(0, i - 1):i]] if w in PARTS), None) or next(
+            (w for w in words[max(0, i - 3):i - 2] if w in PARTS and words[i - 2:i] == ["of", "the"]), None)
         if phrase in ("drawer", "drawers"):
             part = "drawer"
         ordinal = next((ORDINALS[w] for w in words[max(0, i - 2):i] if w in ORDINALS), None)

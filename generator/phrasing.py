@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from generator.command_templates import COMMANDS, PLACE_AT
+
 NAMES: dict[str, tuple[str, ...]] = {
     "peg_holder": ("peg holder", "holder", "pegboard"),
     "spill": ("spill", "stain", "mess"),
@@ -61,6 +63,16 @@ NAMES: dict[str, tuple[str, ...]] = {
     "tumbler": ("tumbler", "drinking glass", "water glass"),
     "beaker": ("beaker", "lab beaker", "measuring beaker"),
     "paper_cup": ("paper cup", "disposable cup", "takeaway cup"),
+    "sugar_box": ("sugar box", "box of sugar"),
+    "pudding_box": ("pudding box", "box of pudding"),
+    "cracker_box": ("cracker box", "box of crackers"),
+    "gelatin_box": ("gelatin box", "box of gelatin", "jelly box"),
+    "sponge": ("sponge", "kitchen sponge", "dish sponge"),
+    "pitcher": ("pitcher", "jug"),
+    "oven": ("oven", "stove oven"),
+    "dishwasher": ("dishwasher", "dish washer"),
+    "dice": ("dice", "die"),
+    "wine_glass": ("wine glass", "wineglass"),
 }
 """Words for a catalog category (default: the category with spaces); every one is read back to that category by
 :mod:`generator.instruction`."""
@@ -86,187 +98,6 @@ SURFACES = ("table", "tabletop", "counter", "worktop")
 
 Chooser = Callable[[list[str]], str]
 """Picks one sentence of those the author could write for a task."""
-
-COMMANDS: dict[str, tuple[str, ...]] = {
-    "lift": (
-        "pick up the {o} and hold it a hand's width above the {s}",
-        "lift the {o} at least ten centimetres off the {s}",
-        "raise the {o} clear of the {s} and keep hold of it",
-        "grab the {o} and hoist it well up off the {s}",
-        "take hold of the {o} and bring it up above the {s}",
-        "get the {o} up off the {s} and keep it in the air",
-    ),
-    "put_in": (
-        "put the {o} into the {d}",
-        "drop the {o} in the {d}",
-        "place the {o} inside the {d}",
-        "transfer the {o} into the {d}",
-        "move the {o} over to the {d} and let it go inside",
-        "deposit the {o} in the {d}",
-        "pop the {o} into the {d}",
-    ),
-    "put_in_drawer": (
-        "put the {o} in the {a}drawer of the {d}",
-        "drop the {o} into the {d}'s open {a}drawer",
-        "place the {o} inside the open {a}drawer of the {d}",
-        "tuck the {o} away in the {d}'s {a}drawer",
-        "store the {o} in the {a}drawer of the {d}",
-    ),
-    "take_out_drawer": (
-        "take the {o} out of the {a}drawer of the {d}",
-        "get the {o} out of the {d}'s open {a}drawer",
-        "remove the {o} from the {a}drawer of the {d}",
-        "lift the {o} out of the {d}'s {a}drawer and leave it on the {s}",
-    ),
-    "take_out": (
-        "take the {o} out of the {d}",
-        "get the {o} out of the {d}",
-        "lift the {o} out of the {d} and leave it on the {s}",
-        "remove the {o} from the {d}",
-        "pull the {o} out of the {d}",
-    ),
-    "place_on": (
-        "set the {o} down on the {d}",
-        "lay the {o} on the {d}",
-        "rest the {o} on top of the {d}",
-        "move the {o} onto the {d}",
-        "put the {o} onto the {d} and leave it there",
-    ),
-    "stack": (
-        "stack the {o} on top of the {d}",
-        "balance the {o} on the {d}",
-        "stack the {o} on the {d} to make a tower",
-        "pile the {o} onto the {d}",
-    ),
-    "push": (
-        "push the {o} across the {s} onto the goal mark without picking it up",
-        "slide the {o} over to the marked spot, keeping it on the {s}",
-        "nudge the {o} along the {s} until it sits on the target, never lifting it",
-        "shove the {o} onto the goal without lifting it off the {s}",
-    ),
-    "open_door": (
-        "pull the {d}'s door open by its handle",
-        "swing the {d} door open by the handle",
-        "open the {d} by pulling on its handle",
-        "grip the handle and pull the {d}'s door open",
-    ),
-    "open_drawer": (
-        "pull the drawer of the {d} out by its handle",
-        "slide the {d}'s drawer open",
-        "pull the drawer out of the {d}",
-    ),
-    "close_door": (
-        "push the {d}'s door shut",
-        "swing the open {d} door closed",
-        "close the {d} door that was left open",
-        "push the {d}'s door back until it shuts",
-    ),
-    "close_drawer": (
-        "push the {d}'s open drawer back in",
-        "slide the open drawer of the {d} shut",
-        "close the drawer sticking out of the {d}",
-    ),
-    "open_lid": (
-        "lift the {d}'s lid open",
-        "flip up the lid of the {d}",
-        "raise the {d} lid by its tab until it stands open",
-        "tip the {d}'s lid back to open it",
-    ),
-    "close_lid": (
-        "close the lid of the {d}",
-        "push the {d}'s lid down until it shuts",
-        "shut the {d}'s lid by flipping it back down",
-        "push the open lid of the {d} closed",
-    ),
-    "turn": (
-        "turn the {d} on by swinging its lever to the side",
-        "swing the {d}'s lever round to turn it on",
-        "turn the {d} on by pushing its handle all the way to one side",
-    ),
-    "twist": (
-        "unscrew the {d}'s cap",
-        "twist the cap off the {d}",
-        "unscrew the lid of the {d}, a turn at a time",
-        "open the {d} by unscrewing its cap",
-        "loosen the {d}'s cap until it comes free",
-    ),
-    "insert": (
-        "insert the {o} into the {d}",
-        "fit the {o} into the hole of the {d}",
-        "slot the {o} down into the {d} and let go of it",
-        "put the {o} into the {d}'s hole, standing straight",
-        "push the {o} into the {d} until it sits on the bottom of the hole",
-    ),
-    "wipe": (
-        "wipe the {d} with the {o}",
-        "wipe up the {d} on the {s} with the {o}",
-        "scrub the {d} with the {o} until it is clean",
-        "mop up the {d} with the {o}",
-        "wipe the {d} clean with the {o}",
-    ),
-    "hang": (
-        "hang the {o} on the {d}",
-        "hang the {o} up on the {d} by its handle",
-        "hang the {o} up on the {d} by the handle",
-        "hang the {o} by its handle from the {d}",
-        "hang up the {o} on the {d}",
-    ),
-    "pour": (
-        "pour the {p} from the {o} into the {d}",
-        "tip the {p} out of the {o} into the {d} and stand the {o} up again",
-        "empty the {o} of {p} into the {d}",
-        "pour the {p} in the {o} out into the {d} and stand the {o} upright again",
-        "tip the {o} over the {d} until the {p} fall in",
-    ),
-    "flip": (
-        "turn the {o} upside down",
-        "turn the {o} over and leave it upside down on the {s}",
-        "flip the {o} over so that it stands upside down",
-        "turn the {o} upside down and let go of it",
-        "upend the {o} on the {s}",
-    ),
-    "hand_over": (
-        "hand the {o} over to the person across the {s}",
-        "pass the {o} over and leave it on the hand-over mat",
-        "give me the {o} and let go of it on the hand-over mat",
-        "hand over the {o}, leaving it still on the yellow mat",
-        "bring me the {o} and set it down on the hand-over mat",
-    ),
-    "press_button": (
-        "press the {d} all the way down",
-        "push the {d} in until it clicks",
-        "press down on the {d} with the open hand",
-        "give the {d} a firm press",
-    ),
-    "press_switch": (
-        "flip the {d} on",
-        "push the {d}'s lever down to switch it on",
-        "switch the {d} on by pressing its lever down",
-        "press the {d}'s lever down until it clicks on",
-    ),
-    "open_door_part": (
-        "open the {d}'s door {a} and hold it there",
-        "pull the {d} door open {a}, no further",
-        "swing the door of the {d} open {a} and keep it there",
-    ),
-    "open_drawer_part": (
-        "pull the {d}'s drawer out {a}",
-        "open the drawer of the {d} {a} and leave it there",
-        "slide the {d}'s drawer open {a}, no further",
-    ),
-    "turn_part": (
-        "turn the {d}'s lever {a} and stop there",
-        "swing the {d}'s lever round {a}, no further",
-        "turn the {d} {a} and hold it there",
-    ),
-    "turn_off": (
-        "turn the {d} off by pushing its lever back",
-        "swing the {d}'s lever back to turn it off",
-        "shut the {d} off by pushing its handle back to the middle",
-    ),
-}
-"""Command templates per task skill: ``{o}`` the object acted on, ``{d}`` the destination or articulated object,
-``{s}`` a word for the table, ``{a}`` how far a part-way open or turn goes (*halfway*, *45 degrees*)."""
 
 SITUATIONS: dict[str, tuple[str, ...]] = {
     "fruit": ("Breakfast is being laid out for a family of four", "The grocery bag was tipped out onto the {s}",
@@ -594,6 +425,6 @@ def split(instruction: str) -> tuple[str | None, str, str | None]:
     return situation, text[:1].lower() + text[1:] if situation is None else text, purpose
 
 
-__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PIECE_NAMES", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS",
+__all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PIECE_NAMES", "PLACE_AT", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS",
            "SITUATIONS_DIRECTED", "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for",
            "object_words", "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]

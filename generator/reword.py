@@ -4,7 +4,10 @@ The offline author frames each command with an optional situation before it and 
 (:func:`generator.phrasing.framings`). Drawn at random, the same few situations come back across a library and its
 instructions read alike (86 tasks measured a mean pairwise all-MiniLM-L6-v2 cosine of 0.299, against 0.191 for
 RoboGen). Here the framing is *chosen*: the one whose embedding is least like the library's other instructions
-(lowest mean cosine). The command, the only part that says what success needs, is never changed.
+(lowest mean cosine). The command, the only part that says what success needs, changes only to another wording the
+instruction reader reads as the very same task (:mod:`generator.command_wording`; :func:`plan_commands`, ``gendex
+reword --commands``, and every proposal of the offline author): the library's commands alone measured 0.333 with one
+template each.
 
 - :class:`LibraryWording` picks for one new task against a fixed library (the offline author's proposals);
 - :func:`plan_rewording` picks for every task of a library at once, each against all the others, a few passes
@@ -122,7 +125,7 @@ class ProposalWording:
     ``stats`` extra is not installed."""
 
     def __init__(self):
-        self._library: tuple[tuple[str, ...], LibraryWording | None] | None = None
+        self._library: tuple[tuple[str, ...], LibraryWording | None, LibraryWording | None] | None = None
 
     def __call__(self, proposal: dict, library: Iterable[str]) -> dict:
         """``proposal`` worded least like ``library`` (unchanged for an empty library)."""
@@ -131,19 +134,34 @@ class ProposalWording:
             return proposal
         if self._library is None or self._library[0] != key:
             try:
-                self._library = (key, LibraryWording(key))
+                self._library = (key, LibraryWording(key), LibraryWording(split(t)[1] for t in key))
             except ImportError as exc:
                 log.info("wording drawn at random: %s is not installed (the optional 'stats' extra)", exc.name)
-                self._library = (key, None)
-        choose = self._library[1]
+                self._library = (key, None, None)
+        _, choose, choose_command = self._library
         if choose is None:
             return proposal
         try:
-            options = candidates_for(proposal["name"], proposal["description"], proposal_frames(proposal))
+            frames = proposal_frames(proposal)
+            command = split(proposal["description"])[1]
+            worded = choose_command(_command_wordings(command))
+            options = candidates_for(proposal["name"], proposal["description"], frames, command=worded)
         except RewordError as exc:
             log.info("kept the drawn wording: %s", exc)
             return proposal
         return dict(proposal, description=choose(options))
+
+
+PROPOSAL_WORDINGS = 60
+"""Most wordings of a proposal's command read (:func:`generator.command_wording.wordings`); the library's rewording
+reads up to :data:`generator.command_wording.MAX_WORDINGS`."""
+
+
+def _command_wordings(command: str) -> list[str]:
+    from generator.catalog_view import asset_dicts
+    from generator.command_wording import wordings
+
+    return wordings(command, asset_dicts(), limit=PROPOSAL_WORDINGS)
 
 
 def _surface(command: str) -> str:
@@ -151,13 +169,16 @@ def _surface(command: str) -> str:
     return next((s for s in sorted(SURFACES, key=len, reverse=True) if s in words), SURFACES[0])
 
 
-def candidates_for(name: str, instruction: str, frames: tuple[Frame, Frame]) -> list[str]:
+def candidates_for(name: str, instruction: str, frames: tuple[Frame, Frame], command: str | None = None) -> list[str]:
     """Every framing (:func:`generator.phrasing.framings`) of the command of ``instruction`` (the instruction with
-    its situation and purpose taken off); ``instruction`` itself is always one of them."""
-    _, command, _ = split(instruction)
-    if not command.strip():
+    its situation and purpose taken off); ``instruction`` itself is always one of them. With ``command`` (another
+    wording of that command: :mod:`generator.command_wording`), the framings of ``command`` instead."""
+    own = split(instruction)[1]
+    if not own.strip():
         raise RewordError(f"{name}: its instruction {instruction!r} has no command")
-    out = framings(command, *frames, _surface(command))
+    if command is not None and command != own:
+        return framings(command, *frames, _surface(command))
+    out = framings(own, *frames, _surface(own))
     return out if instruction in out else [instruction, *out]
 
 
@@ -168,48 +189,96 @@ class Rewording:
     new: str
 
 
-def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = ()) -> tuple[list[Rewording], dict]:
-    """New instructions for the latest version of each task in ``versions`` (task names in ``keep`` keep
-    theirs), chosen to lower the library's mean pairwise cosine; and the numbers before and after.
-
-    Returns only the tasks whose wording changes."""
-    latest = sorted(latest_versions(versions).items())
-    keep = set(keep)
-    ids = [env_id for env_id, _ in latest]
-    current = [v.spec.instruction for _, v in latest]
-    options: list[list[str]] = []
-    for (_, v), text in zip(latest, current, strict=True):
-        options.append([text] if v.name in keep else candidates_for(v.name, text, spec_frames(v.spec)))
-    flat = [t for opts in options for t in opts]
-    emb = embed(flat)[0]
-    starts = np.cumsum([0] + [len(o) for o in options])
-    choice = [int(starts[i] + options[i].index(current[i])) for i in range(len(options))]
+def _descend(emb: np.ndarray, starts: np.ndarray, choice: list[int], allowed_for=None) -> int:
+    """Coordinate descent on the mean pairwise cosine of the chosen rows of ``emb`` (options of task ``i`` are rows
+    ``starts[i]:starts[i+1]``): each task in turn takes its least-alike option (:func:`_least_alike`) among those
+    ``allowed_for(i)`` permits, a few passes round until none changes. Returns the passes made."""
     n = len(choice)
-
-    def mean_cosine() -> float:
-        e = emb[choice]
-        s = e @ e.T
-        return float((s.sum() - np.trace(s)) / (n * (n - 1))) if n > 1 else 0.0
-
-    before = mean_cosine()
-    frames = [split(t)[0::2] for t in flat]  # (situation, purpose) of every option
-    for _ in range(PASSES):
+    for p in range(PASSES):
         changed = 0
         for i in range(n):
-            if len(options[i]) == 1:
+            if starts[i + 1] - starts[i] == 1:
                 continue
-            used = Counter(x for j in range(n) if j != i for x in frames[choice[j]] if x is not None)
-            allowed = np.array([k for k in range(starts[i], starts[i + 1])
-                                if all(x is None or used[x] < MAX_REUSE for x in frames[k])])
+            allowed = allowed_for(i) if allowed_for is not None else np.arange(starts[i], starts[i + 1])
             others = emb[[choice[j] for j in range(n) if j != i]]
             best = int(allowed[_least_alike(emb[allowed] @ others.T, np.arange(len(allowed)))])
             if best != choice[i]:
                 choice[i], changed = best, changed + 1
         if not changed:
-            break
+            return p + 1
+    return PASSES
+
+
+def _mean_cosine(e: np.ndarray) -> float:
+    n = len(e)
+    s = e @ e.T
+    return float((s.sum() - np.trace(s)) / (n * (n - 1))) if n > 1 else 0.0
+
+
+def plan_commands(commands: list[str], fixed: list[bool]) -> list[str]:
+    """The wording of each of ``commands`` (bare commands of a library, one per task) least like the others: of
+    the wordings the reader reads as that command (:func:`generator.command_wording.wordings`), chosen by
+    coordinate descent on the commands' mean pairwise cosine; a ``fixed`` command keeps its words."""
+    from tqdm import tqdm
+
+    from generator.catalog_view import asset_dicts
+    from generator.command_wording import wordings
+
+    assets = asset_dicts()
+    options = [[c] if f else wordings(c, assets)
+               for c, f in tqdm(list(zip(commands, fixed, strict=True)), desc="wordings read", unit="task",
+                                disable=len(commands) < 50)]
+    flat = [t for opts in options for t in opts]
+    emb = embed(flat)[0]
+    starts = np.cumsum([0] + [len(o) for o in options])
+    choice = [int(starts[i]) for i in range(len(options))]  # each command's own words come first
+    _descend(emb, starts, choice)
+    return [flat[k] for k in choice]
+
+
+def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = (),
+                   commands: bool = False) -> tuple[list[Rewording], dict]:
+    """New instructions for the latest version of each task in ``versions`` (task names in ``keep`` keep
+    theirs), chosen to lower the library's mean pairwise cosine; and the numbers before and after.
+
+    With ``commands`` the command itself is first worded least like the library's other commands
+    (:func:`plan_commands`: only wordings the reader reads as the same task); without, it is kept and only its
+    framing chosen. Returns only the tasks whose wording changes."""
+    latest = sorted(latest_versions(versions).items())
+    keep = set(keep)
+    ids = [env_id for env_id, _ in latest]
+    current = [v.spec.instruction for _, v in latest]
+    fixed = [v.name in keep for _, v in latest]
+    old_commands = [split(t)[1] for t in current]
+    new_commands = plan_commands(old_commands, fixed) if commands else old_commands
+    options: list[list[str]] = []
+    for (_, v), text, cmd, f in zip(latest, current, new_commands, fixed, strict=True):
+        options.append([text] if f else candidates_for(v.name, text, spec_frames(v.spec), command=cmd))
+    flat = [t for opts in options for t in opts]
+    emb = embed(flat)[0]
+    starts = np.cumsum([0] + [len(o) for o in options])
+    frames = [split(t)[0::2] for t in flat]  # (situation, purpose) of every option
+    # each task starts from its own instruction, or from the new command framed as before (else bare)
+    choice = [int(starts[i] + next((k for k, o in enumerate(options[i]) if o == current[i]),
+                                   next((k for k, o in enumerate(options[i])
+                                         if frames[starts[i] + k] == tuple(split(current[i])[0::2])), 0)))
+              for i in range(len(options))]
+    before = _mean_cosine(embed(current)[0])
+    commands_before = _mean_cosine(embed(old_commands)[0])
+    n = len(choice)
+
+    def allowed_for(i: int) -> np.ndarray:
+        used = Counter(x for j in range(n) if j != i for x in frames[choice[j]] if x is not None)
+        return np.array([k for k in range(starts[i], starts[i + 1])
+                         if all(x is None or used[x] < MAX_REUSE for x in frames[k])])
+
+    _descend(emb, starts, choice, allowed_for)
     out = [Rewording(ids[i], current[i], flat[choice[i]]) for i in range(n) if flat[choice[i]] != current[i]]
     return out, {"tasks": n, "kept": sorted(keep & {v.name for _, v in latest}), "reworded": len(out),
-                 "mean_pairwise_cosine_before": before, "mean_pairwise_cosine_after": mean_cosine()}
+                 "mean_pairwise_cosine_before": before, "mean_pairwise_cosine_after": _mean_cosine(emb[choice]),
+                 "commands_mean_pairwise_cosine_before": commands_before,
+                 "commands_mean_pairwise_cosine_after": _mean_cosine(embed([split(flat[k])[1] for k in choice])[0]),
+                 "commands_reworded": sum(a != b for a, b in zip(old_commands, new_commands, strict=True))}
 
 
 def replace_instruction(text: str, instruction: str) -> str:
@@ -240,5 +309,6 @@ def publish_reworded(source: TaskVersion, instruction: str, record: dict) -> Tas
     return publish_derived(source, "reword", reword)
 
 
-__all__ = ["LibraryWording", "ProposalWording", "RewordError", "Rewording", "candidates_for", "plan_rewording",
-           "proposal_frames", "publish_reworded", "replace_instruction", "spec_frames"]
+__all__ = ["PROPOSAL_WORDINGS", "LibraryWording", "ProposalWording", "RewordError", "Rewording", "candidates_for",
+           "plan_commands", "plan_rewording", "proposal_frames", "publish_reworded", "replace_instruction",
+           "spec_frames"]

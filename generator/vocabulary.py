@@ -78,6 +78,9 @@ TASK_SKILLS: dict[str, TaskSkill] = {s.name: s for s in (
 
 SYNONYMS: dict[str, str] = {
     # phrase -> catalog category (or id)
+    "box of sugar": "sugar_box", "box of pudding": "pudding_box", "box of crackers": "cracker_box",
+    "box of gelatin": "gelatin_box", "jelly box": "gelatin_box", "kitchen sponge": "sponge", "dish sponge": "sponge",
+    "stove oven": "oven", "dish washer": "dishwasher",
     "fridge": "refrigerator", "refrigerator": "refrigerator", "cupboard": "cabinet", "cabinet": "cabinet",
     "closet": "cabinet", "trash can": "trash_can", "trashcan": "trash_can", "trash bin": "trash_can",
     "bin": "trash_can", "garbage can": "trash_can", "dustbin": "trash_can", "waste bin": "trash_can",

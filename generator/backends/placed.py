@@ -16,7 +16,7 @@ from gendex_envs.spec import RobotSpec
 from gendex_envs.success import REGION_AHEAD_M, REGION_DEPTH_M, REGION_PARTS
 from generator.backends.roles import drawer_joint, drawer_spot, drawer_words
 from generator.backends.wording import camel, step, word
-from generator.phrasing import names_for, painted, phrase, qualifiers
+from generator.phrasing import PLACE_AT, names_for, painted, phrase, qualifiers
 
 HAND_ROOM_M = 0.06
 """Centre distance beyond touching that a side relation's band starts at: room for the fingers round the held object
@@ -123,7 +123,7 @@ def command(rng: np.random.Generator, a: dict, relation: str, b: dict | None, c:
         word = str(rng.choice(names_for(x, "")))
         return f"{colors[k]} {word}" if len(colors) > k and colors[k] else word
 
-    verb = str(rng.choice(("put", "set", "place", "move")))
+    template = str(rng.choice(PLACE_AT))
     o = name(a, 0)
     if relation == "in_region":
         where = f"on the {REGION_WORDS[region]} of the table"
@@ -131,7 +131,7 @@ def command(rng: np.random.Generator, a: dict, relation: str, b: dict | None, c:
         where = f"between the {name(b, 1)} and the {name(c, 2)}"
     else:
         where = f"{SIDE_WORDS[relation]} the {name(b, 1)}"
-    return f"{verb} the {o} {where}", where
+    return template.format(o=o, w=where), where
 
 
 def placed_task(a: dict, relation: str, refs: list[dict], region: str | None, colors: tuple[str | None, ...],

@@ -10,7 +10,7 @@ import pytest
 
 from generator.catalog_view import asset_dicts
 from generator.instruction import is_surface, read_instruction
-from generator.phrasing import COMMANDS, NAMES, PIECE_NAMES, PURPOSES, SITUATIONS, domain, names_for, phrase
+from generator.phrasing import COMMANDS, NAMES, PIECE_NAMES, PLACE_AT, PURPOSES, SITUATIONS, domain, names_for, phrase
 
 ASSETS = {a["id"]: a for a in asset_dicts()}
 READ_AS = {"open_door": "open", "open_drawer": "open", "open_lid": "open", "close_door": "close",
@@ -69,6 +69,17 @@ def test_every_command_reads_back_as_its_task(skill):
                 if piece:
                     assert [m.asset for m in r.objects] == [piece, main, other], text
                 assert not r.substitutions, (text, r.substitutions)
+
+
+@pytest.mark.parametrize("where, relation, region", [
+    ("to the left of the bowl", "left_of", None), ("between the tray and the plate", "between", None),
+    ("in front of the mug", "in_front_of", None), ("on the far left corner of the table", "in_region", "far_left"),
+    ("on the near side of the table", "in_region", "near")])
+def test_every_place_command_reads_back_as_its_place(where, relation, region):
+    for template in PLACE_AT:
+        r = read_instruction(template.format(o="tennis ball", w=where), list(ASSETS.values()))
+        assert (r.skill, r.relation, r.region) == ("place_at", relation, region), template
+        assert r.objects[0].asset == "tennis_ball" and not r.substitutions, template
 
 
 def test_every_name_the_author_uses_is_read_back_as_its_category():

@@ -12,6 +12,7 @@ import yaml
 from gendex_envs import task_store
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dicts
+from generator.command_wording import wordings
 from generator.embedding import embed, embed_each
 from generator.instruction import SYNONYMS
 from generator.novelty import NEAR_DUPLICATE_COSINE
@@ -32,6 +33,7 @@ from generator.phrasing import (
 from generator.reword import (
     MAX_PAIR_COSINE,
     MAX_REUSE,
+    PROPOSAL_WORDINGS,
     LibraryWording,
     ProposalWording,
     RewordError,
@@ -158,6 +160,30 @@ def test_planning_lowers_the_librarys_mean_cosine_keeps_commands_and_caps_reuse(
     assert pairs.max() < MAX_PAIR_COSINE  # no two tasks framed so that they read as one
 
 
+def test_reworded_commands_read_as_the_same_tasks_and_read_less_alike(committed_tasks):
+    """With commands, the command itself may change, but only to a wording the reader reads as the same task; the
+    commands of the planned library then read less alike."""
+    from generator.command_wording import reading_key
+    from generator.instruction import read_instruction
+
+    latest = latest_versions(committed_tasks)
+    ids = sorted(k for k, v in latest.items() if v.name.startswith(("Put", "Set", "Close", "Lift")))[:PLANNED]
+    versions = {k: latest[k] for k in ids}
+    changes, numbers = plan_rewording(versions, commands=True)
+    assert numbers["commands_reworded"] > 0
+    assert numbers["commands_mean_pairwise_cosine_after"] < numbers["commands_mean_pairwise_cosine_before"] - 0.02
+    assets = list(ASSETS.values())
+    moved = [c for c in changes if split(c.new)[1] != split(c.old)[1]]
+    assert len(moved) == numbers["commands_reworded"]
+    for c in moved:
+        assert c.new[0].isupper() and c.new.endswith("."), c.new  # a sentence, as every framing is
+        old, new = split(c.old)[1], split(c.new)[1]
+        assert reading_key(read_instruction(new, assets)) == reading_key(read_instruction(old, assets)), c
+    final = {k: v.spec.instruction for k, v in versions.items()} | {c.env_id: c.new for c in changes}
+    assert abs(_mean_cos([split(t)[1] for t in final.values()])
+               - numbers["commands_mean_pairwise_cosine_after"]) < 1e-4
+
+
 def test_the_offline_author_words_a_proposal_least_like_the_library(task_version, committed_tasks):
     # the library without the task itself (its own instruction is in no option's way then)
     library = [v.spec.instruction for v in latest_versions(committed_tasks).values() if v.name != "PutPlumInPot"]
@@ -166,7 +192,13 @@ def test_the_offline_author_words_a_proposal_least_like_the_library(task_version
                 "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
                 "steps": [], "success": {"type": "inside", "object": "plum", "target": "pot"}}
     worded = ProposalWording()(proposal, library)
-    options = candidates_for("PutPlumInPot", spec.instruction, spec_frames(spec))
+    # the command first: of its wordings the reader reads as the same task, the least like the library's commands
+    command = split(spec.instruction)[1]
+    commands = wordings(command, list(ASSETS.values()), limit=PROPOSAL_WORDINGS)
+    assert len(commands) > 1
+    chosen = LibraryWording(split(t)[1] for t in library)(commands)
+    assert split(worded["description"])[1] == chosen
+    options = candidates_for("PutPlumInPot", spec.instruction, spec_frames(spec), command=chosen)
     sims = embed(options)[0] @ embed_each(library)[0].T
     apart = [k for k in range(len(options)) if sims[k].max() < MAX_PAIR_COSINE]
     assert apart  # some framing reads like no task of the library

@@ -1,0 +1,216 @@
+"""Every wording of a command that asks for the same task: its templates swapped, its objects and the table called by
+their other names, each kept only where the instruction reader reads it exactly as it reads the command.
+
+A library worded from one template per sentence shape reads alike however its situations and purposes vary (206
+tasks measured a mean pairwise all-MiniLM-L6-v2 cosine of 0.333 on their commands alone). People ask for one thing in
+many ways; :func:`wordings` lists the ways the offline author knows for a written command:
+
+- each clause (the author joins steps with *, then*) is matched against the author's templates
+  (:data:`generator.phrasing.COMMANDS`); a clause that matches one is written with every template of that kind;
+- each object phrase in it is also said with the category's other words (:data:`generator.phrasing.NAMES`: *pot*,
+  *saucepan*, *cooking pot*), keeping its colour, size or model word (*red*, *small*, *left-hinged*);
+- the word for the table is any of :data:`generator.phrasing.SURFACES`;
+- a step no template matches (a group of objects) starts with another verb of putting in or on (:data:`VERBS`).
+
+**What keeps a wording faithful is the reader, not the templates**: a candidate survives only when
+:func:`generator.instruction.read_instruction` reads it as the same skill, the same objects (the same catalog
+choices, colours and parts), direction, relation, region, amount and steps as the command itself, with no word it
+does not understand that neither the command nor the author's templates have, and no object called two things in two
+steps. A command the reader cannot read keeps its words.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import re
+from collections.abc import Sequence
+
+import numpy as np
+
+from generator.errors import InstructionError
+from generator.instruction import Reading, read_instruction
+from generator.phrasing import COMMANDS, NAMES, PLACE_AT, SURFACES
+
+STEP_JOINER = ", then "
+"""How the offline author joins the steps of a composed command (:func:`generator.phrasing.phrase_parts`)."""
+MAX_WORDINGS = 240
+"""Most candidate wordings tried for one command (a three-step command has thousands): a seeded sample of them,
+the command itself always first."""
+SLOTS = "odsapw"
+"""Template slots: the object acted on, the destination or articulated object, the table, an amount, the pieces,
+where a placed object goes."""
+PATTERNS = {
+    "w": r"(?:to the left of|to the right of|in front of|behind|next to|between|on the) .+",
+    "a": r"(?:halfway|half|partly|partway|\d+ degrees|top |middle |bottom |)",
+    "s": "|".join(SURFACES),
+}
+"""What a slot matches where not any words: where a placed object goes (a relation and what follows, so *the tennis
+ball on the far side* never splits inside the object's name), how far (or which drawer), the table."""
+PLACE_WORDS = re.compile(r"\b((side|corner|middle|left|right|front) of|behind|between|next to)\b")
+"""Words no object phrase of a template other than a place's has: a place read as an object (*lay the brick on
+the near right corner of the table*) is not a plate."""
+
+
+@functools.cache
+def _templates() -> tuple[tuple[str, str, re.Pattern], ...]:
+    """(kind, template, pattern) for every command template: a slot matches the words it stood for, and a slot
+    that appears twice must match the same words both times."""
+    out = []
+    for kind, templates in {**COMMANDS, "place_at": PLACE_AT}.items():
+        for t in templates:
+            seen: set[str] = set()
+            pattern = ""
+            for piece in re.split(r"(\{[a-z]\})", t):
+                if re.fullmatch(r"\{[a-z]\}", piece):
+                    k = piece[1]
+                    pattern += f"(?P={k})" if k in seen else f"(?P<{k}>{PATTERNS.get(k, '.+?')})"
+                    seen.add(k)
+                else:
+                    pattern += re.escape(piece)
+            out.append((kind, t, re.compile(f"^{pattern}$")))
+    return tuple(out)
+
+
+VERBS = (
+    ("put", "place", "drop", "transfer", "deposit", "pop", "stow", "store", "move"),  # into
+    ("put", "place", "set", "lay", "move"),  # onto
+)
+"""Verbs a step no template matches (a group: *put all the fruit into the pot*) may start with instead of one
+another, by whether it puts into or onto; the reader still decides which of them ask for the same task."""
+
+
+def _verb_swaps(clause: str) -> list[str]:
+    into = re.search(r"\b(into|inside|in)\b", clause) is not None
+    for verbs in VERBS[:1] if into else VERBS[1:]:
+        for v in verbs:
+            if clause.startswith(v + " "):
+                rest = clause[len(v):]
+                return [w + rest for w in verbs if w != v]
+    return []
+
+
+@functools.cache
+def _name_words() -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """(word, its category's words) for every word of :data:`NAMES`, longest first (so *serving bowl* is found
+    before *bowl*)."""
+    pairs = {w: words for words in NAMES.values() for w in words}
+    return tuple(sorted(pairs.items(), key=lambda kv: -len(kv[0])))
+
+
+def names(phrase: str) -> list[str]:
+    """``phrase`` (an object phrase of a command) with the category word at its end said every way the author
+    says it, the words before it (colour, size, model) kept: ``red mixing bowl`` -> ``red bowl``, ``red serving
+    bowl``, ...; ``[phrase]`` when it ends in no known word."""
+    for word, words in _name_words():
+        if phrase == word or phrase.endswith(" " + word):
+            head = phrase[: len(phrase) - len(word)]
+            return list(dict.fromkeys([phrase, *(head + w for w in words)]))
+    return [phrase]
+
+
+def _fill(template: str, slots: dict[str, str]) -> str | None:
+    needed = set(re.findall(r"\{([a-z])\}", template))
+    if not needed <= set(slots):
+        return None
+    if any(re.search(r" (of|with) ", v) and f"{{{k}}}'s" in template for k, v in slots.items()):
+        return None  # not 'the chest of drawers's drawer', 'the box with a lid's lid'
+
+    return template.format(**{k: slots.get(k, "") for k in SLOTS})
+
+
+def clause_wordings(clause: str) -> list[str]:
+    """Every wording of one step of a command the templates and names give (``clause`` itself first); not yet
+    checked by the reader."""
+    out = [clause]
+    for kind, _, pattern in _templates():
+        m = pattern.match(clause)
+        if m is None:
+            continue
+        found = m.groupdict()
+        if kind != "place_at" and any(PLACE_WORDS.search(found.get(k) or "") for k in "od"):
+            continue
+        choices = {k: (names(v) if k in "od" else list(SURFACES) if k == "s" else [v]) for k, v in found.items()}
+        keys = sorted(choices)
+        for values in itertools.product(*(choices[k] for k in keys)):
+            slots = dict(zip(keys, values, strict=True))
+            for other in (PLACE_AT if kind == "place_at" else COMMANDS[kind]):
+                text = _fill(other, slots)
+                if text is not None:
+                    out.append(text)
+    if len(out) == 1:  # no template (a group: 'put all the fruit in the pot'): other names, other verbs
+        for word, words in _name_words():
+            if re.search(rf"\b{re.escape(word)}\b", clause):
+                out += [re.sub(rf"\b{re.escape(word)}\b", w, clause, count=1) for w in words]
+                break
+        out += [x for text in out for x in _verb_swaps(text)]
+    return list(dict.fromkeys(out))
+
+
+def _mention_key(m) -> tuple:
+    return (tuple(sorted(m.options or (m.asset,))), m.color, m.part, m.group)
+
+
+def reading_key(r: Reading) -> tuple:
+    """What a reading asks for, whatever the words: skill, objects (the catalog choices, colour, part, group),
+    direction, relation, region, amount and the steps after it."""
+    return (r.skill, tuple(_mention_key(m) for m in r.objects), r.direction, r.relation, r.region, r.amount,
+            tuple(reading_key(x) for x in r.then))
+
+
+def _names_per_object(r: Reading) -> int:
+    """How many names the steps of ``r`` give its objects beyond one each: *drop the ball in the mixing bowl, then
+    the peach in the serving bowl* reads as two bowls to a person, whatever the reader makes of it."""
+    said: dict[tuple, set[str]] = {}
+    for m in r.all_objects:
+        said.setdefault(_mention_key(m), set()).add(m.phrase)
+    return sum(len(v) - 1 for v in said.values())
+
+
+def _not_understood(r: Reading) -> set[str]:
+    """The words the reader reports it did not understand, in every step."""
+    out = {w for n in r.notes if "not understood" in n for w in re.findall(r"'([^']+)'", n)}
+    return out.union(*(_not_understood(x) for x in r.then))
+
+
+@functools.cache
+def _template_words() -> frozenset[str]:
+    """Every word of the author's templates: each template reads back as its task (a test holds them to it), so a
+    word of them the reader passes over (*no further*, *and stop*) shapes nothing there."""
+    texts = [t for ts in (*COMMANDS.values(), PLACE_AT) for t in ts]
+    return frozenset(w for t in texts for w in re.findall(r"[a-z]+", re.sub(r"\{[a-z]\}", " ", t)))
+
+
+def wordings(command: str, assets: Sequence[dict], limit: int = MAX_WORDINGS, seed: int = 0) -> list[str]:
+    """Every wording of ``command`` (a bare command: no situation, no purpose) that the reader reads as it reads
+    ``command`` (see the module docstring), ``command`` first; at most ``limit`` candidates are read (a sample
+    drawn by ``seed`` when there are more). ``[command]`` when the reader cannot read it."""
+    try:
+        reference = read_instruction(command, assets)
+    except InstructionError:
+        return [command]
+    key, vague, named = reading_key(reference), _not_understood(reference), _names_per_object(reference)
+    steps = [clause_wordings(c) for c in command.split(STEP_JOINER)]
+    total = int(np.prod([len(s) for s in steps]))
+    if total <= limit:
+        combos = list(itertools.product(*steps))
+    else:
+        rng = np.random.default_rng(seed)
+        combos = {tuple(s[int(rng.integers(len(s)))] for s in steps) for _ in range(limit)}
+        combos = sorted(combos)
+    out = [command]
+    for combo in combos:
+        text = STEP_JOINER.join(combo)
+        if text in out:
+            continue
+        try:
+            r = read_instruction(text, assets)
+        except InstructionError:
+            continue
+        if (reading_key(r) == key and _not_understood(r) - vague <= _template_words()
+                and _names_per_object(r) <= named):
+            out.append(text)
+    return out
+
+
+__all__ = ["MAX_WORDINGS", "STEP_JOINER", "VERBS", "clause_wordings", "names", "reading_key", "wordings"]
