@@ -215,17 +215,18 @@ def _mean_cosine(e: np.ndarray) -> float:
     return float((s.sum() - np.trace(s)) / (n * (n - 1))) if n > 1 else 0.0
 
 
-def plan_commands(commands: list[str], fixed: list[bool]) -> list[str]:
+def plan_commands(commands: list[str], fixed: list[bool], limit: int | None = None) -> list[str]:
     """The wording of each of ``commands`` (bare commands of a library, one per task) least like the others: of
     the wordings the reader reads as that command (:func:`generator.command_wording.wordings`), chosen by
-    coordinate descent on the commands' mean pairwise cosine; a ``fixed`` command keeps its words."""
+    coordinate descent on the commands' mean pairwise cosine; a ``fixed`` command keeps its words. ``limit``: the
+    most wordings read per command (default :data:`generator.command_wording.MAX_WORDINGS`)."""
     from tqdm import tqdm
 
     from generator.catalog_view import asset_dicts
-    from generator.command_wording import wordings
+    from generator.command_wording import MAX_WORDINGS, wordings
 
     assets = asset_dicts()
-    options = [[c] if f else wordings(c, assets)
+    options = [[c] if f else wordings(c, assets, limit=limit or MAX_WORDINGS)
                for c, f in tqdm(list(zip(commands, fixed, strict=True)), desc="wordings read", unit="task",
                                 disable=len(commands) < 50)]
     flat = [t for opts in options for t in opts]
@@ -236,21 +237,21 @@ def plan_commands(commands: list[str], fixed: list[bool]) -> list[str]:
     return [flat[k] for k in choice]
 
 
-def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = (),
-                   commands: bool = False) -> tuple[list[Rewording], dict]:
+def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = (), commands: bool = False,
+                   limit: int | None = None) -> tuple[list[Rewording], dict]:
     """New instructions for the latest version of each task in ``versions`` (task names in ``keep`` keep
     theirs), chosen to lower the library's mean pairwise cosine; and the numbers before and after.
 
     With ``commands`` the command itself is first worded least like the library's other commands
     (:func:`plan_commands`: only wordings the reader reads as the same task); without, it is kept and only its
-    framing chosen. Returns only the tasks whose wording changes."""
+    framing chosen (``limit``: see :func:`plan_commands`). Returns only the tasks whose wording changes."""
     latest = sorted(latest_versions(versions).items())
     keep = set(keep)
     ids = [env_id for env_id, _ in latest]
     current = [v.spec.instruction for _, v in latest]
     fixed = [v.name in keep for _, v in latest]
     old_commands = [split(t)[1] for t in current]
-    new_commands = plan_commands(old_commands, fixed) if commands else old_commands
+    new_commands = plan_commands(old_commands, fixed, limit) if commands else old_commands
     options: list[list[str]] = []
     for (_, v), text, cmd, f in zip(latest, current, new_commands, fixed, strict=True):
         options.append([text] if f else candidates_for(v.name, text, spec_frames(v.spec), command=cmd))
