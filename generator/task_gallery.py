@@ -8,6 +8,8 @@ solvability gate measured (success and env steps per success; "—" for a task t
 from __future__ import annotations
 
 import logging
+import re
+import shutil
 from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
@@ -48,21 +50,40 @@ def _row(env_id: str, version: TaskVersion, picture: str) -> str:
             f"{measured} | {per} |")
 
 
+def _picture_of_source(version: TaskVersion, pictures: Path) -> Path | None:
+    """Where the picture of the version ``version`` was reworded from would be (None: not a rewording)."""
+    source = (version.provenance().get("reword") or {}).get("source")
+    m = re.fullmatch(r".*/(\w+)-v(\d+)", source or "")
+    return pictures / f"{m.group(1)}-v{m.group(2)}.png" if m else None
+
+
 def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures: Path | None = None,
                        all_versions: bool = False, size: int = THUMB_PX, rerender: bool = False) -> Path:
     """Write the gallery Markdown to ``out`` and a thumbnail per task into ``pictures`` (default: a folder named
     after ``out`` beside it); returns ``out``. A version's folder never changes once published, so a picture already
     there of that version and size is kept; ``rerender`` draws every one again (after a change to the renderer or to
-    an asset)."""
+    an asset). A reworded version (its scene byte for byte its source's) takes its source's picture. Pictures of
+    versions the gallery no longer shows are removed."""
     chosen = dict(versions) if all_versions else latest_versions(versions)
     pictures = pictures or out.with_suffix("")
     pictures.mkdir(parents=True, exist_ok=True)
     rows = []
+
+    def fits(png: Path) -> bool:
+        return not rerender and png.is_file() and Image.open(png).size == (size, size)
+
     for env_id, version in tqdm(sorted(chosen.items()), desc="task pictures", unit="task"):
         png = pictures / f"{version.name}-v{version.version}.png"
-        if rerender or not png.is_file() or Image.open(png).size != (size, size):
+        source = _picture_of_source(version, pictures)
+        if not fits(png) and source is not None and fits(source):
+            shutil.copyfile(source, png)
+        elif not fits(png):
             Image.fromarray(thumbnail(version, size)).save(png)
         rows.append(_row(env_id, version, png.relative_to(out.parent).as_posix()))
+    shown = {f"{v.name}-v{v.version}.png" for v in chosen.values()}
+    stale = [p for p in pictures.glob("*.png") if re.fullmatch(r"\w+-v\d+\.png", p.name) and p.name not in shown]
+    for p in stale:
+        p.unlink()
     head = ["# Task library", "",
             f"{len(rows)} tasks ({'every version' if all_versions else 'the latest version of each'}), written by "
             "`gendex tasks-doc`. Picture: the task at reset (seed 0). *Solved*: the version's solvability record "

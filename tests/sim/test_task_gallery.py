@@ -52,3 +52,23 @@ def test_a_published_versions_picture_is_kept_unless_asked_to_draw_it_again(tmp_
     Image.new("RGB", (128, 128), (255, 0, 0)).save(pic)
     write_task_gallery(versions, out, size=128, rerender=True)
     assert len(set(Image.open(pic).getdata())) > 50
+
+
+def test_a_reworded_version_takes_its_sources_picture_and_stale_pictures_go(tmp_path, task_copy):
+    """A rewording changes the instruction only: its picture is its source's, not drawn again; a picture of a
+    version the gallery no longer shows is removed (the gallery of a reworded library held both)."""
+    from generator.reword import publish_reworded
+
+    src = task_copy("LiftApple", as_name="ScratchApple")
+    new = publish_reworded(src, "Raise the apple off the counter.", {"reason": "test"})
+    out = tmp_path / "docs" / "tasks.md"
+    pictures = tmp_path / "docs" / "tasks"
+    pictures.mkdir(parents=True)
+    Image.new("RGB", (96, 96), (0, 0, 255)).save(pictures / f"ScratchApple-v{src.version}.png")
+    Image.new("RGB", (96, 96), (0, 255, 0)).save(pictures / "GoneTask-v3.png")
+    (pictures / "notes.txt").write_text("not a picture of a version")
+    write_task_gallery({src.env_id: src, new.env_id: new}, out, size=96)
+    pic = pictures / f"ScratchApple-v{new.version}.png"
+    assert set(Image.open(pic).getdata()) == {(0, 0, 255)}  # the source's, copied
+    assert sorted(p.name for p in pictures.iterdir()) == [pic.name, "notes.txt"]
+    assert f"tasks/{pic.name}" in out.read_text()
