@@ -38,18 +38,20 @@ GOES_ON = ("hold", "keep", "leave", "stay")
 """Verbs that go on with the step before rather than start one (*open the door halfway and hold it there*)."""
 _PRONOUN = re.compile(r"\b(it|them)\b", re.IGNORECASE)
 _BARE_PART = re.compile(r"\b(the|its)\s+(lid|door|drawer)\b", re.IGNORECASE)
+_BARE_PLACE = re.compile(r"\b(in|inside|into|on|onto)$", re.IGNORECASE)
+"""A step that ends at its place word (*open the bin, then drop the apple in*): the place is the step before's."""
 
 
 def and_steps(text: str, starts_with_verb: Callable[[str], bool]) -> list[str]:
-    """``text`` split where *and* is followed by a verb of a skill (*pick up the apple and put it in the bowl*);
-    one part when no *and* is."""
-    parts = re.split(r"\s*,?\s+and\s+", text)
-    out = [parts[0]]
-    for p in parts[1:]:
-        if starts_with_verb(p) and p.split()[0].lower() not in GOES_ON:
+    """``text`` split where *and* or a comma is followed by a verb of a skill (*pick up the apple and put it in the
+    bowl*, *open the drawer, put the ball inside*); one part when none is."""
+    pieces = re.split(r"(\s*,?\s+and\s+|\s*,\s*)", text)
+    out = [pieces[0]]
+    for joiner, p in zip(pieces[1::2], pieces[2::2], strict=True):
+        if p and starts_with_verb(p) and p.split()[0].lower() not in GOES_ON:
             out.append(p)
         else:
-            out[-1] += " and " + p
+            out[-1] += joiner + p
     return out
 
 
@@ -77,10 +79,10 @@ def group_steps(text: str, verb_end: int) -> list[str]:
 
 
 def _with_previous(step: str, previous: Reading, read_one: Callable[[str], Reading]) -> Reading:
-    """``step`` read with its pronoun or bare part standing for an object of ``previous``: the first of them that
-    reads (the error of the first try when none does)."""
-    pronoun, part = _PRONOUN.search(step), _BARE_PART.search(step)
-    if pronoun is None and part is None:
+    """``step`` read with its pronoun, bare part or bare place word standing for an object of ``previous``: the
+    first of them that reads (the error of the first try when none does)."""
+    pronoun, part, place = _PRONOUN.search(step), _BARE_PART.search(step), _BARE_PLACE.search(step)
+    if pronoun is None and part is None and place is None:
         return read_one(step)
     if pronoun is not None:  # 'raise the pear clear of the table and keep hold of it': the step's own object
         try:
@@ -94,7 +96,8 @@ def _with_previous(step: str, previous: Reading, read_one: Callable[[str], Readi
     first_error: InstructionError | None = None
     for m in previous.objects:
         name = f"the {m.color + ' ' if m.color else ''}{m.phrase}"
-        tried = _PRONOUN.sub(name, step) if pronoun else _BARE_PART.sub(f"{name} {part.group(2)}", step)
+        tried = (_PRONOUN.sub(name, step) if pronoun else _BARE_PART.sub(f"{name} {part.group(2)}", step) if part
+                 else f"{step} {name}")  # 'put the ball inside': inside the step before's object
         try:
             return read_one(tried)
         except InstructionError as exc:

@@ -191,3 +191,29 @@ def split_steps(text: str) -> list[str]:
     parts = [re.sub(r"^(first|firstly)\s+", "", p.strip(" ,.;"), flags=re.IGNORECASE) for p in parts]
     return [p for p in parts if p]
 
+
+_WHY = re.compile(r",? so (?:that )?(?:it|they|the|there|we|i|you|nothing|no) .*$")
+_THROWN = re.compile(r"(throw|toss|chuck)\b(?=.*\b(?:in|into|inside)\b)", re.IGNORECASE)
+_ONE = re.compile(r"\bthe\s+([a-z]+)\s+one\b", re.IGNORECASE)
+_PLACE_TAIL = re.compile(r"\s*\b(on top of|next to|in front of|to the left of|to the right of|onto|on|into|in|inside|"
+                         r"beside|behind|by|and|from|than)\s*$", re.IGNORECASE)
+
+
+def restated(text: str) -> tuple[str, str | None]:
+    """What to read of ``text`` when it says more or less than its task, and the note saying so (None: read it as
+    it is): a reason after the request (*flip the cup over so it can dry*: not something to do, unless a step follows
+    it); *throw the apple in the bin* (a drop into it); *the green one* after *the blue cube* (the green cube)."""
+    why = _WHY.search(text)
+    if why is not None and why.start() > 0 and not re.search(r"\bthen\b|;", why.group(0)):
+        return text[:why.start()], f"'{why.group(0).lstrip(', ')}' is read as the reason, not as something to do"
+    thrown = _THROWN.match(text)
+    if thrown is not None:  # not 'throw the ball' (across the room): that is no task
+        return "drop" + text[thrown.end():], f"'{thrown.group(1)}' is read as 'drop' (into the place it names)"
+    one = _ONE.search(text)
+    if one is not None and one.group(1).lower() not in ("other", "same", "first", "last", "next", "right", "left"):
+        noun = re.search(r"([a-z']+)$", _PLACE_TAIL.sub("", text[:one.start()]).rstrip(), re.IGNORECASE)
+        if noun is not None and noun.group(1).lower() not in DETERMINERS | {"it", "them", "one"}:
+            said = f"the {one.group(1)} {noun.group(1)}"
+            return text[:one.start()] + said + text[one.end():], f"'{one.group(0)}' is read as '{said}'"
+    return text, None
+

@@ -29,6 +29,7 @@ from generator.constructs import (
     is_off,
     read_amount,
     read_place,
+    restated,
 )
 from generator.errors import InstructionError
 from generator.nearest import stand_in
@@ -330,11 +331,9 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
     if not text:
         raise InstructionError("the instruction is empty; say what the hand should do, e.g. "
                                + "; ".join(f'"{s.example}"' for s in TASK_SKILLS.values()))
-    why = re.search(r",? so (?:that )?(?:it|they|the|there|we|i|you|nothing|no) .*$", text)
-    if why is not None and why.start() > 0 and not re.search(r"\bthen\b|;", why.group(0)):
-        # 'flip the cup over so it can dry': a purpose, nothing to do (not when a step follows it)
-        reading = read_instruction(text[:why.start()], assets)
-        note = f"'{why.group(0).lstrip(', ')}' is read as the reason, not as something to do"
+    said, note = restated(text)  # a reason after the request; 'the green one' after 'the blue cube'
+    if note is not None:
+        reading = read_instruction(said, assets)
         return dataclasses.replace(reading, instruction=text, notes=(*reading.notes, note))
     compound = read_compound(text, assets, lambda step: read_instruction(step, assets), _starts_with_verb,
                              lambda step: _skill(_words(step)))

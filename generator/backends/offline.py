@@ -498,9 +498,12 @@ class OfflineBackend:
             proposal = self._plate_task(pick(0, carried, "object to set down"),
                                         pick(1, is_surface, "plate, tray or board"), colors)
         elif skill == "stack":  # blocks named by colour alone: the smallest on top, the next size under it
-            a = pick(0, lambda x: graspable(x) and x["category"] == "block", "block to stack", smallest=True)
-            proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a),
-                                                "larger block to stack on", smallest=True), colors)
+            tops = {t for t, _ in STACK_PAIRS}  # and what the grammar stacks on a block (a rubik's cube)
+            a = pick(0, lambda x: graspable(x) and (x["category"] == "block" or x["id"] in tops), "block to stack",
+                     smallest=True)
+            proposal = self._stack_task(a, pick(1, lambda x: x["category"] == "block" and _min_xy(x) > _min_xy(a) and (
+                a["category"] == "block" or (a["id"], x["id"]) in STACK_PAIRS), "larger block to stack on",
+                smallest=True), colors)
         elif skill == "place_at":
             rel = reading.get("relation") or "in_region"
             refs = [pick(k, lambda x: not x.get("joints"), "object to set it by") for k in range(1, len(mentions))]
@@ -557,8 +560,8 @@ class OfflineBackend:
             proposal = flip_task(pick(0, flippable, "glass or paper cup to turn upside down"), self._words,
                                  colors)
         elif skill == "push":
-            proposal = self._push_task(pick(0, lambda x: graspable(x) and x["category"] == "block",
-                                            "block to push"))
+            proposal = self._push_task(pick(0, lambda x: graspable(x) and (x["category"] == "block"
+                                                                           or x["id"] in PUSHED), "block to push"))
         elif skill == "open" and mentions and any(
                 (i in assets and openable(assets[i])) for i in (mentions[0]["options"] or [mentions[0]["asset"]])):
             a = pick(0, openable, "door or drawer to open")

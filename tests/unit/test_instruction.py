@@ -363,3 +363,27 @@ def test_a_backend_that_drops_a_colour_is_overruled():
     assert [o.color for o in p.objects] == ["green"]
     spec, _ = write_scene(Colourless(seed=0), p)
     assert [o.color for o in spec.objects if not o.distractor] == ["green"]
+
+
+def test_the_green_one_is_the_green_block_and_a_thrown_apple_is_dropped_in():
+    r = read("stack the blue cube on the green one")
+    assert r.skill == "stack" and [m.color for m in r.objects] == ["blue", "green"]
+    assert all(m.asset.startswith("block_") for m in r.objects)
+    assert any("'the green one' is read as 'the green cube'" in n for n in r.notes)
+    r = read("open the trash can, then throw the apple in")
+    assert (r.skill, r.then[0].skill) == ("open", "put_in")
+    assert [m.asset for m in r.then[0].objects][0] == "apple"
+    assert set(r.then[0].objects[1].options) == set(r.objects[0].options)  # into the bin just opened
+    assert any("'throw' is read as 'drop'" in n for n in r.then[0].notes)
+    with pytest.raises(InstructionError):
+        read("throw the ball")  # across the room: no task
+
+
+def test_steps_said_with_commas_are_steps_and_a_bare_inside_is_the_step_befores_object():
+    r = read("open the drawer, put the golf ball inside, then close it")
+    assert [r.skill, *(x.skill for x in r.then)] == ["open", "put_in", "close"]
+    assert r.then[0].objects[0].asset == "golf_ball" and r.then[0].objects[1].part == "drawer"
+    r = read("put the apple, the lemon and the plum in the bowl")  # a list of objects is no list of steps
+    assert [x.objects[0].asset for x in (r, *r.then)] == ["apple", "lemon", "plum"]
+    with pytest.raises(InstructionError):  # a step it cannot read is refused, never dropped
+        read("open the drawer, juggle the golf ball, then close it")

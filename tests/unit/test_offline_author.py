@@ -659,3 +659,18 @@ def test_a_box_or_bin_with_a_lid_is_put_into_with_its_lid_open_and_shut_after_if
         assert next(iter(lidded.joint_state.values())) > 1.5, text  # the lid starts open
     with pytest.raises(InstructionError, match="opens a lid first or shuts it last, not both"):
         guided("open the small trash can, then put the apple in it, then close its lid")
+
+
+@pytest.mark.parametrize("request_text, success, moved", [
+    ("stack the rubik's cube on the large block", "over", "rubiks_cube"),
+    ("push the rubik's cube to the target", "near", "rubiks_cube"),
+])
+def test_a_request_for_what_the_grammar_writes_by_itself_is_built(request_text, success, moved):
+    """The autonomous grammar stacks a rubik's cube on the large block and pushes it (STACK_PAIRS, PUSHED); asked
+    for in words, the same was refused ('it writes them with: block_large, ...')."""
+    p, _ = propose(OfflineBackend(seed=3), instruction=request_text)
+    assert not p.substitutions
+    assert {o.asset for o in p.objects} >= {moved}
+    assert p.success["object"] == next(o.name for o in p.objects if o.asset == moved)
+    with pytest.raises(InstructionError, match="'dice' .*cannot be the block to stack"):  # never measured on one
+        propose(OfflineBackend(seed=3), instruction="stack the dice on the large block")
