@@ -52,7 +52,7 @@ NAMES: dict[str, tuple[str, ...]] = {
     "microwave": ("microwave", "microwave oven"),
     "drawer_chest": ("chest of drawers", "dresser", "drawer unit"),
     "trash_can": ("trash can", "bin", "waste bin"),
-    "box_with_lid": ("lidded box", "storage box", "box with a lid"),
+    "box_with_lid": ("lidded box", "storage box"),  # not "box with a lid": "the box with a lid lid"
     "faucet": ("faucet", "tap", "mixer tap"),
     "refrigerator": ("fridge", "refrigerator"),
     "laptop": ("laptop", "notebook computer"),
