@@ -149,7 +149,9 @@ class ProposalWording:
         except RewordError as exc:
             log.info("kept the drawn wording: %s", exc)
             return proposal
-        return dict(proposal, description=choose(options))
+        used = Counter(x for t in key for x in split(t)[0::2] if x is not None)
+        fresh = [o for o in options if all(x is None or used[x] < MAX_REUSE for x in split(o)[0::2])]
+        return dict(proposal, description=choose(fresh or options))  # no frame of the library used MAX_REUSE times
 
 
 PROPOSAL_WORDINGS = 60

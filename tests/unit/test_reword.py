@@ -207,6 +207,23 @@ def test_the_offline_author_words_a_proposal_least_like_the_library(task_version
     assert ProposalWording()(proposal, []) is proposal
 
 
+def test_the_author_frames_no_proposal_with_a_situation_the_library_already_uses_twice(task_version, monkeypatch):
+    """A batch of eight framed three of its tasks with one situation (the author chose against the library by the
+    mean alone); a situation the library has used MAX_REUSE times is not offered again."""
+    spec = task_version("PutPlumInPot").spec
+    proposal = {"name": "PutPlumInPot", "description": spec.instruction,
+                "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
+                "steps": [], "success": {"type": "inside", "object": "plum", "target": "pot"}}
+    favourite = "A still-life painter is arranging a scene"  # a fruit situation: offered for the plum
+    # a chooser that takes the favourite whenever it is offered (the embedding did, three times in one batch)
+    monkeypatch.setattr(LibraryWording, "__call__", lambda self, options: next(
+        (o for o in options if o.startswith(favourite)), options[0]))
+    library = ["Close the drawer.", f"{favourite}: lift the golf ball."]
+    assert ProposalWording()(proposal, library)["description"].startswith(favourite)  # used once: offered
+    library.append(f"{favourite}: set the pear on the plate.")
+    assert not ProposalWording()(proposal, library)["description"].startswith(favourite)  # twice: not again
+
+
 def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     """The left-hinged fridge's task proposed next to the right-hinged one's: the least-alike framing by the mean
     alone took the very frame the sibling had (cosine 0.99, and the proposal was dropped as a near-duplicate)."""
