@@ -115,7 +115,6 @@ def _fill(template: str, slots: dict[str, str]) -> str | None:
         return None
     if any(re.search(r" (of|with) ", v) and f"{{{k}}}'s" in template for k, v in slots.items()):
         return None  # not 'the chest of drawers's drawer', 'the box with a lid's lid'
-
     return template.format(**{k: slots.get(k, "") for k in SLOTS})
 
 
