@@ -28,15 +28,18 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from generator.command_templates import COMMANDS, PLACE_AT
 from generator.errors import InstructionError
 from generator.instruction import Reading, read_instruction
-from generator.phrasing import COMMANDS, NAMES, PLACE_AT, SURFACES
+from generator.phrasing import NAMES, SURFACES
 
 STEP_JOINER = ", then "
 """How the offline author joins the steps of a composed command (:func:`generator.phrasing.phrase_parts`)."""
 MAX_WORDINGS = 240
 """Most candidate wordings tried for one command (a three-step command has thousands): a seeded sample of them,
 the command itself always first."""
+TEMPLATES: dict[str, tuple[str, ...]] = {**COMMANDS, "place_at": PLACE_AT}
+"""Every template the author words a command from, by kind."""
 SLOTS = "odsapw"
 """Template slots: the object acted on, the destination or articulated object, the table, an amount, the pieces,
 where a placed object goes."""
@@ -53,11 +56,11 @@ the near right corner of the table*) is not a plate."""
 
 
 @functools.cache
-def _templates() -> tuple[tuple[str, str, re.Pattern], ...]:
-    """(kind, template, pattern) for every command template: a slot matches the words it stood for, and a slot
-    that appears twice must match the same words both times."""
+def _templates() -> tuple[tuple[str, re.Pattern], ...]:
+    """(kind, pattern) for every command template: a slot matches the words it stood for, and a slot that appears
+    twice must match the same words both times."""
     out = []
-    for kind, templates in {**COMMANDS, "place_at": PLACE_AT}.items():
+    for kind, templates in TEMPLATES.items():
         for t in templates:
             seen: set[str] = set()
             pattern = ""
@@ -68,7 +71,7 @@ def _templates() -> tuple[tuple[str, str, re.Pattern], ...]:
                     seen.add(k)
                 else:
                     pattern += re.escape(piece)
-            out.append((kind, t, re.compile(f"^{pattern}$")))
+            out.append((kind, re.compile(f"^{pattern}$")))
     return tuple(out)
 
 
@@ -81,13 +84,9 @@ another, by whether it puts into or onto; the reader still decides which of them
 
 
 def _verb_swaps(clause: str) -> list[str]:
-    into = re.search(r"\b(into|inside|in)\b", clause) is not None
-    for verbs in VERBS[:1] if into else VERBS[1:]:
-        for v in verbs:
-            if clause.startswith(v + " "):
-                rest = clause[len(v):]
-                return [w + rest for w in verbs if w != v]
-    return []
+    verbs = VERBS[0] if re.search(r"\b(into|inside|in)\b", clause) else VERBS[1]
+    v = next((v for v in verbs if clause.startswith(v + " ")), None)
+    return [] if v is None else [w + clause[len(v):] for w in verbs if w != v]
 
 
 @functools.cache
@@ -122,7 +121,7 @@ def clause_wordings(clause: str) -> list[str]:
     """Every wording of one step of a command the templates and names give (``clause`` itself first); not yet
     checked by the reader."""
     out = [clause]
-    for kind, _, pattern in _templates():
+    for kind, pattern in _templates():
         m = pattern.match(clause)
         if m is None:
             continue
@@ -133,7 +132,7 @@ def clause_wordings(clause: str) -> list[str]:
         keys = sorted(choices)
         for values in itertools.product(*(choices[k] for k in keys)):
             slots = dict(zip(keys, values, strict=True))
-            for other in (PLACE_AT if kind == "place_at" else COMMANDS[kind]):
+            for other in TEMPLATES[kind]:
                 text = _fill(other, slots)
                 if text is not None:
                     out.append(text)
@@ -176,7 +175,7 @@ def _not_understood(r: Reading) -> set[str]:
 def _template_words() -> frozenset[str]:
     """Every word of the author's templates: each template reads back as its task (a test holds them to it), so a
     word of them the reader passes over (*no further*, *and stop*) shapes nothing there."""
-    texts = [t for ts in (*COMMANDS.values(), PLACE_AT) for t in ts]
+    texts = [t for ts in TEMPLATES.values() for t in ts]
     return frozenset(w for t in texts for w in re.findall(r"[a-z]+", re.sub(r"\{[a-z]\}", " ", t)))
 
 
@@ -212,4 +211,4 @@ def wordings(command: str, assets: Sequence[dict], limit: int = MAX_WORDINGS, se
     return out
 
 
-__all__ = ["MAX_WORDINGS", "STEP_JOINER", "VERBS", "clause_wordings", "names", "reading_key", "wordings"]
+__all__ = ["MAX_WORDINGS", "STEP_JOINER", "TEMPLATES", "VERBS", "clause_wordings", "names", "reading_key", "wordings"]

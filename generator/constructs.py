@@ -216,4 +216,3 @@ def restated(text: str) -> tuple[str, str | None]:
             said = f"the {one.group(1)} {noun.group(1)}"
             return text[:one.start()] + said + text[one.end():], f"'{one.group(0)}' is read as '{said}'"
     return text, None
-

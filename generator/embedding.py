@@ -136,4 +136,15 @@ def embed_each(texts: list[str]):
     return out, embedding_source()
 
 
-__all__ = ["DIMENSIONS", "MODEL_PACKAGE", "cache_dir", "embed", "embed_each", "embedding_source"]
+def mean_pairwise_cosine(emb) -> float:
+    """Mean cosine over every pair of distinct rows of ``emb`` (unit-length embeddings, ``[n, d]``); 0 for fewer
+    than two rows. The library's diversity figure (lower: more diverse)."""
+    n = len(emb)
+    if n < 2:
+        return 0.0
+    sims = emb @ emb.T
+    return float((sims.sum() - sims.trace()) / (n * (n - 1)))
+
+
+__all__ = ["DIMENSIONS", "MODEL_PACKAGE", "cache_dir", "embed", "embed_each", "embedding_source",
+           "mean_pairwise_cosine"]

@@ -32,7 +32,7 @@ import yaml
 from gendex_envs.spec import TaskSpec
 from gendex_envs.task_version import TaskLayout, TaskVersion, publish_derived
 from generator.catalog_view import asset_dict
-from generator.embedding import embed, embed_each
+from generator.embedding import embed, embed_each, mean_pairwise_cosine
 from generator.phrasing import SURFACES, Frame, direction, domain, framings, split
 from generator.stats import latest_versions, task_skills
 
@@ -125,7 +125,7 @@ class ProposalWording:
     ``stats`` extra is not installed."""
 
     def __init__(self):
-        self._library: tuple[tuple[str, ...], LibraryWording | None, LibraryWording | None] | None = None
+        self._library: tuple[tuple[str, ...], LibraryWording | None, LibraryWording | None, Counter] | None = None
 
     def __call__(self, proposal: dict, library: Iterable[str]) -> dict:
         """``proposal`` worded least like ``library`` (unchanged for an empty library)."""
@@ -134,11 +134,12 @@ class ProposalWording:
             return proposal
         if self._library is None or self._library[0] != key:
             try:
-                self._library = (key, LibraryWording(key), LibraryWording(split(t)[1] for t in key))
+                used = Counter(x for t in key for x in split(t)[0::2] if x is not None)
+                self._library = (key, LibraryWording(key), LibraryWording(split(t)[1] for t in key), used)
             except ImportError as exc:
                 log.info("wording drawn at random: %s is not installed (the optional 'stats' extra)", exc.name)
-                self._library = (key, None, None)
-        _, choose, choose_command = self._library
+                self._library = (key, None, None, Counter())
+        _, choose, choose_command, used = self._library
         if choose is None:
             return proposal
         try:
@@ -149,7 +150,6 @@ class ProposalWording:
         except RewordError as exc:
             log.info("kept the drawn wording: %s", exc)
             return proposal
-        used = Counter(x for t in key for x in split(t)[0::2] if x is not None)
         fresh = [o for o in options if all(x is None or used[x] < MAX_REUSE for x in split(o)[0::2])]
         return dict(proposal, description=choose(fresh or options))  # no frame of the library used MAX_REUSE times
 
@@ -191,12 +191,12 @@ class Rewording:
     new: str
 
 
-def _descend(emb: np.ndarray, starts: np.ndarray, choice: list[int], allowed_for=None) -> int:
+def _descend(emb: np.ndarray, starts: np.ndarray, choice: list[int], allowed_for=None) -> None:
     """Coordinate descent on the mean pairwise cosine of the chosen rows of ``emb`` (options of task ``i`` are rows
-    ``starts[i]:starts[i+1]``): each task in turn takes its least-alike option (:func:`_least_alike`) among those
-    ``allowed_for(i)`` permits, a few passes round until none changes. Returns the passes made."""
+    ``starts[i]:starts[i+1]``), in ``choice``: each task in turn takes its least-alike option (:func:`_least_alike`)
+    among those ``allowed_for(i)`` permits, a few passes round until none changes."""
     n = len(choice)
-    for p in range(PASSES):
+    for _ in range(PASSES):
         changed = 0
         for i in range(n):
             if starts[i + 1] - starts[i] == 1:
@@ -207,14 +207,7 @@ def _descend(emb: np.ndarray, starts: np.ndarray, choice: list[int], allowed_for
             if best != choice[i]:
                 choice[i], changed = best, changed + 1
         if not changed:
-            return p + 1
-    return PASSES
-
-
-def _mean_cosine(e: np.ndarray) -> float:
-    n = len(e)
-    s = e @ e.T
-    return float((s.sum() - np.trace(s)) / (n * (n - 1))) if n > 1 else 0.0
+            return
 
 
 def plan_commands(commands: list[str], fixed: list[bool], limit: int | None = None) -> list[str]:
@@ -261,13 +254,12 @@ def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = ()
     emb = embed(flat)[0]
     starts = np.cumsum([0] + [len(o) for o in options])
     frames = [split(t)[0::2] for t in flat]  # (situation, purpose) of every option
-    # each task starts from its own instruction, or from the new command framed as before (else bare)
-    choice = [int(starts[i] + next((k for k, o in enumerate(options[i]) if o == current[i]),
-                                   next((k for k, o in enumerate(options[i])
-                                         if frames[starts[i] + k] == tuple(split(current[i])[0::2])), 0)))
+    # each task starts from its own framing (its own instruction, or the new command framed as it was; else bare)
+    own = [tuple(split(t)[0::2]) for t in current]
+    choice = [int(starts[i] + next((k for k, f in enumerate(frames[starts[i]:starts[i + 1]]) if f == own[i]), 0))
               for i in range(len(options))]
-    before = _mean_cosine(embed(current)[0])
-    commands_before = _mean_cosine(embed(old_commands)[0])
+    before = mean_pairwise_cosine(embed(current)[0])
+    commands_before = mean_pairwise_cosine(embed(old_commands)[0])
     n = len(choice)
 
     def allowed_for(i: int) -> np.ndarray:
@@ -277,10 +269,11 @@ def plan_rewording(versions: Mapping[str, TaskVersion], keep: Iterable[str] = ()
 
     _descend(emb, starts, choice, allowed_for)
     out = [Rewording(ids[i], current[i], flat[choice[i]]) for i in range(n) if flat[choice[i]] != current[i]]
+    commands_after = mean_pairwise_cosine(embed([split(flat[k])[1] for k in choice])[0])
     return out, {"tasks": n, "kept": sorted(keep & {v.name for _, v in latest}), "reworded": len(out),
-                 "mean_pairwise_cosine_before": before, "mean_pairwise_cosine_after": _mean_cosine(emb[choice]),
+                 "mean_pairwise_cosine_before": before, "mean_pairwise_cosine_after": mean_pairwise_cosine(emb[choice]),
                  "commands_mean_pairwise_cosine_before": commands_before,
-                 "commands_mean_pairwise_cosine_after": _mean_cosine(embed([split(flat[k])[1] for k in choice])[0]),
+                 "commands_mean_pairwise_cosine_after": commands_after,
                  "commands_reworded": sum(a != b for a, b in zip(old_commands, new_commands, strict=True))}
 
 

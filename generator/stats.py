@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from gendex_envs.spec import GOAL_TARGET, TaskSpec
 from gendex_envs.task_version import TaskVersion
 from generator.catalog_view import asset_dict
-from generator.embedding import embed, embedding_source
+from generator.embedding import embed, embedding_source, mean_pairwise_cosine
 from generator.instruction import part_kinds
 from generator.phrasing import split
 
@@ -172,10 +172,7 @@ def instruction_diversity(texts: list[str]) -> tuple[float | None, str]:
     except ImportError as exc:
         return None, f"not measured: the optional 'stats' extra is not installed ({exc.name}); " \
                      "pip install -e '.[stats]'"
-    sims = emb @ emb.T
-    n = len(texts)
-    value = float((sims.sum() - sims.trace()) / (n * (n - 1)))
-    return value, source
+    return mean_pairwise_cosine(emb), source
 
 
 def library_stats(versions: Mapping[str, TaskVersion], all_versions: bool = False,

@@ -14,6 +14,7 @@ from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 
+from gymnasium.envs.registration import parse_env_id
 from PIL import Image
 from tqdm import tqdm
 
@@ -53,8 +54,10 @@ def _row(env_id: str, version: TaskVersion, picture: str) -> str:
 def _picture_of_source(version: TaskVersion, pictures: Path) -> Path | None:
     """Where the picture of the version ``version`` was reworded from would be (None: not a rewording)."""
     source = (version.provenance().get("reword") or {}).get("source")
-    m = re.fullmatch(r".*/(\w+)-v(\d+)", source or "")
-    return pictures / f"{m.group(1)}-v{m.group(2)}.png" if m else None
+    if source is None:
+        return None
+    _, name, number = parse_env_id(source)
+    return pictures / f"{name}-v{number}.png"
 
 
 def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures: Path | None = None,
@@ -74,11 +77,12 @@ def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures:
 
     for env_id, version in tqdm(sorted(chosen.items()), desc="task pictures", unit="task"):
         png = pictures / f"{version.name}-v{version.version}.png"
-        source = _picture_of_source(version, pictures)
-        if not fits(png) and source is not None and fits(source):
-            shutil.copyfile(source, png)
-        elif not fits(png):
-            Image.fromarray(thumbnail(version, size)).save(png)
+        if not fits(png):
+            source = _picture_of_source(version, pictures)
+            if source is not None and fits(source):
+                shutil.copyfile(source, png)
+            else:
+                Image.fromarray(thumbnail(version, size)).save(png)
         rows.append(_row(env_id, version, png.relative_to(out.parent).as_posix()))
     shown = {f"{v.name}-v{v.version}.png" for v in chosen.values()}
     stale = [p for p in pictures.glob("*.png") if re.fullmatch(r"\w+-v\d+\.png", p.name) and p.name not in shown]
