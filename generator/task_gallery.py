@@ -14,6 +14,7 @@ from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 
+from gymnasium import error as gym_error
 from gymnasium.envs.registration import parse_env_id
 from PIL import Image
 from tqdm import tqdm
@@ -52,12 +53,14 @@ def _row(env_id: str, version: TaskVersion, picture: str) -> str:
 
 
 def _picture_of_source(version: TaskVersion, pictures: Path) -> Path | None:
-    """Where the picture of the version ``version`` was reworded from would be (None: not a rewording)."""
+    """Where the picture of the version ``version`` was reworded from would be (None: not a rewording, or a record
+    whose source is no versioned task id: the folder is untrusted, its picture is then drawn)."""
     source = (version.provenance().get("reword") or {}).get("source")
-    if source is None:
+    try:
+        _, name, number = parse_env_id(source) if isinstance(source, str) else (None, None, None)
+    except gym_error.Error:
         return None
-    _, name, number = parse_env_id(source)
-    return pictures / f"{name}-v{number}.png"
+    return pictures / f"{name}-v{number}.png" if name and number is not None else None
 
 
 def write_task_gallery(versions: Mapping[str, TaskVersion], out: Path, pictures: Path | None = None,

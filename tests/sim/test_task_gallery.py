@@ -72,3 +72,18 @@ def test_a_reworded_version_takes_its_sources_picture_and_stale_pictures_go(tmp_
     assert set(Image.open(pic).getdata()) == {(0, 0, 255)}  # the source's, copied
     assert sorted(p.name for p in pictures.iterdir()) == [pic.name, "notes.txt"]
     assert f"tasks/{pic.name}" in out.read_text()
+
+
+def test_a_rewording_record_naming_no_task_id_gets_its_picture_drawn(tmp_path, task_copy):
+    """A task folder is untrusted: a reword record whose source is a path, a malformed id or no string at all is
+    no source picture, and the gallery draws the version's own (it crashed on a malformed id)."""
+    from gendex_envs.task_version import TaskLayout
+
+    src = task_copy("LiftApple", as_name="ScratchApple")
+    out = tmp_path / "docs" / "tasks.md"
+    for source in ("../../../etc/passwd", 42, "GenDex/ScratchApple"):
+        TaskLayout(src.root).record("reword").write_text(json.dumps({"source": source, "old": "a", "new": "b"}))
+        write_task_gallery({src.env_id: TaskVersion.at(src.root)}, out, size=64, rerender=True)
+        pic = tmp_path / "docs" / "tasks" / f"ScratchApple-v{src.version}.png"
+        assert len(set(Image.open(pic).getdata())) > 50, source  # drawn, not copied from anywhere
+
