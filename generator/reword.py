@@ -69,12 +69,18 @@ class LibraryWording:
         self._emb = embed_each(texts)[0] if texts else None
 
     def __call__(self, candidates: list[str]) -> str:
+        return self.scored(candidates)[0]
+
+    def scored(self, candidates: list[str]) -> tuple[str, float]:
+        """The candidate least like the instructions and its mean cosine to them (infinite when it reads like one
+        of them: a cosine of :data:`MAX_PAIR_COSINE` or more; 0.0 against no instructions)."""
         if not candidates:
             raise ValueError("no sentences to choose from")
-        if self._emb is None or len(candidates) == 1:
-            return candidates[0]
+        if self._emb is None:
+            return candidates[0], 0.0
         sims = embed(candidates)[0] @ self._emb.T
-        return candidates[_least_alike(sims, np.arange(len(candidates)))]
+        best = _least_alike(sims, np.arange(len(candidates)))
+        return candidates[best], float(sims[best].mean()) if sims[best].max() < MAX_PAIR_COSINE else float("inf")
 
 
 def _least_alike(sims: np.ndarray, allowed: np.ndarray) -> int:
@@ -129,9 +135,21 @@ class ProposalWording:
 
     def __call__(self, proposal: dict, library: Iterable[str]) -> dict:
         """``proposal`` worded least like ``library`` (unchanged for an empty library)."""
+        return self._worded(proposal, tuple(library))[0]
+
+    def least_alike(self, proposals: list[dict], library: Iterable[str]) -> dict:
+        """Of ``proposals`` (a few the author drew of one skill), each worded least like ``library``, the one whose
+        command reads least like the library's commands: a library grows towards what it does not say yet (on a
+        tie, as without the ``stats`` extra, the first)."""
+        if not proposals:
+            raise ValueError("no proposals to choose from")
         key = tuple(library)
+        worded = [self._worded(p, key) for p in proposals]
+        return min(worded, key=lambda w: w[1])[0]
+
+    def _worded(self, proposal: dict, key: tuple[str, ...]) -> tuple[dict, float]:
         if not key:
-            return proposal
+            return proposal, 0.0
         if self._library is None or self._library[0] != key:
             try:
                 used = Counter(x for t in key for x in split(t)[0::2] if x is not None)
@@ -141,17 +159,18 @@ class ProposalWording:
                 self._library = (key, None, None, Counter())
         _, choose, choose_command, used = self._library
         if choose is None:
-            return proposal
+            return proposal, 0.0
         try:
             frames = proposal_frames(proposal)
             command = split(proposal["description"])[1]
-            worded = choose_command(_command_wordings(command))
+            worded, score = choose_command.scored(_command_wordings(command))
             options = candidates_for(proposal["name"], proposal["description"], frames, command=worded)
         except RewordError as exc:
             log.info("kept the drawn wording: %s", exc)
-            return proposal
+            return proposal, float("inf")
         fresh = [o for o in options if all(x is None or used[x] < MAX_REUSE for x in split(o)[0::2])]
-        return dict(proposal, description=choose(fresh or options))  # no frame of the library used MAX_REUSE times
+        # no frame the library uses MAX_REUSE times
+        return dict(proposal, description=choose(fresh or options)), score
 
 
 PROPOSAL_WORDINGS = 60

@@ -110,6 +110,9 @@ TWO_IN_M = 0.2
 """A container the autonomous grammar puts two objects in is at least this wide (the large bowl, the pot)."""
 COMPOSE_STRIDE = 12
 """Each articulated first part is composed with every COMPOSE_STRIDE-th rigid task (a different slice for each)."""
+PROPOSAL_DRAWS = 4
+"""Tasks of the drawn skill the author words; it proposes the one whose command reads least like the library's
+(:meth:`generator.reword.ProposalWording.least_alike`)."""
 COMPOSED_WEIGHT = 2.0
 """How much likelier a composed task is drawn than the tasks of any one skill."""
 STACK_GAP_M = 0.03
@@ -150,9 +153,10 @@ class OfflineBackend:
     # ------------------------------------------------------------------ proposals
     def _propose(self, request: ModelRequest, ctx: dict) -> str:
         """A task of a skill drawn evenly from those with a task left to write (so a batch is not six "put X into
-        Y"), then one of that skill's tasks: never an existing name, nor a task with the skills and object kinds of
-        an existing one (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`); worded least like the
-        library's ``ctx["existing_instructions"]`` (:class:`generator.reword.ProposalWording`)."""
+        Y"), then of :data:`PROPOSAL_DRAWS` of that skill's tasks drawn, the one whose command reads least like the
+        library's ``ctx["existing_instructions"]``, worded least like them (:class:`generator.reword.ProposalWording`);
+        never an existing name, nor a task with the skills and object kinds of an existing one
+        (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`)."""
         existing = set(ctx.get("existing_tasks", []))
         taken = {tuple(map(tuple, s)) for s in ctx.get("existing_signatures", [])}
         rng = self._rng(request, ctx.get("index", 0), ctx.get("attempt", 0))
@@ -171,7 +175,8 @@ class OfflineBackend:
         skills = sorted(by_skill)
         weights = np.array([COMPOSED_WEIGHT if k == "composed" else 1.0 for k in skills])
         pool = by_skill[skills[int(rng.choice(len(skills), p=weights / weights.sum()))]]
-        chosen = self._wording(pool[int(rng.integers(len(pool)))], ctx.get("existing_instructions") or ())
+        drawn = rng.choice(len(pool), size=min(PROPOSAL_DRAWS, len(pool)), replace=False)
+        chosen = self._wording.least_alike([pool[int(i)] for i in drawn], ctx.get("existing_instructions") or ())
         return _fence("json", json.dumps(chosen, indent=2))
 
     def _words(self, name: str) -> np.random.Generator:

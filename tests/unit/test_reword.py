@@ -224,6 +224,26 @@ def test_the_author_frames_no_proposal_with_a_situation_the_library_already_uses
     assert not ProposalWording()(proposal, library)["description"].startswith(favourite)  # twice: not again
 
 
+def test_the_author_proposes_of_the_tasks_drawn_the_one_least_like_the_library(task_version):
+    """Of the few tasks of one skill the author draws, it proposes the one whose command the library says least
+    (a library of bowls gets the pot), whatever the order drawn, worded as it would be alone."""
+    def proposal(name, target):
+        spec = task_version(name).spec
+        return {"name": name, "description": spec.instruction,
+                "objects": [{"name": o.name, "asset": o.asset, "role": "graspable"} for o in spec.objects],
+                "steps": [], "success": {"type": "inside", "object": spec.objects[0].name, "target": target}}
+
+    pot, bowl = proposal("PutPlumInPot", "pot"), proposal("PutAppleBowl", "bowl")
+    library = ["Put the pear into the bowl.", "Drop the lemon in the bowl.", "Place the peach inside the bowl.",
+               "Close the drawer."]
+    author = ProposalWording()
+    assert author.least_alike([bowl, pot], library)["name"] == "PutPlumInPot"
+    assert author.least_alike([pot, bowl], library)["name"] == "PutPlumInPot"
+    assert author.least_alike([pot], library) == author(pot, library)
+    with pytest.raises(ValueError, match="no proposals"):
+        author.least_alike([], library)
+
+
 def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     """The left-hinged fridge's task proposed next to the right-hinged one's: the least-alike framing by the mean
     alone took the very frame the sibling had (cosine 0.99, and the proposal was dropped as a near-duplicate)."""
