@@ -31,7 +31,7 @@ import numpy as np
 from generator.command_templates import COMMANDS, PLACE_AT
 from generator.errors import InstructionError
 from generator.instruction import Reading, read_instruction
-from generator.phrasing import NAMES, SURFACES
+from generator.phrasing import NAMES, SURFACES, awkward
 
 STEP_JOINER = ", then "
 """How the offline author joins the steps of a composed command (:func:`generator.phrasing.phrase_parts`)."""
@@ -43,14 +43,26 @@ TEMPLATES: dict[str, tuple[str, ...]] = {**COMMANDS, "place_at": PLACE_AT}
 SLOTS = "odsapw"
 """Template slots: the object acted on, the destination or articulated object, the table, an amount, the pieces,
 where a placed object goes."""
+PLACES: tuple[tuple[str, ...], ...] = (
+    ("to the left of", "on the left side of", "left of"),
+    ("to the right of", "on the right side of", "right of"),
+    ("in front of", "just in front of", "on the near side of"),
+    ("behind", "just behind", "on the far side of", "at the back of"),
+    ("next to", "beside", "alongside", "close to", "near"),
+    ("between", "in between", "midway between"),
+    ("on the", "in the", "at the"),
+)
+"""Ways of saying where a placed object goes that mean the same (each row), by how the place phrase starts; the
+reader decides which of them, with what follows (*in the far right corner*, not *in the near side*), read alike."""
 PATTERNS = {
-    "w": r"(?:to the left of|to the right of|in front of|behind|next to|between|on the) .+",
+    "w": "(?:" + "|".join(sorted({p for row in PLACES for p in row}, key=len, reverse=True)) + ") .+",
     "a": r"(?:halfway|half|partly|partway|\d+ degrees|top |middle |bottom |)",
     "s": "|".join(SURFACES),
 }
 """What a slot matches where not any words: where a placed object goes (a relation and what follows, so *the tennis
 ball on the far side* never splits inside the object's name), how far (or which drawer), the table."""
-PLACE_WORDS = re.compile(r"\b((side|corner|middle|left|right|front) of|behind|between|next to)\b")
+PLACE_WORDS = re.compile(r"\b((side|corner|middle|left|right|front|back) of|behind|between|next to|beside|"
+                         r"alongside|near|close to)\b")
 """Words no object phrase of a template other than a place's has: a place read as an object (*lay the brick on
 the near right corner of the table*) is not a plate."""
 
@@ -108,11 +120,34 @@ def names(phrase: str) -> list[str]:
     return [phrase]
 
 
+def places(where: str) -> list[str]:
+    """``where`` (a placed object's place phrase) and the same place said the other ways of its row of
+    :data:`PLACES` (the longest start that matches), its objects by their other names (:func:`names`); a region of
+    the table only with *on*, *in* or *at* (not *in front of the table*)."""
+    if where.split()[-1] in SURFACES:  # a region: 'on the far right corner of the table'
+        start = next((p for p in PLACES[-1] if where.startswith(p + " ")), None)
+        if start is None:
+            return [where]
+        rest = where[len(start) + 1:]
+        row = (PLACES[-1] if "corner" in rest else ("in the", "at the") if re.search(r"\b(middle|centre)\b", rest)
+               else ("on the", "at the"))
+        return list(dict.fromkeys([where, *(f"{p} {rest}" for p in row)]))
+    start = next((p for p in sorted((p for row in PLACES for p in row), key=len, reverse=True)
+                  if where.startswith(p + " the ")), None)
+    if start is None:
+        return [where]
+    rest = where[len(start) + 5:]
+    row = next(r for r in PLACES if start in r)
+    objects = [names(o) for o in rest.split(" and the ")]
+    said = [" and the ".join(combo) for combo in itertools.product(*objects)]
+    return list(dict.fromkeys([where, *(f"{p} the {o}" for p in row for o in said)]))
+
+
 def _fill(template: str, slots: dict[str, str]) -> str | None:
     needed = set(re.findall(r"\{([a-z])\}", template))
     if not needed <= set(slots):
         return None
-    if any(re.search(r" (of|with) ", v) and f"{{{k}}}'s" in template for k, v in slots.items()):
+    if awkward(template, slots):
         return None  # not 'the chest of drawers's drawer', 'the box with a lid's lid'
     return template.format(**{k: slots.get(k, "") for k in SLOTS})
 
@@ -128,7 +163,8 @@ def clause_wordings(clause: str) -> list[str]:
         found = m.groupdict()
         if kind != "place_at" and any(PLACE_WORDS.search(found.get(k) or "") for k in "od"):
             continue
-        choices = {k: (names(v) if k in "od" else list(SURFACES) if k == "s" else [v]) for k, v in found.items()}
+        choices = {k: (names(v) if k in "od" else list(SURFACES) if k == "s" else places(v) if k == "w" else [v])
+                   for k, v in found.items()}
         keys = sorted(choices)
         for values in itertools.product(*(choices[k] for k in keys)):
             slots = dict(zip(keys, values, strict=True))
@@ -211,4 +247,5 @@ def wordings(command: str, assets: Sequence[dict], limit: int = MAX_WORDINGS, se
     return out
 
 
-__all__ = ["MAX_WORDINGS", "STEP_JOINER", "TEMPLATES", "VERBS", "clause_wordings", "names", "reading_key", "wordings"]
+__all__ = ["MAX_WORDINGS", "PLACES", "STEP_JOINER", "TEMPLATES", "VERBS", "clause_wordings", "names", "places",
+           "reading_key", "wordings"]

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from generator.errors import InstructionError
+from generator.phrasing import SURFACES
 
 
 def find(words: Sequence[str], phrase: str, start: int = 0) -> int:
@@ -154,14 +155,21 @@ REGION_PHRASES: tuple[tuple[str, str], ...] = (
     ("far end", "far"), ("back of the table", "far"), ("near side", "near"), ("front of the table", "near"),
     ("left side", "left"), ("right side", "right"), ("middle of the table", "centre"),
     ("centre of the table", "centre"), ("center of the table", "centre"), ("left of the table", "left"),
-    ("right of the table", "right"), ("to the left", "left"), ("to the right", "right"), ("on the left", "left"),
-    ("on the right", "right"), ("leftward", "left"), ("rightward", "right"))
-"""Phrases naming a region of the table (``placed`` with ``in_region``), longest first."""
+    ("right of the table", "right"), ("near edge", "near"), ("front edge", "near"), ("far edge", "far"),
+    ("back edge", "far"), ("left edge", "left"), ("right edge", "right"), ("to the left", "left"),
+    ("to the right", "right"), ("on the left", "left"), ("on the right", "right"), ("leftward", "left"),
+    ("rightward", "right"))
+"""Phrases naming a region of the table (``placed`` with ``in_region``), longest first; one followed by *of* and an
+object names a side of that object (*on the left side of the bowl*: :data:`RELATION_PHRASES`)."""
 RELATION_PHRASES: tuple[tuple[str, str], ...] = (
-    ("to the left of", "left_of"), ("to the right of", "right_of"), ("left of", "left_of"),
-    ("right of", "right_of"), ("in front of", "in_front_of"), ("behind", "behind"), ("next to", "next_to"),
-    ("beside", "next_to"), ("alongside", "next_to"), ("between", "between"))
-"""Phrases naming a place relative to other objects (``placed``)."""
+    ("to the left of", "left_of"), ("to the right of", "right_of"), ("left side of", "left_of"),
+    ("right side of", "right_of"), ("left of", "left_of"), ("right of", "right_of"), ("in front of", "in_front_of"),
+    ("near side of", "in_front_of"), ("front side of", "in_front_of"), ("far side of", "behind"),
+    ("back side of", "behind"), ("at the back of", "behind"), ("behind", "behind"), ("next to", "next_to"),
+    ("beside", "next_to"), ("alongside", "next_to"), ("close to", "next_to"), ("near to", "next_to"),
+    ("near", "next_to"), ("between", "between"))
+"""Phrases naming a place relative to other objects (``placed``), longest first where one holds another (a side
+*near* an object is beside it: *set the lemon near the plate* is not *on* it)."""
 
 
 def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
@@ -170,10 +178,12 @@ def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
     *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``."""
     for phrase, region in REGION_PHRASES:
         k = find(words, phrase)
-        if k >= 0 and not (phrase.startswith("to the") and words[k + 3:k + 4] == ["of"]):
-            n = len(phrase.split())
-            after = words[k + n:k + n + 3]
-            extra = 3 if after == ["of", "the", "table"] else 0
+        n = len(phrase.split())
+        after = words[k + n:k + n + 3]
+        beyond = words[k + n + (after[:1] == ["side"]):][:3]  # 'on the left' of 'on the left side of the bowl'
+        of_object = beyond[:1] == ["of"] and not set(beyond[1:3]) & set(SURFACES)  # the left side of the bowl
+        if k >= 0 and not of_object:
+            extra = 1 + (after[1:2] == ["the"]) + 1 if after[:1] == ["of"] else 0
             return "in_region", region, set(range(k, k + n + extra))
     for phrase, relation in RELATION_PHRASES:
         k = find(words, phrase)

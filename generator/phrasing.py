@@ -22,6 +22,7 @@ library's instructions: :mod:`generator.reword`). :func:`split` takes a written 
 from __future__ import annotations
 
 import functools
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -295,8 +296,17 @@ def command(part: Part, rng: np.random.Generator, surface: str) -> str:
     o = _pick(rng, names_for(part.main, part.main_qualifier or MODEL_WORDS.get(part.main["id"], "")))
     d = _pick(rng, names_for(part.other, part.other_qualifier)) if part.other is not None else o
     p = _pick(rng, PIECE_NAMES.get(part.pieces, (part.pieces.replace("_", " ") + "s",))) if part.pieces else ""
-    return _pick(rng, COMMANDS[part.skill]).format(o=o, d=d if not articulated else o, s=surface, a=part.amount,
-                                                   p=p)
+    slots = dict(o=o, d=d if not articulated else o, s=surface, a=part.amount, p=p)
+    template = _pick(rng, COMMANDS[part.skill])
+    if awkward(template, slots):  # another of the skill's templates (drawn as before where the first one reads well)
+        template = _pick(rng, [t for t in COMMANDS[part.skill] if not awkward(t, slots)] or [template])
+    return template.format(**slots)
+
+
+def awkward(template: str, slots: dict[str, str]) -> bool:
+    """Whether ``template`` filled with ``slots`` makes a possessive of a name with *of* or *with* in it (*the
+    chest of drawers's drawer*, *the box with a lid's lid*)."""
+    return any(re.search(r" (of|with) ", v) and f"{{{k}}}'s" in template for k, v in slots.items())
 
 
 def qualifiers(a: dict, b: dict | None, colors: tuple[str | None, ...] = ()) -> dict[str, str]:
@@ -426,5 +436,6 @@ def split(instruction: str) -> tuple[str | None, str, str | None]:
 
 
 __all__ = ["COMMANDS", "MODEL_WORDS", "NAMES", "PIECE_NAMES", "PLACE_AT", "PURPOSES", "PURPOSES_DIRECTED", "SITUATIONS",
-           "SITUATIONS_DIRECTED", "Chooser", "Frame", "Part", "command", "direction", "domain", "framings", "names_for",
-           "object_words", "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations", "split"]
+           "SITUATIONS_DIRECTED", "Chooser", "Frame", "Part", "awkward", "command", "direction", "domain", "framings",
+           "names_for", "object_words", "phrase", "painted", "phrase_parts", "purposes", "qualifiers", "situations",
+           "split"]

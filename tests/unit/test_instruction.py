@@ -387,3 +387,9 @@ def test_steps_said_with_commas_are_steps_and_a_bare_inside_is_the_step_befores_
     assert [x.objects[0].asset for x in (r, *r.then)] == ["apple", "lemon", "plum"]
     with pytest.raises(InstructionError):  # a step it cannot read is refused, never dropped
         read("open the drawer, juggle the golf ball, then close it")
+
+
+def test_a_bare_part_after_an_object_named_by_that_part_is_not_said_twice():
+    r = read_instruction("put the pear in the drawer, then close the drawer", asset_dicts())
+    assert [x.skill for x in (r, *r.then)] == ["put_in", "close"]
+    assert r.then[0].instruction == "close the drawer"
