@@ -172,10 +172,12 @@ RELATION_PHRASES: tuple[tuple[str, str], ...] = (
 *near* an object is beside it: *set the lemon near the plate* is not *on* it)."""
 
 
-def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
+def read_place(words: list[str], beside_by: bool = False) -> tuple[str | None, str | None, set[int]]:
     """``(relation, region, where its words are)``: where the request sets something down, seen from the robot
     (*to the left of the bowl*: ``left_of``; *on the far right corner of the table*: ``in_region``, ``far_right``;
-    *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``."""
+    *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``. With ``beside_by`` (a request that
+    sets something down and says neither *in* nor *on*), *by the plate* is beside it (*lift the mug by its handle*
+    is not a place)."""
     for phrase, region in REGION_PHRASES:
         k = find(words, phrase)
         n = len(phrase.split())
@@ -189,6 +191,9 @@ def read_place(words: list[str]) -> tuple[str | None, str | None, set[int]]:
         k = find(words, phrase)
         if k >= 0:
             return relation, None, set(range(k, k + len(phrase.split())))
+    k = find(words, "by")
+    if beside_by and k >= 0 and words[k + 1:k + 2] in (["the"], ["a"], ["an"]):
+        return "next_to", None, {k}
     if words and words[-1] in ("left", "right"):  # 'push the block left' (a model's qualifier is checked later)
         return "in_region", words[-1], {len(words) - 1}
     return None, None, set()
