@@ -102,7 +102,7 @@ TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
               "press", "hand_over", "twist", "insert", "wipe", "hang", "pour", "flip",
               "several", "composed")
-"""The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend._task_options`): a task skill, a door
+"""The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend.task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``: none while no lever's layout
 is measured turning part way, see :mod:`generator.backends.layouts`), or two tasks in turn
 (``composed``), or several objects (``several``: two put in one container, a tower of blocks)."""
@@ -163,7 +163,7 @@ class OfflineBackend:
         from generator.novelty import proposal_signature
 
         by_skill: dict[str, list[dict]] = {}
-        options = self._task_options(ctx["assets"])
+        options = self.task_options(ctx["assets"])
         for skill, proposal in options:
             if (proposal["name"] not in existing and proposal_signature(proposal) not in taken
                     and (self.kinds is None or skill in self.kinds)):
@@ -184,7 +184,7 @@ class OfflineBackend:
         same sentence, whatever else the author was asked."""
         return np.random.default_rng([self.seed, zlib.crc32(name.encode())])
 
-    def _task_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
+    def task_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
         """Every task this grammar can write from ``assets``, each with its task skill."""
         g = [a for a in assets if graspable(a)]
         m = [a for a in g if carried(a)]  # carried to a place; g are lifted

@@ -243,7 +243,7 @@ def test_an_object_the_solver_lifts_but_does_not_carry_is_lifted_and_never_set_d
                  "hand me the cracker box", "put the cracker box to the left of the bowl"):
         with pytest.raises(InstructionError, match=r"cannot be the object .*lifted, not carried: carried and set down"):
             _guided(OfflineBackend(seed=1), text)
-    options = OfflineBackend(seed=1)._task_options(list(asset_dicts()))
+    options = OfflineBackend(seed=1).task_options(list(asset_dicts()))
     with_box = {k for k, raw in options if any(o["asset"] == "cracker_box" for o in raw["objects"])}
     assert with_box <= {"lift", "composed"}, with_box
     assert all(raw["steps"][-1]["skill"] != "release" for k, raw in options if k == "composed"

@@ -96,7 +96,7 @@ def test_a_part_way_or_turned_off_joint_is_another_task_than_all_the_way():
     from generator.novelty import proposal_signature
 
     by_kind: dict[str, set] = {}
-    for k, p in OfflineBackend(seed=0)._task_options(list(asset_dicts())):
+    for k, p in OfflineBackend(seed=0).task_options(list(asset_dicts())):
         by_kind.setdefault(k, set()).add(proposal_signature(p))
     part_turns = by_kind.get("turn_part", set())  # none while no lever is measured turning part way
     assert by_kind["open_part"] and all(("part_way" in s[0]) for s in by_kind["open_part"] | part_turns)

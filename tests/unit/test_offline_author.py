@@ -167,7 +167,7 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=3)
-    options = [o for skill, o in b._task_options(list(asset_dicts())) if skill != "composed"]
+    options = [o for skill, o in b.task_options(list(asset_dicts())) if skill != "composed"]
     picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn", "Press", "Unscrew"))
               and not o["name"].endswith(("Half", "Degrees"))
               or (o["name"].startswith("Open") and o["objects"][0]["asset"] in {i for _, i in ARTICULATED_LAYOUTS})]
@@ -208,7 +208,7 @@ def test_a_lid_opened_before_other_steps_is_laid_out_where_it_can_be_pushed_past
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=4)
-    options = b._task_options(list(asset_dicts()))
+    options = b.task_options(list(asset_dicts()))
     checked = set()
     for asset in ("box_with_lid_large", "trash_can_tall"):
         layout = ARTICULATED_LAYOUTS["open", asset]
@@ -248,7 +248,7 @@ def test_scenes_may_carry_clutter_that_no_stage_or_condition_names():
     from generator.steps.scene import MAX_DISTRACTORS
 
     b = OfflineBackend(seed=5)
-    raw = next(o for skill, o in b._task_options(list(asset_dicts())) if skill == "put_in")
+    raw = next(o for skill, o in b.task_options(list(asset_dicts())) if skill == "put_in")
     p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
     ids = {o.asset for o in p.objects}
     seen = 0
@@ -279,7 +279,7 @@ def test_clutter_in_a_composed_task_keeps_out_of_the_way_of_the_door_the_hand_wo
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=7)
-    composed = [o for skill, o in b._task_options(list(asset_dicts())) if skill == "composed"]
+    composed = [o for skill, o in b.task_options(list(asset_dicts())) if skill == "composed"]
     sided = 0
     for i, raw in enumerate(composed[::5]):
         p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
@@ -311,7 +311,7 @@ def test_composed_tasks_do_two_parts_in_turn_and_check_both():
     from generator.steps.propose import parse_proposal
 
     b = OfflineBackend(seed=2)
-    composed = [o for skill, o in b._task_options(list(asset_dicts())) if skill == "composed"]
+    composed = [o for skill, o in b.task_options(list(asset_dicts())) if skill == "composed"]
     assert len(composed) >= 50
     for i, raw in enumerate(composed[::25]):
         p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
@@ -576,7 +576,7 @@ def test_every_task_the_grammar_can_write_is_a_valid_proposal_with_distinct_obje
     p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")
     assert [o.name for o in p.objects] == ["apple", "bowl", "bowl_large"]
 
-    options = OfflineBackend(seed=1)._task_options(list(asset_dicts()))
+    options = OfflineBackend(seed=1).task_options(list(asset_dicts()))
     kinds = {k for k, _ in options}
     from generator.backends.layouts import ARTICULATED_LAYOUTS
 

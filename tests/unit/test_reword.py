@@ -331,7 +331,7 @@ def test_a_place_task_is_framed_by_the_object_it_moves():
     from generator.backends.offline import OfflineBackend
     from generator.reword import proposal_frames
 
-    options = OfflineBackend(seed=1)._task_options(list(asset_dicts()))
+    options = OfflineBackend(seed=1).task_options(list(asset_dicts()))
     placed = next(raw for kind, raw in options if kind == "place_at")
     first, last = proposal_frames(placed)
     assert first == last and first.domain and first.direction is None  # the moved object's domain
