@@ -96,7 +96,8 @@ def _with_previous(step: str, previous: Reading, read_one: Callable[[str], Readi
     first_error: InstructionError | None = None
     for m in previous.objects:
         name = f"the {m.color + ' ' if m.color else ''}{m.phrase}"
-        whole = name if part is None or name.endswith(" " + part.group(2)) else f"{name} {part.group(2)}"
+        said = part is not None and m.part == part.group(2) and name.endswith(" " + part.group(2))  # 'the drawer'
+        whole = name if part is None or said else f"{name} {part.group(2)}"
         tried = (_PRONOUN.sub(name, step) if pronoun else _BARE_PART.sub(whole, step) if part
                  else f"{step} {name}")  # 'put the ball inside': inside the step before's object
         # ('close the drawer' after 'the drawer' stays that, not 'the drawer drawer')
