@@ -47,13 +47,14 @@ PLACES: tuple[tuple[str, ...], ...] = (
     ("to the left of", "on the left side of", "left of"),
     ("to the right of", "on the right side of", "right of"),
     ("in front of", "just in front of", "on the near side of"),
-    ("behind", "just behind", "on the far side of", "at the back of"),
+    ("behind", "just behind", "on the far side of"),
     ("next to", "beside", "alongside", "close to", "near"),
     ("between", "in between", "midway between"),
-    ("on the", "in the", "at the"),
+    ("on the", "in the"),
 )
 """Ways of saying where a placed object goes that mean the same (each row), by how the place phrase starts; the
-reader decides which of them, with what follows (*in the far right corner*, not *in the near side*), read alike."""
+reader decides which of them, with what follows (*in the far right corner*, not *in the near side*), read alike.
+None starts with *at*: *move the ball at the corner* is what *move* makes of it."""
 PATTERNS = {
     "w": "(?:" + "|".join(sorted({p for row in PLACES for p in row}, key=len, reverse=True)) + ") .+",
     "a": r"(?:halfway|half|partly|partway|\d+ degrees|top |middle |bottom |)",
@@ -123,14 +124,13 @@ def names(phrase: str) -> list[str]:
 def places(where: str) -> list[str]:
     """``where`` (a placed object's place phrase) and the same place said the other ways of its row of
     :data:`PLACES` (the longest start that matches), its objects by their other names (:func:`names`); a region of
-    the table only with *on*, *in* or *at* (not *in front of the table*)."""
+    the table only with *on* or *in* (not *in front of the table*; *in* only for a corner or the middle)."""
     if where.split()[-1] in SURFACES:  # a region: 'on the far right corner of the table'
         start = next((p for p in PLACES[-1] if where.startswith(p + " ")), None)
         if start is None:
             return [where]
         rest = where[len(start) + 1:]
-        row = (PLACES[-1] if "corner" in rest else ("in the", "at the") if re.search(r"\b(middle|centre)\b", rest)
-               else ("on the", "at the"))
+        row = PLACES[-1] if re.search(r"\b(corner|middle|centre)\b", rest) else ("on the",)
         return list(dict.fromkeys([where, *(f"{p} {rest}" for p in row)]))
     start = next((p for p in sorted((p for row in PLACES for p in row), key=len, reverse=True)
                   if where.startswith(p + " the ")), None)
