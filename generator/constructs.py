@@ -166,33 +166,38 @@ RELATION_PHRASES: tuple[tuple[str, str], ...] = (
     ("right side of", "right_of"), ("left of", "left_of"), ("right of", "right_of"), ("in front of", "in_front_of"),
     ("near side of", "in_front_of"), ("front side of", "in_front_of"), ("far side of", "behind"),
     ("back side of", "behind"), ("at the back of", "behind"), ("behind", "behind"), ("next to", "next_to"),
-    ("beside", "next_to"), ("alongside", "next_to"), ("close to", "next_to"), ("near to", "next_to"),
-    ("near", "next_to"), ("between", "between"))
-"""Phrases naming a place relative to other objects (``placed``), longest first where one holds another (a side
-*near* an object is beside it: *set the lemon near the plate* is not *on* it)."""
+    ("beside", "next_to"), ("alongside", "next_to"), ("between", "between"))
+"""Phrases naming a place relative to other objects (``placed``), longest first where one holds another."""
+NEAR_PHRASES = ("close to", "near to", "near")
+"""Phrases that name a place beside an object only where something is set down there (*set the lemon near the plate*
+is not *on* it); elsewhere they say which object (*lift the apple near the bowl*)."""
+_IN_OR_ON = frozenset({"in", "into", "inside", "on", "onto", "upon"})
 
 
-def read_place(words: list[str], beside_by: bool = False) -> tuple[str | None, str | None, set[int]]:
+def read_place(words: list[str], setting_down: bool = False) -> tuple[str | None, str | None, set[int]]:
     """``(relation, region, where its words are)``: where the request sets something down, seen from the robot
     (*to the left of the bowl*: ``left_of``; *on the far right corner of the table*: ``in_region``, ``far_right``;
-    *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``. With ``beside_by`` (a request that
-    sets something down and says neither *in* nor *on*), *by the plate* is beside it (*lift the mug by its handle*
-    is not a place)."""
+    *push the block left*: ``in_region``, ``left``), or ``(None, None, set())``. With ``setting_down`` (a put, set
+    or push), *near the plate* (:data:`NEAR_PHRASES`) is beside it, and so is *by the plate* where nothing is put in
+    or on (*lift the mug by its handle* is no place)."""
     for phrase, region in REGION_PHRASES:
         k = find(words, phrase)
+        if k < 0:
+            continue
         n = len(phrase.split())
         after = words[k + n:k + n + 3]
         beyond = words[k + n + (after[:1] == ["side"]):][:3]  # 'on the left' of 'on the left side of the bowl'
-        of_object = beyond[:1] == ["of"] and not set(beyond[1:3]) & set(SURFACES)  # the left side of the bowl
-        if k >= 0 and not of_object:
-            extra = 1 + (after[1:2] == ["the"]) + 1 if after[:1] == ["of"] else 0
-            return "in_region", region, set(range(k, k + n + extra))
-    for phrase, relation in RELATION_PHRASES:
+        if beyond[:1] == ["of"] and not set(beyond[1:3]) & set(SURFACES):  # the left side of the bowl
+            continue
+        extra = 1 + (after[1:2] == ["the"]) + 1 if after[:1] == ["of"] else 0
+        return "in_region", region, set(range(k, k + n + extra))
+    near = tuple((p, "next_to") for p in NEAR_PHRASES) if setting_down else ()
+    for phrase, relation in RELATION_PHRASES + near:
         k = find(words, phrase)
         if k >= 0:
             return relation, None, set(range(k, k + len(phrase.split())))
     k = find(words, "by")
-    if beside_by and k >= 0 and words[k + 1:k + 2] in (["the"], ["a"], ["an"]):
+    if setting_down and k >= 0 and words[k + 1:k + 2] in (["the"], ["a"], ["an"]) and not set(words) & _IN_OR_ON:
         return "next_to", None, {k}
     if words and words[-1] in ("left", "right"):  # 'push the block left' (a model's qualifier is checked later)
         return "in_region", words[-1], {len(words) - 1}

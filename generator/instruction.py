@@ -374,8 +374,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
         mentions.append(Mention(phrase, match[0]["id"], how, part, options=tuple(a["id"] for a in match)))
         at.append(i)
     # kind words ('a fruit') and unknown nouns, outside the catalog phrases and the verb
-    relation, region, at_place = read_place(words, beside_by=skill in ("put_in", "place_on") and not set(words) & {
-        *_INTO, "onto", "on", "upon"})
+    relation, region, at_place = read_place(words, setting_down=skill in ("put_in", "place_on", "push"))
     no_object = amount_words(words) | at_place  # the words of an amount or a place
     unknown = []
     unread = []  # words no part of the reading takes: said in a note

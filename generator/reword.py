@@ -69,7 +69,7 @@ class LibraryWording:
         self._emb = embed_each(texts)[0] if texts else None
 
     def __call__(self, candidates: list[str]) -> str:
-        return self.scored(candidates)[0]
+        return candidates[0] if len(candidates) == 1 else self.scored(candidates)[0]
 
     def scored(self, candidates: list[str]) -> tuple[str, float]:
         """The candidate least like the instructions and its mean cosine to them (infinite when it reads like one

@@ -393,3 +393,14 @@ def test_a_bare_part_after_an_object_named_by_that_part_is_not_said_twice():
     r = read_instruction("put the pear in the drawer, then close the drawer", asset_dicts())
     assert [x.skill for x in (r, *r.then)] == ["put_in", "close"]
     assert r.then[0].instruction == "close the drawer"
+
+
+@pytest.mark.parametrize("text", ["lift the apple near the bowl", "lift the mug by its handle"])
+def test_near_or_by_says_which_object_where_nothing_is_set_down(text):
+    """'near the bowl' is a place only for a put, set or push: after 'lift' it says which apple (here a refusal,
+    the bowl having no part in a lift), never a place_at the person did not ask for."""
+    try:
+        r = read_instruction(text, asset_dicts())
+    except InstructionError:
+        return
+    assert r.skill == "lift" and r.relation is None
