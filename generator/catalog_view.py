@@ -29,4 +29,12 @@ def asset_dict(asset_id: str) -> dict:
 
 
 def guidance() -> str:
-    return guidance_text()
+    """The catalog block of the proposal prompts, the graspable-tagged objects the solver does not reliably hold
+    (below :data:`~generator.backends.roles.MIN_GRASP_RATE` in ``benchmarks/grasp.py``'s record) marked as such."""
+    from gendex.solve.lift_check import measured_rates
+    from generator.backends.roles import MIN_GRASP_RATE
+
+    rates = measured_rates()
+    weak = {a["id"]: f"held in {rates[a['id']]:.0%} of recorded lifts" for a in asset_dicts()
+            if "graspable" in a["tags"] and rates.get(a["id"], 1.0) < MIN_GRASP_RATE}
+    return guidance_text(weak)

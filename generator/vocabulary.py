@@ -126,6 +126,26 @@ SYNONYMS: dict[str, str] = {
     "jam jar": "jar", "glass jar": "jar", "mason jar": "jar", "kitchen canister": "canister",
     "tin canister": "canister",
     "wide mouth bottle": "screw_bottle", "water bottle": "screw_bottle", "sports bottle": "screw_bottle",
+    # everyday objects (gendex_envs.assets.procedural_household)
+    "kiwifruit": "kiwi", "kiwi fruit": "kiwi", "capsicum": "bell_pepper", "sweet pepper": "bell_pepper",
+    "pepper": "bell_pepper", "spud": "potato", "garlic bulb": "garlic",
+    "head of garlic": "garlic", "hen's egg": "egg", "salt": "salt_shaker", "salt cellar": "salt_shaker",
+    "shaker": "salt_shaker", "pepper grinder": "pepper_mill", "grinder": "pepper_mill", "spice": "spice_jar",
+    "yoghurt cup": "yogurt_cup", "yogurt pot": "yogurt_cup", "pot of yogurt": "yogurt_cup",
+    "carton of milk": "milk_carton", "juice carton": "juice_box", "juice": "juice_box",
+    "drink box": "juice_box", "wax candle": "candle", "pillar candle": "candle", "shampoo": "shampoo_bottle",
+    "bottle of shampoo": "shampoo_bottle", "toothpaste": "toothpaste_tube", "tube of toothpaste": "toothpaste_tube",
+    "soap": "soap_bar", "bar of soap": "soap_bar", "desk bell": "service_bell", "bell": "service_bell",
+    "torch": "flashlight", "tape": "tape_roll", "roll of tape": "tape_roll", "duct tape": "tape_roll",
+    "roll of duct tape": "tape_roll",
+    "sticky tape": "tape_roll", "billiard ball": "pool_ball", "snooker ball": "pool_ball",
+    "bouncy ball": "rubber_ball", "king": "chess_king", "rook": "chess_rook", "castle": "chess_rook",
+    "car": "toy_car", "model car": "toy_car", "teddy": "teddy_bear",
+    "bear": "teddy_bear", "stuffed bear": "teddy_bear", "wicker basket": "basket", "fruit basket": "basket",
+    "casserole dish": "baking_dish", "oven dish": "baking_dish", "roasting dish": "baking_dish",
+    "crate": "storage_bin", "tub": "storage_bin", "plastic bin": "storage_bin", "place mat": "placemat",
+    "table mat": "placemat", "baking tray": "baking_sheet", "sheet pan": "baking_sheet",
+    "cookie sheet": "baking_sheet", "oven tray": "baking_sheet",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 
@@ -134,6 +154,7 @@ POUR_VESSELS: dict[str, str] = {"glass": "tumbler", "cup": "paper_cup", "beaker"
 not a wine glass; a cup of them a paper cup, not a teacup)."""
 
 KINDS: dict[str, str] = {"fruit": "fruit", "ball": "ball", "toy": "toy", "block": "block", "food": "food",
+                         "vegetable": "vegetable", "veggie": "vegetable", "toiletry": "toiletry",
                          "tool": "tool", "utensil": "utensil", "container": "container", "box": "box",
                          "thing": "graspable", "object": "graspable", "item": "graspable"}
 """Words naming a kind of object (a catalog tag): 'a fruit' is any fruit; which one is a recorded choice."""

@@ -40,12 +40,26 @@ def catalog_json() -> dict:
     }
 
 
-def guidance_text() -> str:
-    """The block of text the proposal prompts get: every asset id with category, real size, mass and joints."""
+def guidance_text(not_graspable: dict[str, str] | None = None) -> str:
+    """The block of text the proposal prompts get: the rigid objects grouped by category (the tags its objects share,
+    then each id with its real size and mass, and what sets it apart), then every articulated asset with its
+    joints. ``not_graspable``: ids the hand does not reliably hold, with why (marked, so a prompt does not ask it
+    to grasp them)."""
+    not_graspable = not_graspable or {}
     records = sorted(catalog().values(), key=lambda r: (r.articulated, r.category, r.id))
-    lines = ["Objects (id | category | size cm x*y*z at scale 1 | mass kg | tags):"]
-    lines += [f"- {r.id} | {r.category} | {_cm(r.size_m)} | {r.mass_kg:.3g} | {', '.join(r.tags)}"
-              for r in records if not r.articulated]
+    rigid = [r for r in records if not r.articulated]
+    lines = ["Objects by category (the tags its objects share: each id, size cm x*y*z at scale 1, mass kg):"]
+    for category in dict.fromkeys(r.category for r in rigid):
+        group = [r for r in rigid if r.category == category]
+        shared = [t for t in group[0].tags if all(t in r.tags for r in group)]
+        items = []
+        for r in group:
+            extra = [t for t in r.tags if t not in shared]
+            why = not_graspable.get(r.id)
+            notes = extra + ([f"not graspable: {why}"] if why else [])
+            items.append(f"{r.id} {_cm(r.size_m)}, {r.mass_kg:.3g}"
+                         + (f" ({'; '.join(notes)})" if notes else ""))
+        lines.append(f"- {category} ({', '.join(shared)}): " + "; ".join(items))
     lines += ["", "Articulated objects (id | category | size cm | base | joints: name type [limits] closed->open, "
                   "handle link):"]
     for r in (r for r in records if r.articulated):

@@ -84,7 +84,7 @@ def _fruit_profile(R, H, n=24, top_bulge=0.0, top_dimple=0.0, bottom_dimple=0.0,
     return np.column_stack([r, z])
 
 
-def _fruit(asset_id, profile, mass, rgba, amp, splits=(), stem=None, friction=0.9, lying=False, flat=None):
+def _fruit(asset_id, profile, mass, rgba, amp, splits=(), stem=None, friction=0.9, lying=False, flat=None, tags=FRUIT):
     """A solid of revolution with seeded asymmetry, optional stem (length cm) at the top, optional flat bottom
     (the profile cut at z = ``flat``, so it stands instead of rocking). Hulls: per band, the poles and at most 7
     rings of 16 points (<= 114 vertices), always including the lowest and the widest one."""
@@ -118,7 +118,7 @@ def _fruit(asset_id, profile, mass, rgba, amp, splits=(), stem=None, friction=0.
         parts.convex(cyl_between(base, tip, 0.17, 0.13, n=8))
     if lying:
         parts.transform(rot("y", 90))
-    return _done(parts, id=asset_id, category=asset_id, tags=FRUIT, mass_kg=mass, friction=friction, rgba=rgba,
+    return _done(parts, id=asset_id, category=asset_id, tags=tags, mass_kg=mass, friction=friction, rgba=rgba,
                  source=SOURCE_REVOLVE, params={"amp": amp})
 
 
@@ -598,8 +598,8 @@ _register("fork", _fork)
 _register("knife", _knife)
 
 
-# registers the hooks a mug hangs on, the beads a vessel pours and the vessels that pour them
-from gendex_envs.assets import procedural_hanging, procedural_pouring  # noqa: E402,F401
+# registers the hooks a mug hangs on, the beads a vessel pours and the vessels that pour them, and the everyday objects
+from gendex_envs.assets import procedural_hanging, procedural_household, procedural_pouring  # noqa: E402,F401
 
 
 def build_all() -> list[ProceduralShape]:

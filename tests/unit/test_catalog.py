@@ -1,13 +1,17 @@
 """The catalog as users and prompts see it: `gendex assets --json` / `--guidance`, and lookup errors."""
 
 import json
+import re
 
 import pytest
 from typer.testing import CliRunner
 
 from gendex.cli import app
-from gendex_envs.assets.catalog import get_asset
+from gendex.solve.lift_check import measured_rates
+from gendex_envs.assets.catalog import catalog, get_asset
+from gendex_envs.assets.guidance import guidance_text
 from gendex_envs.errors import AssetNotFoundError
+from generator.backends.roles import MIN_GRASP_RATE
 
 
 @pytest.fixture(scope="module")
@@ -47,9 +51,27 @@ def test_guidance_names_every_asset_with_size():
     result = CliRunner().invoke(app, ["assets", "--guidance"])
     assert result.exit_code == 0
     text = result.output
-    for asset_id in ("apple", "bowl", "cabinet_left_hinge", "drawer_chest_2"):
+    for asset_id in ("cabinet_left_hinge", "drawer_chest_2"):
         assert f"- {asset_id} |" in text
     assert "door_hinge revolute [0, 1.9] 0->1.4, handle door" in text
+    # rigid objects one line per category: the tags they share, then each id with size and mass
+    assert "- bowl (graspable, container, tableware, kitchenware): bowl 15.0 x 15.0 x 6.3, 0.25; bowl_large 22" in text
+    assert "- apple (graspable, food, fruit): apple 7.5 x 7.7 x 7.0, 0.15; apple_scan 8.0 x 7.8 x 8.8, 0.16 " \
+           "(textured)" in text
+    for r in catalog().values():
+        assert f" {r.id} " in text or f"- {r.id} |" in text, r.id
+
+
+def test_guidance_marks_objects_the_hand_does_not_hold():
+    from generator.catalog_view import guidance
+
+    text = guidance_text({"apple": "held in 50 % of recorded lifts"})
+    assert "apple 7.5 x 7.7 x 7.0, 0.15 (not graspable: held in 50 % of recorded lifts)" in text
+    assert "(not graspable" not in guidance_text()
+    text, rates = guidance(), measured_rates()
+    for asset_id, rate in rates.items():  # each measured object is marked exactly when it is held too rarely
+        marked = re.search(rf"[:;] {asset_id} [^;\n]*\(not graspable: held in \d+% of recorded lifts\)", text)
+        assert bool(marked) == (rate < MIN_GRASP_RATE), asset_id
 
 
 def test_unknown_asset_suggests_close_ids():

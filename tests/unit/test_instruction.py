@@ -53,8 +53,8 @@ def test_synonyms_and_variants_are_recorded_with_every_asset_they_may_mean():
 
 
 def test_objects_the_catalog_lacks_are_substituted_and_said_so():
-    r = read("grab the mango")
-    assert r.substitutions == {"mango": r.objects[0].asset}
+    r = read("grab the apricot")
+    assert r.substitutions == {"apricot": r.objects[0].asset}
     assert "SUBSTITUTED" in "\n".join(r.lines())
     r = read("put the dragon fruit in the bowl")  # one phrase, replaced by a fruit
     assert list(r.substitutions) == ["dragon fruit"]
@@ -84,8 +84,8 @@ def test_the_proposal_records_the_reading_and_the_offline_author_keeps_to_it():
     assert p.reading["skill"] == "close" and [o.asset for o in p.objects] == ["trash_can_small"]
     assert p.success["type"] == "joint_open" and p.success["negate"] is True
     assert p.substitutions == {}
-    p, _ = propose(OfflineBackend(seed=0), instruction="grab the mango")
-    assert p.substitutions == {"mango": p.objects[0].asset} and p.reading["substitutions"] == p.substitutions
+    p, _ = propose(OfflineBackend(seed=0), instruction="grab the apricot")
+    assert p.substitutions == {"apricot": p.objects[0].asset} and p.reading["substitutions"] == p.substitutions
     # 'tap' means either faucet: one with a measured layout is used, no substitution
     p, _ = propose(OfflineBackend(seed=0), instruction="turn on the tap")
     assert p.objects[0].asset in ("faucet_lever_swivel", "faucet_lever_lift") and p.substitutions == {}

@@ -49,8 +49,8 @@ def test_a_batch_can_be_held_to_some_kinds_of_task():
 
 
 def test_guided_proposal_substitutes_the_closest_catalog_object():
-    p, _ = propose(OfflineBackend(seed=0), instruction="grab the mango")
-    assert p.substitutions == {"mango": p.objects[0].asset}
+    p, _ = propose(OfflineBackend(seed=0), instruction="grab the apricot")
+    assert p.substitutions == {"apricot": p.objects[0].asset}
     assert "fruit" in next(d for d in asset_dicts() if d["id"] == p.objects[0].asset)["tags"]
     assert p.success["type"] == "lifted"
 
@@ -78,7 +78,9 @@ def test_only_objects_the_solver_measurably_holds_are_proposed_for_grasping(tmp_
 
     held = measured_graspable()
     below = {a for a, rate in measured_rates().items() if rate < 0.9}
-    assert not below and "wrench" in held  # 20/20 in the committed record (12/20 and 8/20 in the two before)
+    # the record's objects below 90 % (benchmarks/results/grasp.md, session 44), never proposed for grasping (below)
+    assert below == {"service_bell", "pool_ball"}
+    assert "wrench" in held  # 20/20 in the committed record (12/20 and 8/20 in the two before)
     assert {"fork", "hammer", "golf_ball", "knife", "spoon", "scissors"} <= held  # the scissors 19/20 since the hook
     rows = [{"asset": "apple", "held": 19, "attempts": 20, "scale": 1.0},
             {"asset": "fork", "held": 3, "attempts": 20, "scale": 1.0}]
@@ -607,7 +609,7 @@ def test_a_take_out_starts_the_object_in_its_container_and_succeeds_with_it_besi
         return b.complete(ModelRequest(step="propose_guided", prompt="", context={
             "reading": read_instruction(text, asset_dicts()).to_dict(), "assets": asset_dicts()})).text
 
-    with pytest.raises(InstructionError, match="stand 3 cm above its rim.*takes out: bottle, can"):
+    with pytest.raises(InstructionError, match="stand 3 cm above its rim.*takes out: .*bottle, can, "):
         guided("take the apple out of the bowl")
     p = parse_proposal(guided("take the can out of the bowl"))
     assert p.name == "TakeCanOutOfBowl" and p.objects[0].starts_in == "bowl"

@@ -20,9 +20,14 @@ ENTRIES = read_manifest(OBJECTS / MANIFEST)
 BY_ID = {e.id: e for e in ENTRIES}
 IDS = sorted(BY_ID)
 CONTAINERS = [e.id for e in ENTRIES if "container" in e.tags]
+VESSELS = [e.id for e in ENTRIES if "container" in e.tags and "seal0_x" in e.params]
+"""Containers that are solids of revolution (their walls sealed by overlapping wedges)."""
+OPEN_BOXES = [e.id for e in ENTRIES if "container" in e.tags and e.params.get("material")
+              and e.source.endswith("(trimesh primitives)")]
 TAGS = {"graspable", "container", "tableware", "food", "fruit", "ball", "tool", "utensil", "box", "block", "toy",
         "kitchenware", "surface", "handover", "marker", "peg", "holder", "insert", "wiper", "spill", "wipe_area",
-        "hangable", "hook", "hang_on", "pourer", "pourable", "bead"}
+        "hangable", "hook", "hang_on", "pourer", "pourable", "bead", "vegetable", "household", "office", "toiletry",
+        "chess"}
 
 
 def _parse_obj(path) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -71,7 +76,7 @@ def test_library_is_complete_and_well_formed():
         assert re.fullmatch(r"[a-z][a-z0-9_]*", e.id), e.id
         assert e.kind == "rigid" and e.licence == "Apache-2.0" and e.source.startswith("gendex procedural")
         assert set(e.tags) <= TAGS and {"graspable", "surface", "handover", "insert", "wipe_area",
-                                        "hang_on", "pourable"} & set(e.tags), (e.id, e.tags)
+                                        "hang_on", "pourable", "container"} & set(e.tags), (e.id, e.tags)
         assert e.visual == f"{e.id}/visual.obj" and e.collision == f"{e.id}/collision.obj"
         assert all(0.0 <= c <= 1.0 for c in e.rgba)
     for must in ("apple", "banana", "tennis_ball", "golf_ball", "mug", "bowl", "plate", "cracker_box", "hammer",
@@ -177,7 +182,7 @@ def test_container_cavity_is_open_and_floored(asset_id):
     assert inside_hulls(hulls, [[x, y, floor - 0.002]]).all(), "no floor under the cavity"
 
 
-@pytest.mark.parametrize("asset_id", CONTAINERS)
+@pytest.mark.parametrize("asset_id", VESSELS)
 def test_container_wall_has_no_gaps(asset_id):
     """Sweep each wall mid-surface probe around the axis: every point must be inside some hull, with 1 mm to
     spare radially (the wedges overlap, so nothing slips between them)."""
@@ -191,6 +196,26 @@ def test_container_wall_has_no_gaps(asset_id):
             ring = np.column_stack([p["cavity_x"] + (r + dr) * np.cos(theta), p["cavity_y"] + (r + dr) * np.sin(theta),
                                     np.full(len(theta), p[f"{s}_z"])])
             assert inside_hulls(hulls, ring).all(), (s, dr)
+
+
+def test_vessels_and_open_boxes_are_every_container():
+    assert sorted(VESSELS + OPEN_BOXES) == sorted(CONTAINERS)
+    assert {"basket", "baking_dish", "storage_bin"} <= set(OPEN_BOXES)
+
+
+@pytest.mark.parametrize("asset_id", OPEN_BOXES)
+def test_open_box_walls_are_closed(asset_id):
+    """A ring of points half-way up the walls, in the middle of their thickness, all round: every point is inside a
+    hull (the corners included), and none of the points 1 cm further in is."""
+    e, hulls = BY_ID[asset_id], _hulls(asset_id)
+    (x0, y0, _), (x1, y1, h) = e.bbox_min_m, e.bbox_max_m
+    wall = min(np.ptp(v.vertices[:, :2], axis=0).min() for v in hulls[1:])  # hull 0 is the floor
+    for inset, inside in ((wall / 2, True), (wall + 0.01, False)):
+        xs, ys = np.linspace(x0 + inset, x1 - inset, 60), np.linspace(y0 + inset, y1 - inset, 40)
+        ring = np.vstack([np.column_stack([xs, np.full(60, y)]) for y in (ys[0], ys[-1])]
+                         + [np.column_stack([np.full(40, x), ys]) for x in (xs[0], xs[-1])])
+        pts = np.column_stack([ring, np.full(len(ring), h / 2)])
+        assert inside_hulls(hulls, pts).all() == inside and (inside or not inside_hulls(hulls, pts).any()), inset
 
 
 def test_mug_has_a_handle():
