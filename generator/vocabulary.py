@@ -146,6 +146,25 @@ SYNONYMS: dict[str, str] = {
     "crate": "storage_bin", "tub": "storage_bin", "plastic bin": "storage_bin", "place mat": "placemat",
     "table mat": "placemat", "baking tray": "baking_sheet", "sheet pan": "baking_sheet",
     "cookie sheet": "baking_sheet", "oven tray": "baking_sheet",
+    # the pantry and the home (procedural_pantry, procedural_home), and the colour variants' own kinds
+    "can of soda": "soda_can", "drinks can": "soda_can", "soft drink can": "soda_can", "cola can": "soda_can",
+    "pepper pot": "pepper_shaker", "courgette": "zucchini", "aubergine": "eggplant", "yam": "sweet_potato",
+    "ear of corn": "corn", "corn cob": "corn", "mini pumpkin": "pumpkin", "beet": "beetroot",
+    "ketchup": "ketchup_bottle", "bottle of ketchup": "ketchup_bottle", "honey": "honey_jar",
+    "jar of honey": "honey_jar", "olive oil": "olive_oil_bottle", "bottle of olive oil": "olive_oil_bottle",
+    "oil bottle": "olive_oil_bottle", "beer": "beer_bottle", "bottle of beer": "beer_bottle",
+    "tub of ice cream": "ice_cream_tub", "ice cream": "ice_cream_tub", "tin of tea": "tea_tin",
+    "tea caddy": "tea_tin", "block of butter": "butter", "box of cereal": "cereal_box", "wedge of cheese": "cheese",
+    "cheese wedge": "cheese", "bun": "bread_roll", "doughnut": "donut", "pawn": "chess_pawn",
+    "bishop": "chess_bishop", "queen": "chess_queen", "knight": "chess_knight", "skittle": "bowling_pin",
+    "alphabet block": "letter_block", "train": "toy_train", "boat": "toy_boat", "money box": "piggy_bank",
+    "bottle of lotion": "lotion_bottle", "pump bottle": "lotion_bottle", "deodorant stick": "deodorant",
+    "box of tissues": "tissue_box", "bottle of perfume": "perfume_bottle", "perfume": "perfume_bottle",
+    "bath sponge": "loofah", "toilet paper": "toilet_roll", "roll of toilet paper": "toilet_roll",
+    "glue": "glue_bottle", "bottle of glue": "glue_bottle", "board eraser": "whiteboard_eraser",
+    "eraser": "whiteboard_eraser", "paper punch": "hole_punch", "bulb": "light_bulb", "lightbulb": "light_bulb",
+    "sand timer": "hourglass", "tin of paint": "paint_can", "paint tin": "paint_can", "clock": "alarm_clock",
+    "plant pot": "flower_pot",
 }
 """Words people use for catalog objects: phrase -> catalog category or id."""
 

@@ -55,13 +55,15 @@ def collision_obj(shape: ProceduralShape) -> str:
 
 
 def entry_for(shape: ProceduralShape) -> AssetEntry:
+    """The manifest entry of ``shape``; a variant (``files_of``) points at its base's files."""
     lo, hi = shape.bounds
+    files = shape.files_of or shape.id
     if lo[2] != 0.0 or abs(lo[0] + hi[0]) > 2e-6 or abs(lo[1] + hi[1]) > 2e-6:
         raise AssertionError(f"{shape.id}: not in the asset frame (bounds {lo}, {hi})")
     return AssetEntry(
         id=shape.id, category=shape.category, kind="rigid", source=shape.source, licence=LICENCE, tags=shape.tags,
         bbox_min_m=tuple(float(v) for v in lo), bbox_max_m=tuple(float(v) for v in hi), mass_kg=shape.mass_kg,
-        friction=shape.friction, visual=f"{shape.id}/visual.obj", collision=f"{shape.id}/collision.obj",
+        friction=shape.friction, visual=f"{files}/visual.obj", collision=f"{files}/collision.obj",
         volume_m3=float(f"{shape.volume_m3:.6e}"), rgba=shape.rgba, params=dict(shape.params))
 
 
@@ -76,8 +78,9 @@ def build(out: Path = DEFAULT_OUT) -> list[AssetEntry]:
     out = Path(out)
     entries = []
     for shape in build_all():
-        _write(out / shape.id / "visual.obj", visual_obj(shape))
-        _write(out / shape.id / "collision.obj", collision_obj(shape))
+        if not shape.files_of:  # a variant shares its base's files
+            _write(out / shape.id / "visual.obj", visual_obj(shape))
+            _write(out / shape.id / "collision.obj", collision_obj(shape))
         entries.append(entry_for(shape))
         log.debug("%s: %d hulls, size %s m", shape.id, len(shape.hulls), np.round(shape.bounds[1] - shape.bounds[0], 4))
     _write(out / "LICENSE", LICENCE_TEXT)

@@ -44,6 +44,8 @@ class ProceduralShape:
     hulls: list[trimesh.Trimesh]
     source: str
     params: dict[str, float | str] = field(default_factory=dict)
+    files_of: str = ""
+    """The id whose mesh files this shape uses (a colour variant: its base's), or empty for its own."""
 
     @property
     def volume_m3(self) -> float:

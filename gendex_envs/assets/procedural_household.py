@@ -211,7 +211,7 @@ _register("chess_king", _revolved("chess_king", [([(0, 0), (2.0, 0), (2.0, 0.5),
                                                  ([(0, 5.8), (1.35, 5.8), (1.35, 6.3), (0, 6.3)], ()),
                                                  ([(0, 6.2), (0.9, 6.2), (1.25, 7.6), (1.1, 8.4), (0, 8.6)], ()),
                                                  ([(0, 8.5), (0.25, 8.5), (0.25, 9.9), (0, 9.9)], ())],
-                                  0.06, 0.7, (0.85, 0.7, 0.5, 1.0), CHESS))
+                                  0.06, 0.7, (0.9, 0.85, 0.7, 1.0), CHESS))
 _register("chess_rook", _revolved("chess_rook", [([(0, 0), (1.9, 0), (1.9, 0.5), (1.5, 1.0), (0, 1.0)], ()),
                                                  ([(0, 0.9), (1.3, 0.9), (1.05, 4.2), (0, 4.2)], ()),
                                                  ([(0, 4.1), (1.4, 4.1), (1.4, 5.6), (0, 5.6)], ())],
@@ -239,7 +239,7 @@ def _teddy_bear():
                                 ((1.0, 1.0, 2.2), (0.8, -3.3, 5.6), None), ((2.8, 2.8, 2.8), (0, 0, 9.8), None),
                                 ((1.0, 0.5, 1.0), (0, 2.2, 12.0), None), ((1.0, 0.5, 1.0), (0, -2.2, 12.0), None),
                                 ((1.2, 1.2, 0.9), (2.5, 0, 9.4), None)):
-        parts.convex(ellipsoid_pts(radii, centre, 3, flat), ellipsoid_pts(radii, centre, flat_z=flat, n=100))
+        parts.convex(ellipsoid_pts(radii, centre, 2, flat), ellipsoid_pts(radii, centre, flat_z=flat, n=100))
     return _done(parts, id="teddy_bear", category="teddy_bear", tags=TOY, mass_kg=0.12, friction=1.0,
                  rgba=(0.6, 0.4, 0.22, 1.0), source=SOURCE_PRIMITIVES)
 

@@ -598,8 +598,17 @@ _register("fork", _fork)
 _register("knife", _knife)
 
 
-# registers the hooks a mug hangs on, the beads a vessel pours and the vessels that pour them, and the everyday objects
-from gendex_envs.assets import procedural_hanging, procedural_household, procedural_pouring  # noqa: E402,F401
+# registers the hooks a mug hangs on, the beads a vessel pours and the vessels that pour them, the everyday objects
+# (household, pantry, home),
+# and the colour variants (last: they copy the others)
+from gendex_envs.assets import (  # noqa: E402,F401
+    procedural_hanging,
+    procedural_home,
+    procedural_household,
+    procedural_pantry,
+    procedural_pouring,
+    procedural_variants,
+)
 
 
 def build_all() -> list[ProceduralShape]:

@@ -55,9 +55,9 @@ def test_guidance_names_every_asset_with_size():
         assert f"- {asset_id} |" in text
     assert "door_hinge revolute [0, 1.9] 0->1.4, handle door" in text
     # rigid objects one line per category: the tags they share, then each id with size and mass
-    assert "- bowl (graspable, container, tableware, kitchenware): bowl 15.0 x 15.0 x 6.3, 0.25; bowl_large 22" in text
-    assert "- apple (graspable, food, fruit): apple 7.5 x 7.7 x 7.0, 0.15; apple_scan 8.0 x 7.8 x 8.8, 0.16 " \
-           "(textured)" in text
+    assert "- bowl (graspable, container, tableware, kitchenware): bowl 15.0 x 15.0 x 6.3, 0.25; bowl_blue 15.0" in text
+    assert "- apple (graspable, food, fruit): apple 7.5 x 7.7 x 7.0, 0.15; apple_green 7.5 x 7.7 x 7.0, 0.15;" in text
+    assert "; apple_scan 8.0 x 7.8 x 8.8, 0.16 (textured)" in text  # a tag not all apples have
     for r in catalog().values():
         assert f" {r.id} " in text or f"- {r.id} |" in text, r.id
 

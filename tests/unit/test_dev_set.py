@@ -10,6 +10,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from gendex_envs.assets.catalog import get_asset
+from gendex_envs.attributes import color_name
 from generator.catalog_view import asset_dicts
 from generator.instruction import InstructionError, Reading, read_instruction
 
@@ -81,7 +83,8 @@ def _misread_step(reading: Reading, step: dict) -> str | None:
             return f"{m.asset} read as one object, not one of a group"
         if ("id" in want and got["id"] != want["id"]) or ("category" in want and got["category"] != want["category"]):
             return f"{want} read as {m.asset}"
-        if want.get("color") != m.color:
+        own = color_name(get_asset(m.asset).entry.rgba) if want.get("color") and m.color is None else None
+        if want.get("color") != (m.color or own):  # painted as asked, or an object of the catalog in that colour
             return f"colour {want.get('color')!r} of {m.asset} read as {m.color!r}"
     return None
 

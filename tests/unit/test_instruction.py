@@ -340,8 +340,10 @@ def test_colours_are_read_proposed_and_painted_in_the_scene():
     spec, _ = write_scene(OfflineBackend(seed=0), p)
     assert {o.name: o.color for o in spec.objects if not o.distractor} == {"block_small": "red",
                                                                           "block_medium": "blue"}
-    p, _ = propose(OfflineBackend(seed=0), instruction="put the yellow apple in the white bowl")
-    assert [(o.asset, o.color) for o in p.objects] == [("apple", "yellow"), ("bowl", "white")]
+    p, _ = propose(OfflineBackend(seed=0), instruction="put the blue apple in the white bowl")
+    assert [(o.asset, o.color) for o in p.objects] == [("apple", "blue"), ("bowl", "white")]
+    # an object the catalog has in the colour asked is that object, not another one painted
+    assert [(m.asset, m.color) for m in read("pick up the green apple").objects] == [("apple_green", None)]
     with pytest.raises(InstructionError, match="painting an articulated object"):
         read("open the red fridge")
     with pytest.raises(InstructionError, match="names 2 colours"):

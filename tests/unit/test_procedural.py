@@ -77,7 +77,9 @@ def test_library_is_complete_and_well_formed():
         assert e.kind == "rigid" and e.licence == "Apache-2.0" and e.source.startswith("gendex procedural")
         assert set(e.tags) <= TAGS and {"graspable", "surface", "handover", "insert", "wipe_area",
                                         "hang_on", "pourable", "container"} & set(e.tags), (e.id, e.tags)
-        assert e.visual == f"{e.id}/visual.obj" and e.collision == f"{e.id}/collision.obj"
+        files = e.params.get("variant_of", e.id)  # a colour variant uses its base's mesh files
+        assert e.visual == f"{files}/visual.obj" and e.collision == f"{files}/collision.obj"
+        assert files == e.id or ("variant_of" not in BY_ID[files].params and BY_ID[files].mass_kg == e.mass_kg)
         assert all(0.0 <= c <= 1.0 for c in e.rgba)
     for must in ("apple", "banana", "tennis_ball", "golf_ball", "mug", "bowl", "plate", "cracker_box", "hammer",
                  "spoon", "fork", "knife", "sponge", "dice", "toy_duck", "scissors", "wrench"):
