@@ -46,6 +46,7 @@ from generator.backends.roles import (
     CARRY_FALLS_SHORT,
     EMPTIED_DRAWERS,
     STICK_OUT_M,
+    TAKE_OUT_MAX_HEIGHT_M,
     _acts,
     _joint_at,
     _kind,
@@ -529,8 +530,9 @@ class OfflineBackend:
                               if graspable(a) and fits_in(a, box) and sticks_out(a, box))
                 raise InstructionError(
                     f"the offline author takes out of a container only objects that stand {STICK_OUT_M * 100:.0f} cm "
-                    f"above its rim, where the fingers close ('{mentions[0]['phrase']}' ({g['id']}) in the "
-                    f"{box['id']} does not); from the {box['id']} it takes out: {', '.join(able) or 'nothing'}")
+                    f"above its rim, where the fingers close, and no taller than {TAKE_OUT_MAX_HEIGHT_M * 100:.0f} cm "
+                    f"('{mentions[0]['phrase']}' ({g['id']}) in the {box['id']} is not); from the {box['id']} it "
+                    f"takes out: {', '.join(able) or 'nothing'}")
             proposal = placed_tasks.take_out_task(g, box, colors, self._words)
         elif skill == "hand_over":
             zone = next((x for x in assets.values() if handover_zone(x)), None)

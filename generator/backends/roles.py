@@ -211,11 +211,20 @@ to the hand: the fingers close on it above the rim (a can from the bowl: 6/6 in 
 level with the rim: 3 of 9 held)."""
 
 
+TAKE_OUT_MAX_HEIGHT_M = 0.19
+"""The tallest object (fitted to the hand) the offline author takes out of a container. Taken out at the gate: the
+sugar box (17.5 cm) from the large bowl and from the pot, the bottle (22.3 cm) from the bowl; not: the bottle from the
+pot (4/7, slips on the carry, batch 1157003) and the shampoo bottle (20 cm) from the storage bin and from the large
+bowl (1/4 each, grasps that failed between its walls, batch 1203319)."""
+
+
 def sticks_out(g: dict, c: dict) -> bool:
-    """Graspable ``g``, fitted to the hand, stands :data:`STICK_OUT_M` above container ``c``'s rim."""
+    """Graspable ``g``, fitted to the hand, stands :data:`STICK_OUT_M` above container ``c``'s rim and is no taller
+    than :data:`TAKE_OUT_MAX_HEIGHT_M`: what the offline author takes out of ``c``."""
     from gendex.solve.grasp import hand_fit_scale
 
-    return g["size_m"][2] * hand_fit_scale(g["size_m"][:2]) >= c["size_m"][2] + STICK_OUT_M
+    height = g["size_m"][2] * hand_fit_scale(g["size_m"][:2])
+    return c["size_m"][2] + STICK_OUT_M <= height <= TAKE_OUT_MAX_HEIGHT_M
 
 
 RECEIVING_DRAWERS = {"drawer_chest_1": "drawer_0_slide", "drawer_chest_2": "drawer_1_slide",

@@ -609,8 +609,12 @@ def test_a_take_out_starts_the_object_in_its_container_and_succeeds_with_it_besi
         return b.complete(ModelRequest(step="propose_guided", prompt="", context={
             "reading": read_instruction(text, asset_dicts()).to_dict(), "assets": asset_dicts()})).text
 
-    with pytest.raises(InstructionError, match="stand 3 cm above its rim.*takes out: .*bottle, can, "):
+    with pytest.raises(InstructionError, match="stand 3 cm above its rim.*takes out: .*candle, .*sugar_box"):
         guided("take the apple out of the bowl")
+    # nor anything taller than the tallest taken out at the gate (the bottle slipped, the shampoo was not grasped)
+    for tall in ("bottle", "shampoo bottle"):
+        with pytest.raises(InstructionError, match="no taller than 19 cm"):
+            guided(f"take the {tall} out of the bowl")
     p = parse_proposal(guided("take the can out of the bowl"))
     assert p.name == "TakeCanOutOfBowl" and p.objects[0].starts_in == "bowl"
     assert (p.success["type"], p.success["relation"], p.success["target"]) == ("placed", "next_to", "bowl")
