@@ -30,6 +30,13 @@ def _min_xy(a: dict) -> float:
     return float(min(a["size_m"][:2]))
 
 
+def _held(a: dict) -> bool:
+    """Picked up and held by the solver in >= :data:`MIN_GRASP_RATE` of its recorded ``benchmarks/grasp.py``
+    attempts (when a record exists): what every role the hand grasps asks."""
+    measured = _measured()
+    return not measured or a["id"] in measured
+
+
 def graspable(a: dict) -> bool:
     """Objects the offline grammar lets the hand grasp: compact, not flat, not too heavy, and picked up and held by
     the solver in >= 90 % of the recorded ``benchmarks/grasp.py`` attempts (when a record exists)."""
@@ -72,7 +79,7 @@ def carried(a: dict) -> bool:
 
 def insertable(a: dict) -> bool:
     """A peg: what the offline author inserts into a holder."""
-    return "peg" in a["tags"] and not a.get("joints")
+    return "peg" in a["tags"] and not a.get("joints") and _held(a)
 
 
 def socket(a: dict) -> bool:
@@ -96,7 +103,7 @@ def fits_hole(peg: dict, holder: dict) -> bool:
 
 def wiper(a: dict) -> bool:
     """A sponge that wipes: pinched high and pressed flat on a spill (an asset tagged ``wiper``)."""
-    return "wiper" in a["tags"] and not a.get("joints")
+    return "wiper" in a["tags"] and not a.get("joints") and _held(a)
 
 
 def wipe_area(a: dict) -> bool:
@@ -106,7 +113,7 @@ def wipe_area(a: dict) -> bool:
 
 def hangable(a: dict) -> bool:
     """Something hung by its handle on a peg (an asset tagged ``hangable``: a mug, its handle's opening recorded)."""
-    return "hangable" in a["tags"] and not a.get("joints")
+    return "hangable" in a["tags"] and not a.get("joints") and _held(a)
 
 
 def hook_stand(a: dict) -> bool:
@@ -117,7 +124,7 @@ def hook_stand(a: dict) -> bool:
 def pourer(a: dict) -> bool:
     """A tall open vessel the offline author pours from (an asset tagged ``pourer``: held by its side, tipped over a
     bowl)."""
-    return "pourer" in a["tags"] and not a.get("joints")
+    return "pourer" in a["tags"] and not a.get("joints") and _held(a)
 
 
 FLIPPABLE = frozenset({"tumbler", "paper_cup"})
