@@ -256,11 +256,15 @@ def assets(as_json: bool = typer.Option(False, "--json", help="Machine-readable 
 
 @app.command()
 def gallery(out: Path = typer.Option(Path("docs/assets"), "--out", help="Folder for thumbnails and index."),
-            size: int = typer.Option(256, help="Thumbnail size in pixels.")) -> None:
+            size: int = typer.Option(256, help="Thumbnail size in pixels."),
+            rerender: bool = typer.Option(True, help="Render every thumbnail again (--no-rerender: only the "
+                                                     "assets that have none yet).")) -> None:
     """Render a thumbnail of every asset (on the task table, next to the hand) and write ``<out>.md``."""
     from gendex.gallery import render_gallery
+    from gendex.solve.lift_check import held_summary
+    from generator.backends.roles import MIN_GRASP_RATE
 
-    index = render_gallery(out, size)
+    index = render_gallery(out, size, rerender, held_summary(MIN_GRASP_RATE))
     typer.echo(f"wrote {index}")
 
 

@@ -58,29 +58,49 @@ def render_thumbnail(record: AssetRecord, size: int = 256) -> np.ndarray:
         env.close()
 
 
-def render_gallery(out: Path, size: int = 256) -> Path:
-    """Write ``out/<id>.png`` for every asset and the index ``out.md``; returns the index path."""
+def render_gallery(out: Path, size: int = 256, rerender: bool = True, held: dict[str, str] | None = None) -> Path:
+    """Write ``out/<id>.png`` for every asset (``rerender=False``: only those not there yet) and the index
+    ``out.md``, rigid objects and articulated models in two tables by category; ``held``: what the *held* column
+    says of each rigid object (how the solver holds it); returns the index path."""
+    held = held or {}
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     records = sorted(catalog().values(), key=lambda r: (r.articulated, r.category, r.id))
-    rows = []
+    rows: dict[bool, list[str]] = {False: [], True: []}
     for record in tqdm(records, desc="gallery", unit="asset"):
         png = out / f"{record.id}.png"
-        with atomic_path(png) as tmp:
-            Image.fromarray(render_thumbnail(record, size)).save(tmp)
+        if rerender or not png.is_file():
+            with atomic_path(png) as tmp:
+                Image.fromarray(render_thumbnail(record, size)).save(tmp)
         size_cm = " × ".join(f"{100 * v:.1f}" for v in record.size_m)
-        joints = ", ".join(f"{j.name} ({j.type})" for j in record.joints) or "—"
-        rows.append(f"| ![{record.id}]({out.name}/{png.name}) | `{record.id}` | {record.category} | {size_cm} | "
-                    f"{record.mass_kg:.3g} | {joints} | {', '.join(record.tags)} | {record.entry.licence} |")
+        last = (", ".join(f"{j.name} ({j.type})" for j in record.joints) if record.articulated
+                else held.get(record.id, "—"))
+        rows[record.articulated].append(
+            f"| ![{record.id}]({out.name}/{png.name}) | `{record.id}` | {record.category} | {size_cm} | "
+            f"{record.mass_kg:.3g} | {last} | {', '.join(record.tags)} | {record.entry.licence} |")
+    rigid = [r for r in records if not r.articulated]
+    arts = [r for r in records if r.articulated]
     index = out.with_suffix(".md")
-    header = [
+    text = [
         "# Asset gallery",
         "",
-        f"{len(records)} assets, each rendered on the task table by `gendex gallery` (the project's own env; the "
-        "ShadowHand may appear at the edge for scale). Sizes are real-world at scale 1.",
+        f"{len(records)} assets: {len(rigid)} rigid objects in {len({r.category for r in rigid})} categories and "
+        f"{len(arts)} articulated models in {len({r.category for r in arts})} categories, each rendered on the task "
+        "table by `gendex gallery` (the project's own env; the ShadowHand may appear at the edge for scale). Sizes are "
+        "real-world at scale 1. *Held* is the solver's lift-and-hold record (`benchmarks/grasp.py`, "
+        "`gendex/solve/grasp_measured.json`): the offline author grasps only objects held in at least 90 % of it.",
+        "",
+        "## Rigid objects",
+        "",
+        "| view | id | category | size cm (x × y × z) | mass kg | held | tags | licence |",
+        "|---|---|---|---|---|---|---|---|",
+        *rows[False],
+        "",
+        "## Articulated models",
         "",
         "| view | id | category | size cm (x × y × z) | mass kg | joints | tags | licence |",
         "|---|---|---|---|---|---|---|---|",
+        *rows[True],
     ]
-    write_text(index, "\n".join(header + rows) + "\n")
+    write_text(index, "\n".join(text) + "\n")
     return index

@@ -161,6 +161,25 @@ def measured_graspable(min_rate: float = 0.9, path: Path = MEASURED_FILE) -> fro
     return frozenset(a for a, rate in measured_rates(path).items() if rate >= min_rate)
 
 
+def held_summary(min_rate: float = 0.9, path: Path = MEASURED_FILE) -> dict[str, str]:
+    """Each graspable-tagged rigid catalog object -> how the record says the solver holds it: ``"19/20"``,
+    ``"**not graspable** (12/20)"`` below ``min_rate``, or ``"not measured"`` (what the asset gallery shows)."""
+    from gendex_envs.assets.catalog import catalog
+
+    rows = json.loads(path.read_text())["assets"] if path.is_file() else {}
+    out = {}
+    for asset_id, record in catalog().items():
+        if "graspable" not in record.tags or record.articulated:
+            continue
+        row = rows.get(asset_id)
+        if not row:
+            out[asset_id] = "not measured"
+            continue
+        rate = f"{row['held']}/{row['attempts']}"
+        out[asset_id] = rate if row["held"] / row["attempts"] >= min_rate else f"**not graspable** ({rate})"
+    return out
+
+
 def write_record(rows: list[dict], seeds: list[int], path: Path = MEASURED_FILE, merge: bool = False) -> None:
     """Record a ``benchmarks/grasp.py`` run (what :func:`measured_graspable` reads). ``merge``: keep the record's other
     assets and replace only those of ``rows`` (a run over some objects), each that was measured on other seeds than

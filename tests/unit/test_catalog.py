@@ -90,3 +90,35 @@ def test_shipped_meshes_rebuild_identically(tmp_path):
         assert filecmp.cmp(path, DEFAULT_OUT / path.relative_to(tmp_path), shallow=False), path.name
     record = get_asset("apple_scan")
     assert record.entry.visual.endswith(".glb") and 0.07 < record.size_m[0] < 0.09
+
+
+def test_held_summary_says_how_the_solver_holds_each_graspable_object(tmp_path):
+    from gendex.solve.lift_check import held_summary, write_record
+
+    write_record([{"asset": "apple", "held": 20, "attempts": 20, "scale": 1.0},
+                  {"asset": "fork", "held": 3, "attempts": 20, "scale": 1.0}], [1], tmp_path / "rec.json")
+    held = held_summary(0.9, tmp_path / "rec.json")
+    assert held["apple"] == "20/20" and held["fork"] == "**not graspable** (3/20)"
+    assert held["banana"] == "not measured"
+    assert "basket" not in held and "cabinet_left_hinge" not in held  # nothing to grasp
+    assert set(held) == {k for k, r in catalog().items() if "graspable" in r.tags and not r.articulated}
+
+
+def test_the_asset_gallery_shows_every_asset():
+    """docs/assets.md (`gendex gallery`) has a row and a picture for every catalog asset, and says how each
+    graspable object is held as the committed record does."""
+    from pathlib import Path
+
+    from gendex.solve.lift_check import held_summary
+
+    docs = Path(__file__).parents[2] / "docs"
+    text = (docs / "assets.md").read_text()
+    held = held_summary(MIN_GRASP_RATE)
+    for asset_id, record in catalog().items():
+        if record.root == Path("/"):  # a user-supplied dataset's (YCB, PartNet-Mobility): not shipped
+            continue
+        row = next((line for line in text.splitlines() if f"| `{asset_id}` |" in line), None)
+        assert row is not None, asset_id
+        assert (docs / "assets" / f"{asset_id}.png").is_file(), asset_id
+        if asset_id in held:
+            assert f"| {held[asset_id]} |" in row, (asset_id, row)
