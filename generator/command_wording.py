@@ -181,8 +181,24 @@ def clause_wordings(clause: str) -> list[str]:
     return list(dict.fromkeys(out))
 
 
+@functools.cache
+def _variant_of(asset_id: str) -> str | None:
+    """The object a colour variant copies (``params["variant_of"]``), else None."""
+    from gendex_envs.assets.catalog import catalog
+
+    record = catalog().get(asset_id)
+    return None if record is None else record.entry.params.get("variant_of")
+
+
 def _mention_key(m) -> tuple:
-    return (tuple(sorted(m.options or (m.asset,))), m.color, m.part, m.group)
+    """The catalog choices of mention ``m`` with its colour, part and group (for one of a group, the group alone).
+    Colour variants whose base is among the choices are left out: *the dinner plate* and *the plate* choose the same
+    plate, whatever colours the catalog also has it in (*the blue plate* is the variant itself)."""
+    if m.group:  # one of a group (*all the fruit*): which members is the reader's choice from the catalog, not words
+        return ((), m.color, m.part, m.group)
+    options = m.options or (m.asset,)
+    kept = tuple(sorted(o for o in options if _variant_of(o) not in options))
+    return (kept, m.color, m.part, m.group)
 
 
 def reading_key(r: Reading) -> tuple:

@@ -238,7 +238,7 @@ SITUATIONS_DIRECTED: dict[tuple[str, str], tuple[str, ...]] = {
     ("appliance", "open"): ("The leftovers from the party are waiting", "Breakfast porridge is ready to come out",
                             "A cake has to be checked for doneness"),
     ("appliance", "close"): ("The kitchen is being shut down for the night", "The timer has just been set"),
-    ("cold", "open"): ("The butter is needed for the toast", "Someone wants a cold drink"),
+    ("cold", "open"): ("Breakfast needs something from the top shelf", "Someone wants a cold drink"),
     ("cold", "close"): ("The door alarm keeps beeping", "The ice cream is starting to melt"),
     ("furniture", "open"): ("Someone is hunting for a spare key", "The winter coats have to come out",
                             "A birthday present is hidden somewhere"),
@@ -302,7 +302,8 @@ PURPOSES_DIRECTED: dict[tuple[str, str], tuple[str, ...]] = {
 """Reasons that only suit a task that opens (or turns on) or one that closes something."""
 
 LEGACY_SITUATIONS = ("The sink is full of dirty dishes", "The dishwasher has just finished its cycle",
-                     "A burglar alarm test needs every cupboard checked", "The toolbox is being sorted into trays")
+                     "A burglar alarm test needs every cupboard checked", "The toolbox is being sorted into trays",
+                     "The butter is needed for the toast")
 """Situations earlier versions of the author used and no longer do (they name catalog objects); kept so
 :func:`split` still takes them off instructions already written."""
 

@@ -153,7 +153,7 @@ SYNONYMS: dict[str, str] = {
     "ketchup": "ketchup_bottle", "bottle of ketchup": "ketchup_bottle", "honey": "honey_jar",
     "jar of honey": "honey_jar", "olive oil": "olive_oil_bottle", "bottle of olive oil": "olive_oil_bottle",
     "oil bottle": "olive_oil_bottle", "beer": "beer_bottle", "bottle of beer": "beer_bottle",
-    "tub of ice cream": "ice_cream_tub", "ice cream": "ice_cream_tub", "tin of tea": "tea_tin",
+    "tub of ice cream": "ice_cream_tub", "tin of tea": "tea_tin",
     "tea caddy": "tea_tin", "block of butter": "butter", "box of cereal": "cereal_box", "wedge of cheese": "cheese",
     "cheese wedge": "cheese", "bun": "bread_roll", "doughnut": "donut", "pawn": "chess_pawn",
     "bishop": "chess_bishop", "queen": "chess_queen", "knight": "chess_knight", "skittle": "bowling_pin",

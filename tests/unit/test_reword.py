@@ -247,11 +247,11 @@ def test_the_author_proposes_of_the_tasks_drawn_the_one_least_like_the_library(t
 def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
     """The left-hinged fridge's task proposed next to the right-hinged one's: the least-alike framing by the mean
     alone took the very frame the sibling had (cosine 0.99, and the proposal was dropped as a near-duplicate)."""
-    right = "The butter is needed for the toast: pull the right-hinged fridge's door open by its handle."
+    right = "Breakfast needs something from the top shelf: pull the right-hinged fridge's door open by its handle."
     library = [right, "Put the apple into the bowl.", "Close the drawer.", "Lift the golf ball off the table."]
     command = "pull the left-hinged fridge's door open by its handle"
     options = framings(command, Frame("cold", "open"), Frame("cold", "open"), "table")
-    assert any(o.startswith("The butter is needed") for o in options)
+    assert any(o.startswith("Breakfast needs something") for o in options)
     chosen = LibraryWording(library)(options)
     e = embed_each([chosen, right])[0]
     assert float(e[0] @ e[1]) < MAX_PAIR_COSINE, chosen
@@ -259,9 +259,11 @@ def test_a_sibling_is_not_worded_like_the_task_it_is_the_sibling_of():
 
 def test_the_committed_library_reads_as_varied_as_the_issue_asks(committed_tasks):
     """The library's instruction diversity (mean pairwise MiniLM cosine of the latest versions) meets the task
-    library issue's goal of <= 0.19 (RoboGen 0.191; before the rewording 0.299)."""
+    library issue's goal of <= 0.19 (RoboGen 0.191; before the rewording 0.299), and its commands alone (situations
+    and purposes taken off) the task-language issue's <= 0.25 (0.335 when it was filed)."""
     texts = [v.spec.instruction for v in latest_versions(committed_tasks).values()]
-    assert len(texts) >= 60 and _mean_cos(texts) <= 0.19
+    assert len(texts) >= 165 and _mean_cos(texts) <= 0.19
+    assert _mean_cos([split(t)[1] for t in texts]) <= 0.25
     e = embed(texts)[0]
     pairs = e @ e.T
     np.fill_diagonal(pairs, 0.0)
