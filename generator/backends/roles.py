@@ -220,9 +220,9 @@ level with the rim: 3 of 9 held)."""
 
 TAKE_OUT_MAX_HEIGHT_M = 0.19
 """The tallest object (fitted to the hand) the offline author takes out of a container. Taken out at the gate: the
-sugar box (17.5 cm) from the large bowl and from the pot, the bottle (22.3 cm) from the bowl; not: the bottle from the
-pot (4/7, slips on the carry, batch 1157003) and the shampoo bottle (20 cm) from the storage bin and from the large
-bowl (1/4 each, grasps that failed between its walls, batch 1203319)."""
+sugar box (17.5 cm) from the large bowl and from the pot, the bottle (22.3 cm) and the shampoo bottle (20 cm) from the
+bowl; not: the bottle from the pot (4/7, slips on the carry, batch 1157003) and the shampoo bottle from the storage bin
+and from the large bowl (1/4 each, grasps that failed between the walls, batch 1203319). Two of five above 19 cm."""
 
 
 def sticks_out(g: dict, c: dict) -> bool:
