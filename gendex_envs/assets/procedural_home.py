@@ -9,7 +9,6 @@ Built from the same exact convex pieces as the rest of the catalogue (see
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
 from gendex_envs.assets.procedural import (
     SOURCE_PRIMITIVES,
@@ -19,10 +18,9 @@ from gendex_envs.assets.procedural import (
     cyl_between,
     ellipsoid_pts,
     revolved_solid,
-    ring_hulls,
     rounded_box_pts,
 )
-from gendex_envs.assets.procedural_household import CHESS, HOUSEHOLD, TOILETRY, TOY, _revolved
+from gendex_envs.assets.procedural_household import CHESS, HOUSEHOLD, TOILETRY, TOY, _revolved, _ring
 from gendex_envs.assets.procedural_shapes import _ball, _box, _done, _register, _vessel_parts
 
 DESK = ("graspable", "office")
@@ -156,16 +154,6 @@ def _loofah():
     radii, centre, flat = (6.0, 3.6, 3.2), (0, 0, 2.6), -2.6
     parts = Parts().convex(ellipsoid_pts(radii, centre, 3, flat), ellipsoid_pts(radii, centre, flat_z=flat, n=100))
     return _shapes("loofah", parts, 0.04, 1.2, (0.85, 0.75, 0.5, 1.0), TOILETRY)
-
-
-def _ring(asset_id, r_in, r_out, h, mass, friction, rgba, tags):
-    """A hollow cylinder standing on its end (a toilet roll): 16 ring sectors."""
-    def make():
-        visual = trimesh.creation.annulus(r_in, r_out, h, sections=48)
-        visual.apply_translation([0, 0, h / 2])
-        parts = Parts().add(visual, ring_hulls(r_in, r_out, 0.0, h, pieces=16, overlap=0.05))
-        return _shapes(asset_id, parts, mass, friction, rgba, tags)
-    return make
 
 
 _register("perfume_bottle", _perfume_bottle)

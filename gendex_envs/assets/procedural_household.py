@@ -249,13 +249,16 @@ _register("teddy_bear", _teddy_bear)
 
 
 # ------------------------------------------------------------------------------------------------ desk
-def _tape_roll():
-    """A roll of duct tape lying flat: a ring 10 cm across, 5 cm high, its core 7.6 cm across (16 ring sectors)."""
-    visual = trimesh.creation.annulus(3.8, 5.0, 5.0, sections=48)
-    visual.apply_translation([0, 0, 2.5])
-    parts = Parts().add(visual, ring_hulls(3.8, 5.0, 0.0, 5.0, pieces=16, overlap=0.05))
-    return _done(parts, id="tape_roll", category="tape_roll", tags=HOUSEHOLD, mass_kg=0.15, friction=0.8,
-                 rgba=(0.6, 0.6, 0.62, 1.0), source=SOURCE_PRIMITIVES)
+def _ring(asset_id, r_in, r_out, h, mass, friction, rgba, tags):
+    """A hollow cylinder standing on its end, ``r_in`` to ``r_out`` cm round and ``h`` cm high (a roll of tape, a
+    toilet roll, a doughnut): 16 overlapping ring sectors."""
+    def make():
+        visual = trimesh.creation.annulus(r_in, r_out, h, sections=48)
+        visual.apply_translation([0, 0, h / 2])
+        parts = Parts().add(visual, ring_hulls(r_in, r_out, 0.0, h, pieces=16, overlap=0.05))
+        return _done(parts, id=asset_id, category=asset_id, tags=tags, mass_kg=mass, friction=friction, rgba=rgba,
+                     source=SOURCE_PRIMITIVES)
+    return make
 
 
 def _stapler():
@@ -268,7 +271,8 @@ def _stapler():
                  rgba=(0.15, 0.15, 0.18, 1.0), source=SOURCE_PRIMITIVES)
 
 
-_register("tape_roll", _tape_roll)
+# a roll of duct tape lying flat: 10 cm across, 5 cm high, its core 7.6 cm across
+_register("tape_roll", _ring("tape_roll", 3.8, 5.0, 5.0, 0.15, 0.8, (0.6, 0.6, 0.62, 1.0), HOUSEHOLD))
 _register("stapler", _stapler)
 
 

@@ -8,10 +8,9 @@ Built from the same exact convex pieces as the rest of the catalogue (see
 from __future__ import annotations
 
 import numpy as np
-import trimesh
 
-from gendex_envs.assets.procedural import SOURCE_PRIMITIVES, Parts, ellipsoid_pts, ring_hulls
-from gendex_envs.assets.procedural_household import VEGETABLE, _long, _pointed, _produce, _revolved
+from gendex_envs.assets.procedural import SOURCE_PRIMITIVES, Parts, ellipsoid_pts
+from gendex_envs.assets.procedural_household import VEGETABLE, _long, _pointed, _produce, _revolved, _ring
 from gendex_envs.assets.procedural_shapes import BOX, FRUIT, _box, _done, _register
 
 FOOD = ("graspable", "food")
@@ -73,17 +72,9 @@ def _bread_roll():
                  rgba=(0.8, 0.55, 0.25, 1.0), source=SOURCE_PRIMITIVES)
 
 
-def _donut():
-    """A ring doughnut lying flat: 9 cm across, 3.2 cm high, a 2.6 cm hole (16 ring sectors)."""
-    visual = trimesh.creation.annulus(1.3, 4.5, 3.2, sections=48)
-    visual.apply_translation([0, 0, 1.6])
-    parts = Parts().add(visual, ring_hulls(1.3, 4.5, 0.0, 3.2, pieces=16, overlap=0.05))
-    return _done(parts, id="donut", category="donut", tags=FOOD, mass_kg=0.06, friction=0.9,
-                 rgba=(0.95, 0.55, 0.7, 1.0), source=SOURCE_PRIMITIVES)
-
-
 _register("cheese", _cheese)
 _register("bread_roll", _bread_roll)
-_register("donut", _donut)
+# a ring doughnut lying flat: 9 cm across, 3.2 cm high, a 2.6 cm hole
+_register("donut", _ring("donut", 1.3, 4.5, 3.2, 0.06, 0.9, (0.95, 0.55, 0.7, 1.0), FOOD))
 
 __all__ = ["FOOD"]

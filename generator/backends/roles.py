@@ -41,10 +41,9 @@ def graspable(a: dict) -> bool:
     """Objects the offline grammar lets the hand grasp: compact, not flat, not too heavy, and picked up and held by
     the solver in >= 90 % of the recorded ``benchmarks/grasp.py`` attempts (when a record exists)."""
     s = a["size_m"]
-    measured = _measured()
     return ("graspable" in a["tags"] and "container" not in a["tags"] and a["category"] != "plate"
             and 0.035 <= _min_xy(a) and max(s) <= 0.25 and s[2] >= 0.03 and a["mass_kg"] <= 0.6
-            and not a.get("joints") and (not measured or a["id"] in measured))
+            and not a.get("joints") and _held(a))
 
 
 @functools.cache
@@ -58,9 +57,8 @@ def handed(a: dict) -> bool:
     """Objects the offline author hands over: the graspable ones, and the small vessels a person takes by hand (a
     mug, a cup, a jar), held by the solver as :func:`graspable` asks."""
     s = a["size_m"]
-    measured = _measured()
     vessel = ("graspable" in a["tags"] and "container" in a["tags"] and max(s) <= 0.16 and a["mass_kg"] <= 0.6
-              and not a.get("joints") and (not measured or a["id"] in measured))
+              and not a.get("joints") and _held(a))
     return graspable(a) or vessel
 
 
