@@ -48,6 +48,8 @@ class ExistingTask:
     env_id: str
     signature: Signature
     instruction: str
+    assets: tuple[str, ...] = ()
+    """The catalog assets the task's scene holds (what ``gendex stats`` counts as used)."""
 
 
 def _how(kind_: str, negate: bool, part: str | None) -> str | None:
@@ -85,6 +87,16 @@ def proposal_signature(proposal: dict) -> Signature:
             tuple(sorted({kind(a) for a in (*objects.values(), *pieces)})))
 
 
+def fresh_first(proposals: list[dict], used: Iterable[str]) -> list[dict]:
+    """The ``proposals`` that put an asset in their scene which no existing task uses (``used``), or all of them
+    when none does: of the tasks of a drawn skill the autonomous author writes one that widens the library's set of
+    objects when it can (the objects issue asks for >= 150 assets in library tasks; a task of the same skill on a
+    used object is still written once every object of that skill is used)."""
+    used = set(used)
+    fresh = [p for p in proposals if set(proposal_assets(p)) - used]
+    return fresh or proposals
+
+
 def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:
     """The latest version of every task under ``roots`` (a missing root holds none)."""
     from gendex_envs.registry import discover_tasks
@@ -94,17 +106,29 @@ def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:
     return [ExistingTask(env_id, *_spec_facts(v)) for env_id, v in sorted(latest_versions(found).items())]
 
 
-_FACTS: dict[str, tuple[Signature, str]] = {}
-"""(signature, instruction) by the SHA-256 of a spec's bytes: a process generating several batches parses each
+_FACTS: dict[str, tuple[Signature, str, tuple[str, ...]]] = {}
+"""(signature, instruction, assets) by the SHA-256 of a spec's bytes: a process generating several batches parses each
 library spec once, not once a batch (the catalog the signatures read is fixed for a process)."""
 
 
-def _spec_facts(version) -> tuple[Signature, str]:
+def _spec_facts(version) -> tuple[Signature, str, tuple[str, ...]]:
     key = hashlib.sha256(version.files.spec.read_bytes()).hexdigest()
     hit = _FACTS.get(key)
     if hit is None:
-        hit = _FACTS[key] = (spec_signature(version.spec), version.spec.instruction)
+        hit = _FACTS[key] = (spec_signature(version.spec), version.spec.instruction, spec_assets(version.spec))
     return hit
+
+
+def spec_assets(spec: TaskSpec) -> tuple[str, ...]:
+    """The catalog assets of a spec's objects, sorted, each once."""
+    return tuple(sorted({o.asset for o in spec.objects}))
+
+
+def proposal_assets(proposal: dict) -> tuple[str, ...]:
+    """The catalog assets a proposal (as a backend writes it) puts in its scene, fills included."""
+    found = {o["asset"] for o in proposal["objects"]} | {o["fill"]["asset"] for o in proposal["objects"]
+                                                         if o.get("fill")}
+    return tuple(sorted(found))
 
 
 class Novelty:
@@ -187,4 +211,4 @@ def closest_tasks(request: str, tasks: Iterable[ExistingTask], k: int = 3,
 
 
 __all__ = ["ExistingTask", "MATCH_COSINE", "NEAR_DUPLICATE_COSINE", "Novelty", "closest_tasks", "existing_tasks",
-           "kind", "proposal_signature", "spec_signature"]
+           "fresh_first", "kind", "proposal_assets", "proposal_signature", "spec_assets", "spec_signature"]

@@ -29,7 +29,7 @@ from generator.backends.transcript import RecordingBackend
 from generator.catalog_view import asset_dicts
 from generator.errors import GeneratorError
 from generator.instruction import Reading, read_instruction
-from generator.novelty import ExistingTask, Novelty, existing_tasks, spec_signature
+from generator.novelty import ExistingTask, Novelty, existing_tasks, spec_assets, spec_signature
 from generator.records import GenerationInfo, to_json
 from generator.render import render_spec
 from generator.steps.gate import GATE_ATTEMPTS, GateResult, run_gate
@@ -354,13 +354,14 @@ class _TaskWorker:
 
 def _library_entry(version: TaskVersion) -> ExistingTask:
     """The near-duplicate test's entry for a committed task."""
-    return ExistingTask(version.env_id, spec_signature(version.spec), version.spec.instruction)
+    return ExistingTask(version.env_id, spec_signature(version.spec), version.spec.instruction,
+                        spec_assets(version.spec))
 
 
 def _guess(backend_factory, state: BatchState, index: int, instruction, reading, novelty: Novelty | None
            ) -> BatchState:
     """The state after task ``index`` if its first proposal is committed as proposed: a guess, checked later."""
-    from generator.novelty import proposal_signature
+    from generator.novelty import proposal_assets, proposal_signature
 
     try:
         proposal, _ = propose(backend_factory(), index=index, existing=state.existing(), instruction=instruction,
@@ -369,8 +370,9 @@ def _guess(backend_factory, state: BatchState, index: int, instruction, reading,
         return state
     entry = None
     if novelty is not None:
-        entry = ExistingTask(f"GenDex/{proposal.name}-v0", proposal_signature(dataclasses.asdict(proposal)),
-                             proposal.description)
+        as_written = dataclasses.asdict(proposal)
+        entry = ExistingTask(f"GenDex/{proposal.name}-v0", proposal_signature(as_written), proposal.description,
+                             proposal_assets(as_written))
     return state.after(proposal.name, frozenset(), entry)
 
 

@@ -158,14 +158,14 @@ class OfflineBackend:
     # ------------------------------------------------------------------ proposals
     def _propose(self, request: ModelRequest, ctx: dict) -> str:
         """A task of a skill drawn evenly from those with a task left to write (so a batch is not six "put X into
-        Y"), then of :data:`PROPOSAL_DRAWS` of that skill's tasks drawn, the one whose command reads least like the
-        library's ``ctx["existing_instructions"]``, worded least like them (:class:`generator.reword.ProposalWording`);
-        never an existing name, nor a task with the skills and object kinds of an existing one
-        (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`)."""
+        Y"), then of :data:`PROPOSAL_DRAWS` of that skill's tasks that bring an object the library has not used
+        (:func:`generator.novelty.fresh_first`) the one whose command reads least like the library's, worded least
+        like them (:class:`generator.reword.ProposalWording`); never an existing name, nor a task with the skills
+        and object kinds of an existing one (``ctx["existing_signatures"]``, :func:`generator.novelty.signature`)."""
         existing = set(ctx.get("existing_tasks", []))
         taken = {tuple(map(tuple, s)) for s in ctx.get("existing_signatures", [])}
         rng = self._rng(request, ctx.get("index", 0), ctx.get("attempt", 0))
-        from generator.novelty import proposal_signature
+        from generator.novelty import fresh_first, proposal_signature
 
         by_skill: dict[str, list[dict]] = {}
         options = self.task_options(ctx["assets"])
@@ -179,7 +179,8 @@ class OfflineBackend:
                                "an existing task's skills and objects")
         skills = sorted(by_skill)
         weights = np.array([COMPOSED_WEIGHT if k == "composed" else 1.0 for k in skills])
-        pool = by_skill[skills[int(rng.choice(len(skills), p=weights / weights.sum()))]]
+        skill = skills[int(rng.choice(len(skills), p=weights / weights.sum()))]
+        pool = fresh_first(by_skill[skill], ctx.get("existing_assets") or ())
         drawn = rng.choice(len(pool), size=min(PROPOSAL_DRAWS, len(pool)), replace=False)
         chosen = self._wording.least_alike([pool[int(i)] for i in drawn], ctx.get("existing_instructions") or ())
         return _fence("json", json.dumps(chosen, indent=2))

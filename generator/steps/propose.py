@@ -256,6 +256,7 @@ def propose(backend: Backend, *, index: int = 0, existing: tuple[str, ...] = (),
             context["existing_signatures"] = [[list(t.signature[0]), list(t.signature[1])]
                                               for t in novelty.existing]
             context["existing_instructions"] = [t.instruction for t in novelty.existing]
+            context["existing_assets"] = sorted({a for t in novelty.existing for a in t.assets})
         if instruction is not None:
             context["instruction"] = instruction
             context["reading"] = reading.to_dict()

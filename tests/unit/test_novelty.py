@@ -70,6 +70,28 @@ def test_the_offline_author_proposes_no_duplicate_of_the_library_or_of_its_own_b
         novelty.add(ExistingTask(f"GenDex/{p.name}-v0", sig, p.description))
 
 
+def test_the_offline_author_widens_the_set_of_objects_the_library_uses():
+    """Each autonomous proposal puts in its scene an object no library task (nor one of its batch) has used while
+    the drawn skill has such a task; ``fresh_first`` keeps every proposal when none brings a new object."""
+    from generator.novelty import ExistingTask, fresh_first, proposal_assets
+
+    novelty = Novelty(existing_tasks([REPO_TASKS_DIR]))
+    used = {a for t in novelty.existing for a in t.assets}
+    assert "apple" in used and len(used) >= 100  # the committed library's assets are read from the specs
+    b, names = OfflineBackend(seed=23), ()
+    for i in range(6):
+        p, _ = propose(b, index=i, existing=names, novelty=novelty)
+        as_written = dataclasses.asdict(p)
+        assert set(proposal_assets(as_written)) - used, (p.name, proposal_assets(as_written))
+        used |= set(proposal_assets(as_written))
+        names += (p.name,)
+        novelty.add(ExistingTask(f"GenDex/{p.name}-v0", proposal_signature(as_written), p.description,
+                                 proposal_assets(as_written)))
+    old = [_put("apple", "bowl", ""), _put("peach", "bowl", "")]
+    assert fresh_first(old, {"apple", "bowl", "peach"}) == old
+    assert fresh_first(old, {"apple", "bowl"}) == old[1:]
+
+
 def test_an_extension_equals_adding_one_by_one_leaves_the_original_and_is_made_once(novelty):
     import numpy as np
 
