@@ -13,7 +13,8 @@ manifest :class:`~gendex_envs.assets.manifest.AssetEntry` (:meth:`Model.entry`).
 * Each link's ``<inertial>``: its mass at the shapes' volume-weighted centroid, with the inertia of a solid box of
   that mass filling the link's collision bounding box.
 
-``python -m gendex_envs.assets.build_articulated`` writes every variant of :func:`all_models`.
+``python -m gendex_envs.assets.build_articulated`` writes every variant of :data:`VARIANTS` and of
+:mod:`gendex_envs.assets.articulated_more`.
 """
 
 from __future__ import annotations
@@ -644,7 +645,3 @@ VARIANTS: dict[str, Callable[[], Model]] = {
     "switch_lever_tall": lambda: lever_switch("switch_lever_tall", 0.12, 0.15),
 }
 """Every shipped variant, by asset id."""
-
-
-def all_models() -> list[Model]:
-    return [make() for _, make in sorted(VARIANTS.items())]
