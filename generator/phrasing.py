@@ -141,6 +141,9 @@ MODEL_WORDS: dict[str, str] = {
     "oven_standard": "standard", "drawer_chest_1": "single-drawer", "drawer_chest_2": "two-drawer",
     "drawer_chest_3": "three-drawer", "trash_can_small": "small", "trash_can_tall": "tall",
     "box_with_lid_small": "small", "box_with_lid_large": "large", "laptop_13in": "13-inch", "laptop_15in": "15-inch",
+    "trash_can_medium": "medium", "box_with_lid_medium": "medium", "laptop_14in": "14-inch",
+    "microwave_large": "large", "drawer_chest_2_wide": "wide", "cabinet_tall": "tall",
+    "dishwasher_plain": "plain", "dishwasher_rack": "racked",
     "peg_round": "round", "peg_square": "square", "peg_thin": "thin",
     "spill_round": "round", "spill_square": "square", "spill_long": "long",
 }

@@ -151,6 +151,24 @@ def test_sibling_models_are_worded_apart_and_read_back_as_themselves():
     assert "two-drawer" in two and "three-drawer" in three
 
 
+def test_every_articulated_model_with_siblings_has_its_own_words():
+    """A model added beside others of its category (articulated_more.py's medium bin, large microwave ...) gets
+    words of its own, or its tasks read like its siblings' and the near-duplicate test refuses them."""
+    from collections import defaultdict
+
+    from generator.phrasing import MODEL_WORDS
+
+    by_category = defaultdict(list)
+    for a in ASSETS.values():
+        if a.get("joints") and a["category"] not in ("button", "switch", "knob", "faucet", "valve", "bottle", "jar",
+                                                     "canister"):  # these are told apart by colour or not at all
+            by_category[a["category"]].append(a["id"])
+    for category, ids in by_category.items():
+        if len(ids) > 1:
+            words = [MODEL_WORDS.get(i) for i in ids]
+            assert None not in words and len(set(words)) == len(ids), (category, {i: MODEL_WORDS.get(i) for i in ids})
+
+
 def test_no_command_makes_a_possessive_of_a_name_with_of_or_with():
     """'shut the chest of drawers's drawer' was written for a chest (its names include 'chest of drawers'); the
     author takes another template of the skill there."""
