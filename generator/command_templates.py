@@ -157,6 +157,13 @@ COMMANDS: dict[str, tuple[str, ...]] = {
         "open the {d} by unscrewing its cap",
         "loosen the {d}'s cap until it comes free",
     ),
+    "twist_on": (
+        "screw the {d}'s cap back on",
+        "tighten the cap of the {d}",
+        "screw the lid back down on the {d}, a turn at a time",
+        "screw the {d}'s lid shut",
+        "put the cap back on the {d}",
+    ),
     "insert": (
         "insert the {o} into the {d}",
         "fit the {o} into the hole of the {d}",

@@ -87,7 +87,7 @@ class Reading:
     """Parts of the request that shape nothing (``the top drawer``: the drawer the solver opens is the first)."""
     direction: str | None = None
     """For a turn: ``"on"`` (towards the open end, the default) or ``"off"`` (*turn the tap off*, *close the
-    valve*: back to the shut end)."""
+    valve*: back to the shut end); for a twist: ``"on"`` screws the cap on (*close the jar*), None unscrews it."""
     relation: str | None = None
     """For ``place_at``: where the object goes relative to the others (a relation of the ``placed`` condition:
     ``left_of``, ``between``, ..., or ``in_region``)."""
@@ -458,7 +458,6 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
                                 color=colours[0] if len(colours) == 1 else None))
         at.append(run[0][0])
     mentions = _one_per_object([m for _, m in sorted(zip(at, mentions, strict=True), key=lambda p: p[0])])
-    direction = None
     amount, loose = read_amount(words)
     if loose:
         notes.append(loose)
@@ -467,6 +466,7 @@ def read_instruction(instruction: str, assets: Sequence[dict]) -> Reading:
 
     r = object_skill(Read(skill, roles, relation, region, mentions), words, text, assets)
     skill, roles, relation, region, mentions = r.skill, r.roles, r.relation, r.region, r.mentions
+    direction = r.direction  # 'on': a cap screwed on
     if skill in ("push", "turn", "flip") and mentions and mentions[0].asset and ROLE_TESTS["pressable"](
             _by_id(assets, mentions[0].asset)):
         skill, roles = "press", SKILL_ROLES["press"]  # 'push the button', 'turn on the switch'

@@ -54,10 +54,13 @@ class ExistingTask:
 
 def _how(kind_: str, negate: bool, part: str | None) -> str | None:
     """How a joint condition moves its part, beyond its task skill: ``part_way`` (held at a fraction), ``off`` (a
-    lever turned back shut); None for all the way (a half-open door is another task than an open one)."""
+    lever turned back shut), ``on`` (a cap screwed on); None for all the way (a half-open door is another task than
+    an open one)."""
     if kind_ == "joint_at":
         return "part_way"
-    return "off" if kind_ == "joint_open" and negate and part == "lever" else None
+    if kind_ == "joint_open" and negate and part in ("lever", "cap"):
+        return "off" if part == "lever" else "on"  # a cap screwed on is another task than one unscrewed
+    return None
 
 
 def spec_signature(spec: TaskSpec) -> Signature:

@@ -421,7 +421,7 @@ def direction(skill: str) -> str | None:
     switches on and a twist unscrews: both open."""
     if skill.startswith(("open_", "press_")) or skill in ("turn", "turn_part", "press", "twist"):
         return "open"
-    if skill.startswith("close_") or skill == "turn_off":
+    if skill.startswith("close_") or skill in ("turn_off", "twist_on"):
         return "close"
     return None
 

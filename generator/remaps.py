@@ -3,7 +3,7 @@
 
 - a hand-over mat among the objects: ``hand_over`` (*set the bottle on the hand-over mat*); the mat is the task's own;
 - a screw-top model opened, turned, taken off or pressed: ``twist`` (*open the jar*, *take the lid off the bottle*);
-  screwing one on is refused, saying what is built;
+  screwed on, tightened or closed: ``twist`` with direction ``on`` (*screw the lid on the jar*, *close the jar*);
 - a peg put, placed, inserted or fitted into a holder (or a peg inserted): ``insert`` (*put the square peg in the
   square hole*, *push the peg into the hole*, *insert the peg*); a peg picked up, or pushed to the goal, stays a
   lift or a push;
@@ -24,8 +24,6 @@ import dataclasses
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from generator.errors import InstructionError
-
 if TYPE_CHECKING:  # pragma: no cover
     from generator.instruction import Mention
 
@@ -42,6 +40,8 @@ class Read:
     relation: str | None
     region: str | None
     mentions: list[Mention]
+    direction: str | None = None
+    """``"on"``: a cap screwed on (a twist that shuts)."""
 
 
 def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -> Read:
@@ -56,13 +56,12 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
         # the mat is the task's own, not an object to assign
         r = Read("hand_over", SKILL_ROLES["hand_over"], None, None, [m for m in r.mentions if m not in zone])
     screws = [m for m in (_screw_model(m, assets) for m in r.mentions) if m is not None]
-    tighten = r.skill == "close" or words[-1:] == ["on"] or any(w in ("screw", "tighten") for w in words)
-    capped = r.skill != "take_out" or any(w in ("lid", "cap", "top") for w in words)  # not 'take the apple out of'
-    if screws and capped and r.skill in ("open", "turn", "take_out", "press", "close", "twist"):
-        if tighten:
-            raise InstructionError(f'"{text}": screwing a cap on (tightening it) is not built yet; GenDex unscrews '
-                                   "caps and lids ('unscrew the jar lid')")
-        r = dataclasses.replace(r, skill="twist", roles=SKILL_ROLES["twist"], mentions=screws[:1])
+    tighten = r.skill in ("close", "place_on") or words[-1:] == ["on"] or any(w in ("screw", "tighten") for w in words)
+    # not 'take the apple out of the jar', 'put the apple on the jar'; but 'put the cap back on the bottle'
+    capped = r.skill not in ("take_out", "place_on") or any(w in ("lid", "cap", "top") for w in words)
+    if screws and capped and r.skill in ("open", "turn", "take_out", "press", "close", "twist", "place_on"):
+        r = dataclasses.replace(r, skill="twist", roles=SKILL_ROLES["twist"], mentions=screws[:1],
+                                direction="on" if tighten else None)  # 'screw the lid on the jar', 'close the jar'
     socket = any(plays(m, "socket") for m in r.mentions)
     peg_only = r.skill == "put_in" and all(plays(m, "insertable") for m in r.mentions)  # 'insert the peg'
     if r.mentions and (r.skill == "insert" or peg_only or (socket and r.skill in ("put_in", "place_on", "place_at",

@@ -95,12 +95,12 @@ class TwistPrimitives:
         m.avoid_objects()
         radius = float(env.asset_record(name).entry.params.get("cap_radius", 1.0)) * env.task_spec.object(name).scale
         families = NARROW_FAMILIES if radius < NARROW_CAP_M else TWIST_FAMILIES
-        candidates = list(synth.candidates())
+        candidates, sign = list(synth.candidates()), self._goal(stage)[0]
         for plan in (p for fam in families for p in candidates if p.kind == fam):
             q_pre = m.ik.solve(plan.pregrasp, m.with_hand(m.target(), plan.open_hand), restarts=20,
                                valid=m.collision.is_free)
             q_palm = None if q_pre is None else m.ik.solve(plan.palm, q_pre, restarts=0)
-            if q_palm is None or not self._turns(plan, q_palm, env.handle_pos(name)[0].cpu().numpy()):
+            if q_palm is None or not self._turns(plan, q_palm, env.handle_pos(name)[0].cpu().numpy(), sign):
                 continue
             log.info("twisting %r with a %s", name, plan)
             self.plan = plan
@@ -110,13 +110,14 @@ class TwistPrimitives:
         raise ExecutionError(f"no grasp of {name!r}'s cap ({', '.join(TWIST_FAMILIES)}) that the arm reaches "
                              f"without collision (families {synth.families()})", cause="no_ik")
 
-    def _turns(self, plan: GraspPlan, q: np.ndarray, pivot: np.ndarray) -> bool:
-        """Whether the arm turns the palm of ``plan`` (at joint positions ``q``) a whole slice counter-clockwise
-        about ``pivot``, IK step by step as :meth:`~gendex.solve.motion.Motion.turn_about` will."""
+    def _turns(self, plan: GraspPlan, q: np.ndarray, pivot: np.ndarray, sign: float = 1.0) -> bool:
+        """Whether the arm turns the palm of ``plan`` (at joint positions ``q``) a whole slice about ``pivot``,
+        counter-clockwise (``sign`` +1: unscrewing) or clockwise (-1: screwing on), IK step by step as
+        :meth:`~gendex.solve.motion.Motion.turn_about` will."""
         ik, at = self.rigid.m.ik, sapien.Pose(np.asarray(pivot, dtype=np.float64))
         n = int(np.ceil(TWIST_SLICE_RAD / TWIST_RAD_PER_STEP))
         for k in range(1, n + 1):
-            half = TWIST_SLICE_RAD * k / n / 2
+            half = sign * TWIST_SLICE_RAD * k / n / 2
             q = ik.solve(at * sapien.Pose(q=[np.cos(half), 0.0, 0.0, np.sin(half)]) * at.inv() * plan.palm, q,
                          restarts=0)
             if q is None:

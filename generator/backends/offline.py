@@ -39,7 +39,7 @@ from gendex_envs.spec import JOINT_SKILLS
 from generator.backends import placed as placed_tasks
 from generator.backends import sequence
 from generator.backends.base import ModelRequest, ModelResponse
-from generator.backends.dexterous import flip_task, hang_task, insert_task, pour_task, wipe_task
+from generator.backends.dexterous import flip_task, hang_task, insert_task, joint_goal, pour_task, wipe_task
 from generator.backends.layouts import ARTICULATED_LAYOUTS
 from generator.backends.offline_scene import scene_spec
 from generator.backends.roles import (
@@ -102,7 +102,7 @@ PART_TURN = 0.65
 """How far the autonomous grammar turns a lever part way (0.65 of a 1.2 rad range: 45 degrees)."""
 TASK_KINDS = ("lift", "put_in", "place_on", "stack", "push", "open_door", "open_drawer", "open_lid", "close_door",
               "close_drawer", "close_lid", "turn", "turn_off", "open_part", "turn_part", "place_at", "take_out",
-              "press", "hand_over", "twist", "insert", "wipe", "hang", "pour", "flip",
+              "press", "hand_over", "twist", "twist_on", "insert", "wipe", "hang", "pour", "flip",
               "several", "composed")
 """The kinds of task the autonomous grammar draws evenly (:meth:`OfflineBackend.task_options`): a task skill, a door
 or drawer held part way open (``open_part``), a lever turned part way (``turn_part``: none while no lever's layout
@@ -243,7 +243,7 @@ class OfflineBackend:
         # in the middle of where the rigid part works: measured 0/3), then a rigid task
         firsts = [(skill, by_id[i]) for (skill, i), lay in ARTICULATED_LAYOUTS.items()
                   if i in by_id and not lay["grasp"] and lay["measured"]
-                  and skill not in ("turn", "turn_off", "press", "twist")
+                  and skill not in ("turn", "turn_off", "press", "twist", "twist_on")
                   and lay.get("composed", True)]
         seconds = ([("lift", a, None) for a in g] + [("put_in", a, b) for a in m for b in c if fits_in(a, b)]
                    + [("place_on", a, b) for a in m for b in p])
@@ -405,34 +405,10 @@ class OfflineBackend:
         steps = [_step("reach", n, "arm", f"Bring the open hand to the {_w(n)}'s {part}.")]
         if layout["grasp"]:
             steps.append(_step("grasp", n, "hand", "Hook the fingers around the handle."))
-        if skill == "close":
-            steps.append(_step("close", n, "both", f"Push the {part} along its path until it is shut."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
-            text = f"The {part} is shut to less than 10 % of its opening."
-        elif skill == "turn":
-            steps.append(_step("turn", n, "both", f"Push the {part} round until it is fully turned."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.8}
-            text = f"The {part} is turned to at least 80 % of its range."
-        elif skill == "press":  # past the detent: a latching button or a switch then stays there
-            what = "button all the way down" if a["category"] == "button" else "switch's lever down past its click"
-            steps.append(_step("press", n, "both", f"Press the {what}."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
-            text = (f"The {_w(n)} is pressed in to at least 90 % of its travel." if a["category"] == "button"
-                    else f"The {_w(n)} is on: its lever is pressed down to at least 90 % of its swing.")
-        elif skill == "twist":  # a full turn counter-clockwise, a turn of the hand at a time
-            steps.append(_step("twist", n, "both", f"Unscrew the {_w(n)}'s cap, regrasping it between turns."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.9}
-            text = f"The {_w(n)}'s cap is unscrewed: turned at least 90 % of a full turn."
-        elif skill == "turn_off":  # a turn whose success is the joint shut: the stage pushes the lever back
-            steps.append(_step("turn", n, "both", f"Push the {part} back until the {_w(n)} is off."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.1, "negate": True}
-            text = f"The {part} is back to less than 10 % of its range: the {_w(n)} is off."
-        else:
-            steps.append(_step("open", n, "both", f"Lift the {part} along its arc until it is open."))
-            success = {"type": "joint_open", "object": n, "min_fraction": 0.5}
-            text = f"The {part} is open to at least half of its opening."
+        verb, doing, success, text = joint_goal(skill, a, n, part)
+        steps.append(_step(verb, n, "both", doing))
         name = (_camel("turn", a["id"], "off") if skill == "turn_off" else _camel("unscrew", n) if skill == "twist"
-                else _camel(skill, a["id"]))
+                else _camel("screw", "on", n) if skill == "twist_on" else _camel(skill, a["id"]))
         return {
             "name": name, "description": phrase(f"press_{a['category']}" if skill == "press" else _kind(skill, a),
                                                 a, self._words(name)),
@@ -582,7 +558,8 @@ class OfflineBackend:
                                        f"way falls); '{mentions[0]['phrase']}' ({a['id']}) opens by its {_part(a)}")
             proposal = self._open_task(a, None if amount is None else joint_fraction(amount, a))
         elif skill in JOINT_SKILLS:
-            act = "turn_off" if skill == "turn" and reading.get("direction") == "off" else skill
+            act = ("turn_off" if skill == "turn" and reading.get("direction") == "off" else "twist_on"
+                   if skill == "twist" and reading.get("direction") == "on" else skill)
             if amount is not None and act != "turn":
                 raise InstructionError(f"the offline author opens only doors and drawers part way (by their handle: "
                                        f"a lid let go part way falls); it cannot {act} "

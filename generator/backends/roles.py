@@ -17,9 +17,9 @@ def _part(a: dict) -> str:
 
 
 def _kind(skill: str, a: dict) -> str:
-    """The task skill of ``skill`` (open, close, turn, turn_off) on articulated ``a``: ``close_door``, ``open_lid``,
-    ``turn``, ``turn_off``."""
-    return skill if skill in ("turn", "turn_off", "press", "twist") else f"{skill}_{_part(a)}"
+    """The task skill of ``skill`` (open, close, turn, turn_off, twist, twist_on) on articulated ``a``:
+    ``close_door``, ``open_lid``, ``turn``, ``turn_off``, ``twist_on``."""
+    return skill if skill in ("turn", "turn_off", "press", "twist", "twist_on") else f"{skill}_{_part(a)}"
 
 
 MIN_GRASP_RATE = 0.9
@@ -197,10 +197,12 @@ def fits_in(g: dict, c: dict) -> bool:
 
 def _acts(proposal: dict) -> dict[str, str]:
     """What the proposal does to each articulated object, as a key of :data:`ARTICULATED_LAYOUTS`: its step's skill
-    (open, close, turn), ``turn_off`` for a turn whose success condition is the joint shut."""
+    (open, close, turn, twist), ``turn_off`` for a turn and ``twist_on`` for a twist whose success condition is the
+    joint shut."""
     shut = {c["object"] for c in (proposal["success"], *(proposal.get("also") or ()))
             if c["type"] == "joint_open" and c.get("negate")}
-    return {s["target"]: "turn_off" if s["skill"] == "turn" and s["target"] in shut else s["skill"]
+    back = {"turn": "turn_off", "twist": "twist_on"}
+    return {s["target"]: back[s["skill"]] if s["skill"] in back and s["target"] in shut else s["skill"]
             for s in proposal["steps"] if s["skill"] in JOINT_SKILLS}
 
 

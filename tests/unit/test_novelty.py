@@ -71,22 +71,26 @@ def test_the_offline_author_proposes_no_duplicate_of_the_library_or_of_its_own_b
 
 
 def test_the_offline_author_widens_the_set_of_objects_the_library_uses():
-    """Each autonomous proposal puts in its scene an object no library task (nor one of its batch) has used while
-    the drawn skill has such a task; ``fresh_first`` keeps every proposal when none brings a new object."""
-    from generator.novelty import ExistingTask, fresh_first, proposal_assets
+    """Of a drawn skill's tasks the author proposes one that puts in its scene an object no existing task uses
+    (``ctx["existing_assets"]``, handed over by the propose step from the library's specs); ``fresh_first`` keeps
+    every proposal when none brings a new object."""
+    import json
+
+    from generator.backends.base import ModelRequest
+    from generator.catalog_view import asset_dicts
+    from generator.novelty import fresh_first, proposal_assets
 
     novelty = Novelty(existing_tasks([REPO_TASKS_DIR]))
     used = {a for t in novelty.existing for a in t.assets}
     assert "apple" in used and len(used) >= 100  # the committed library's assets are read from the specs
-    b, names = OfflineBackend(seed=23), ()
-    for i in range(6):
-        p, _ = propose(b, index=i, existing=names, novelty=novelty)
-        as_written = dataclasses.asdict(p)
-        assert set(proposal_assets(as_written)) - used, (p.name, proposal_assets(as_written))
-        used |= set(proposal_assets(as_written))
-        names += (p.name,)
-        novelty.add(ExistingTask(f"GenDex/{p.name}-v0", proposal_signature(as_written), p.description,
-                                 proposal_assets(as_written)))
+    everything = {a["id"] for a in asset_dicts()}
+    for fresh in ("pear", "lime", "hourglass"):  # every lift but one is of a used object: that one is proposed
+        ctx = {"assets": list(asset_dicts()), "existing_assets": sorted(everything - {fresh})}
+        for seed in range(3):
+            text = OfflineBackend(seed=seed, kinds=("lift",)).complete(
+                ModelRequest(step="propose", prompt="", context=ctx)).text
+            p = json.loads(text.split("```json")[1].split("```")[0])
+            assert proposal_assets(p) == (fresh,), (fresh, p["name"])
     old = [_put("apple", "bowl", ""), _put("peach", "bowl", "")]
     assert fresh_first(old, {"apple", "bowl", "peach"}) == old
     assert fresh_first(old, {"apple", "bowl"}) == old[1:]

@@ -161,7 +161,8 @@ def test_a_tall_appliance_is_scaled_down_but_keeps_a_handle_the_fingers_fit_behi
 
 
 def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
-    """Stack, push and every measured articulated layout (close a door or drawer, open or close a lid, turn a lever):
+    """Stack, push and every measured articulated layout (close a door or drawer, open or close a lid, turn a lever,
+    unscrew a cap or screw it on):
     the scene parses with the task schema, starts the joint where the reference task measured it, and the composed
     reward modules pass the static validator (a shut joint rewards closing, a push rewards the object's way to the
     goal mark)."""
@@ -170,11 +171,12 @@ def test_every_skill_template_gives_a_valid_scene_and_vetted_reward_code():
 
     b = OfflineBackend(seed=3)
     options = [o for skill, o in b.task_options(list(asset_dicts())) if skill != "composed"]
-    picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn", "Press", "Unscrew"))
+    picked = [o for o in options if o["name"].startswith(("Stack", "Push", "Close", "Turn", "Press", "Unscrew",
+                                                          "ScrewOn"))
               and not o["name"].endswith(("Half", "Degrees"))
               or (o["name"].startswith("Open") and o["objects"][0]["asset"] in {i for _, i in ARTICULATED_LAYOUTS})]
     kinds = {o["name"][:4] for o in picked}
-    assert kinds == {"Stac", "Push", "Clos", "Turn", "Open", "Pres", "Unsc"}, kinds
+    assert kinds == {"Stac", "Push", "Clos", "Turn", "Open", "Pres", "Unsc", "Scre"}, kinds
     laid_out = 0
     for i, raw in enumerate(picked):
         p = parse_proposal("```json\n" + json.dumps(raw) + "\n```")

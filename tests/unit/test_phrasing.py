@@ -16,7 +16,7 @@ ASSETS = {a["id"]: a for a in asset_dicts()}
 READ_AS = {"open_door": "open", "open_drawer": "open", "open_lid": "open", "close_door": "close",
            "close_drawer": "close", "close_lid": "close", "turn_off": "turn", "open_door_part": "open",
            "open_drawer_part": "open", "turn_part": "turn", "put_in_drawer": "put_in", "take_out_drawer": "take_out",
-           "press_button": "press", "press_switch": "press"}
+           "press_button": "press", "press_switch": "press", "twist_on": "twist"}
 CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks of that skill
     "lift": ("apple", None), "put_in": ("lemon", "pot"), "place_on": ("pear", "plate"),
     "stack": ("block_medium", "block_large"), "push": ("block_large", None),
@@ -28,7 +28,7 @@ CASES = {  # skill -> (object acted on, destination), one of the grammar's tasks
     "turn_part": ("valve_lever_short", None), "take_out": ("can", "bowl"),
     "put_in_drawer": ("lemon", "drawer_chest_2"), "take_out_drawer": ("can", "drawer_chest_3"),
     "press_button": ("button_estop", None), "press_switch": ("switch_lever", None), "hand_over": ("mug", None),
-    "twist": ("screw_jar", None), "insert": ("peg_square", "peg_holder_square"),
+    "twist": ("screw_jar", None), "twist_on": ("screw_bottle", None), "insert": ("peg_square", "peg_holder_square"),
     "wipe": ("sponge_block", "spill_square"), "hang": ("mug", "mug_tree"), "pour": ("tumbler", "bowl"),
     "flip": ("paper_cup", None),
 }
@@ -58,8 +58,9 @@ def test_every_command_reads_back_as_its_task(skill):
                 r = read_instruction(text, list(ASSETS.values()))
                 assert r.amount == AMOUNTS.get(skill, ("", None))[1], text
                 assert r.skill == READ_AS.get(skill, skill), text
-                if r.skill == "turn":  # the direction the command says, read back
-                    assert r.direction == ("off" if skill == "turn_off" else "on"), text
+                if r.skill in ("turn", "twist"):  # the direction the command says, read back
+                    said = {"turn_off": "off", "twist": None}.get(skill, "on")
+                    assert r.direction == said, text
                 got = [ASSETS[m.asset]["category"] for m in r.objects]
                 want = ([ASSETS[piece]["category"]] if piece else []) + [ASSETS[main]["category"]] + (
                     [ASSETS[other]["category"]] if other else [])

@@ -13,7 +13,7 @@ from generator.backends.layouts import ARTICULATED_LAYOUTS, TWIST_RANDOMIZE
 from generator.backends.offline import OfflineBackend
 from generator.backends.offline_scene import STAGE_HORIZONS
 from generator.catalog_view import asset_dicts
-from generator.instruction import InstructionError, read_instruction
+from generator.instruction import read_instruction
 from generator.phrasing import split
 from generator.reward_library import compose_stage_module, compose_task_module, roles_of
 from generator.stats import condition_skill, part_of
@@ -42,10 +42,40 @@ def test_the_same_words_keep_their_other_skills(text, skill, asset):
     assert (r.skill, r.objects[0].asset) == (skill, asset)
 
 
-@pytest.mark.parametrize("text", ["screw the lid on the jar", "tighten the jar lid", "close the jar"])
-def test_screwing_on_is_refused_saying_what_is_built(text):
-    with pytest.raises(InstructionError, match="not built yet.*unscrews"):
-        read_instruction(text, asset_dicts())
+@pytest.mark.parametrize("text, asset", [
+    ("screw the lid on the jar", "screw_jar"), ("tighten the jar lid", "screw_jar"), ("close the jar", "screw_jar"),
+    ("put the cap back on the bottle", "screw_bottle"), ("screw the canister's lid back on", "screw_canister")])
+def test_screwing_on_reads_as_a_twist_on(text, asset):
+    r = read_instruction(text, asset_dicts())
+    assert (r.skill, r.direction, [m.asset for m in r.objects]) == ("twist", "on", [asset]), r.lines()
+    assert read_instruction("unscrew the jar lid", asset_dicts()).direction is None
+
+
+@pytest.mark.parametrize("text, asset", [("screw the lid back on the jar", "screw_jar"),
+                                         ("close the bottle", "screw_bottle")])
+def test_a_screw_on_task_starts_a_full_turn_off_and_ends_shut(text, asset):
+    """The cap starts at its open end (FULL_TURN) and the task ends with it screwed shut (under 10 % of a turn):
+    another task than unscrewing (its signature says ``on``), worded so the reader reads it back as screwing on."""
+    from generator.backends.layouts import FULL_TURN
+    from generator.novelty import proposal_signature
+
+    b = OfflineBackend(seed=5)
+    reading = read_instruction(text, asset_dicts())
+    p = parse_proposal(b.complete(ModelRequest(step="propose_guided", prompt="", context={
+        "reading": reading.to_dict(), "assets": asset_dicts()})).text)
+    assert [o.asset for o in p.objects] == [asset] and [s.skill for s in p.steps] == ["reach", "twist"]
+    assert p.name.startswith("ScrewOn") and p.success["negate"] and p.success["min_fraction"] == 0.1
+    back = read_instruction(split(p.description)[1], asset_dicts())
+    assert (back.skill, back.direction) == ("twist", "on"), (p.description, back.lines())
+    assert proposal_signature(dataclasses.asdict(p))[0] == ("twist", "on")
+    context = {"proposal": dataclasses.asdict(p), "candidate_index": 0, "index": 0, "attempt": 0,
+               "assets": [a for a in asset_dicts() if a["id"] == asset]}
+    spec = adjust_sizes(parse_scene(b.complete(ModelRequest(step="scene", prompt="", context=context)).text, p), p)
+    assert spec.objects[0].joint_state == {"cap_screw": FULL_TURN}
+    # shut is the whole success: no cap in the hand at the end
+    assert [(c.type, c.negate) for c in spec.success.conditions] == [("joint_open", True)]
+    raw, roles = spec_to_dict(spec), roles_of(dataclasses.asdict(p))
+    check_reward_source(compose_task_module(raw, roles))
 
 
 @pytest.mark.parametrize("text, asset", [("unscrew the jar lid", "screw_jar"),
