@@ -36,7 +36,7 @@ TASKS = ("GenDex/PutAppleBowl-v1", "GenDex/OpenCabinet-v2", "GenDex/CloseMicrowa
 
 
 def timed(checkout: Path, code: str) -> float:
-    env = dict(os.environ, PYTHONPATH=str(checkout), GENDEX_CACHE=os.environ.get("GENDEX_CACHE", ""))
+    env = dict(os.environ, PYTHONPATH=str(checkout))
     out = subprocess.run([sys.executable, "-c", code], cwd=checkout, env=env, capture_output=True, text=True,
                          check=True)
     return float(out.stdout.strip().splitlines()[-1])
