@@ -51,6 +51,14 @@ def test_screwing_on_reads_as_a_twist_on(text, asset):
     assert read_instruction("unscrew the jar lid", asset_dicts()).direction is None
 
 
+def test_putting_something_on_top_of_a_jar_is_no_twist():
+    """'on top of the jar' is a place (refused: a jar is no surface), not the cap screwed on."""
+    from generator.instruction import InstructionError
+
+    with pytest.raises(InstructionError, match="place_on"):
+        read_instruction("put the lemon on top of the jar", asset_dicts())
+
+
 @pytest.mark.parametrize("text, asset", [("screw the lid back on the jar", "screw_jar"),
                                          ("close the bottle", "screw_bottle")])
 def test_a_screw_on_task_starts_a_full_turn_off_and_ends_shut(text, asset):
