@@ -106,7 +106,12 @@ def existing_tasks(roots: Iterable[Path]) -> list[ExistingTask]:
     from generator.stats import latest_versions
 
     found = discover_tasks([r for r in roots if Path(r).is_dir()])
-    return [ExistingTask(env_id, *_spec_facts(v)) for env_id, v in sorted(latest_versions(found).items())]
+    return [library_entry(v) for _, v in sorted(latest_versions(found).items())]
+
+
+def library_entry(version) -> ExistingTask:
+    """The near-duplicate test's entry for a committed task version (its facts parsed once per spec's bytes)."""
+    return ExistingTask(version.env_id, *_spec_facts(version))
 
 
 _FACTS: dict[str, tuple[Signature, str, tuple[str, ...]]] = {}
@@ -214,4 +219,5 @@ def closest_tasks(request: str, tasks: Iterable[ExistingTask], k: int = 3,
 
 
 __all__ = ["ExistingTask", "MATCH_COSINE", "NEAR_DUPLICATE_COSINE", "Novelty", "closest_tasks", "existing_tasks",
-           "fresh_first", "kind", "proposal_assets", "proposal_signature", "spec_assets", "spec_signature"]
+           "fresh_first", "kind", "library_entry", "proposal_assets", "proposal_signature", "spec_assets",
+           "spec_signature"]

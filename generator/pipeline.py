@@ -29,7 +29,7 @@ from generator.backends.transcript import RecordingBackend
 from generator.catalog_view import asset_dicts
 from generator.errors import GeneratorError
 from generator.instruction import Reading, read_instruction
-from generator.novelty import ExistingTask, Novelty, existing_tasks, spec_assets, spec_signature
+from generator.novelty import ExistingTask, Novelty, existing_tasks, library_entry
 from generator.records import GenerationInfo, to_json
 from generator.render import render_spec
 from generator.steps.gate import GATE_ATTEMPTS, GateResult, run_gate
@@ -291,7 +291,7 @@ def _generate(backend_factory: Callable[[], Backend], root: Path, *, n: int, see
             continue
         existing = (*existing, summary.committed.name)
         if novelty is not None:
-            novelty.add(_library_entry(summary.committed))
+            novelty.add(library_entry(summary.committed))
         out.append(summary)
         if progress is not None:
             progress(summary)
@@ -350,12 +350,6 @@ class _TaskWorker:
             except GeneratorError as exc:
                 return _Outcome(index, state, None, str(exc), frozenset(dropped))
         return _Outcome(index, state, built, None, frozenset(dropped))
-
-
-def _library_entry(version: TaskVersion) -> ExistingTask:
-    """The near-duplicate test's entry for a committed task."""
-    return ExistingTask(version.env_id, spec_signature(version.spec), version.spec.instruction,
-                        spec_assets(version.spec))
 
 
 def _guess(backend_factory, state: BatchState, index: int, instruction, reading, novelty: Novelty | None
@@ -441,7 +435,7 @@ def _generate_in_parallel(backend_factory, root: Path, *, n: int, seed: int, ins
                 else:
                     summary = outcome.built.publish(root)
                     state = state.after(summary.committed.name, outcome.dropped,
-                                        _library_entry(summary.committed) if novelty is not None else None)
+                                        library_entry(summary.committed) if novelty is not None else None)
                     out.append(summary)
                     if progress is not None:
                         progress(summary)

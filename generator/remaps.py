@@ -58,8 +58,8 @@ def object_skill(r: Read, words: list[str], text: str, assets: Sequence[dict]) -
     screws = [m for m in (_screw_model(m, assets) for m in r.mentions) if m is not None]
     tighten = r.skill in ("close", "place_on") or words[-1:] == ["on"] or any(w in ("screw", "tighten") for w in words)
     # not 'take the apple out of the jar', 'put the apple on (top of) the jar'; but 'put the cap back on the bottle'
-    capped = (r.skill not in ("take_out", "place_on")
-              or any(w in (("lid", "cap") if r.skill == "place_on" else ("lid", "cap", "top")) for w in words))
+    cap_words = ("lid", "cap") if r.skill == "place_on" else ("lid", "cap", "top")
+    capped = r.skill not in ("take_out", "place_on") or any(w in cap_words for w in words)
     if screws and capped and r.skill in ("open", "turn", "take_out", "press", "close", "twist", "place_on"):
         r = dataclasses.replace(r, skill="twist", roles=SKILL_ROLES["twist"], mentions=screws[:1],
                                 direction="on" if tighten else None)  # 'screw the lid on the jar', 'close the jar'

@@ -95,7 +95,8 @@ class TwistPrimitives:
         m.avoid_objects()
         radius = float(env.asset_record(name).entry.params.get("cap_radius", 1.0)) * env.task_spec.object(name).scale
         families = NARROW_FAMILIES if radius < NARROW_CAP_M else TWIST_FAMILIES
-        candidates, sign = list(synth.candidates()), self._goal(stage)[0]
+        candidates = list(synth.candidates())
+        sign = self._goal(stage)[0]  # the slice turns the way the task moves the cap
         for plan in (p for fam in families for p in candidates if p.kind == fam):
             q_pre = m.ik.solve(plan.pregrasp, m.with_hand(m.target(), plan.open_hand), restarts=20,
                                valid=m.collision.is_free)

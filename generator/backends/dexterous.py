@@ -144,10 +144,6 @@ def flip_task(a: dict, words: Words, colors: tuple[str | None, ...] = ()) -> dic
     }
 
 
-__all__ = ["FLIP_TILT_DEG", "HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "POUR_FRACTION", "POUR_PIECES",
-           "WIPE_FRACTION", "flip_task", "hang_task", "insert_task", "pour_task", "wipe_task"]
-
-
 def joint_goal(skill: str, a: dict, n: str, part: str) -> tuple[str, str, dict, str]:
     """What a task that moves articulated ``a`` (spec name ``n``, its moving ``part``) by ``skill`` asks: the stage
     skill, what the stage does, the success condition and its sentence. ``skill``: close, turn, press (past the
@@ -185,3 +181,6 @@ def joint_goal(skill: str, a: dict, n: str, part: str) -> tuple[str, str, dict, 
     return ("open", doing, {"type": "joint_open", "object": n, "min_fraction": 0.5},
             f"The {part} is open to at least half of its opening.")
 
+
+__all__ = ["FLIP_TILT_DEG", "HANG_LIFT_M", "INSERT_DZ_M", "INSERT_XY_M", "POUR_FRACTION", "POUR_PIECES",
+           "WIPE_FRACTION", "flip_task", "hang_task", "insert_task", "joint_goal", "pour_task", "wipe_task"]

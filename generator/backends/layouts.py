@@ -99,51 +99,6 @@ ARTICULATED_LAYOUTS: dict[tuple[str, str], dict[str, Any]] = {
         "measured": "gate 10/10 (guided generation, seed 8502)", "randomize": TWIST_RANDOMIZE},
     ("twist", "screw_canister"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
         "measured": "gate 10/10 (guided generation, seed 8503)", "randomize": TWIST_RANDOMIZE},
-    # caps screwed back on from a full turn off (the joint's open end), at the unscrewing layouts
-    ("twist_on", "screw_jar"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": FULL_TURN, "grasp": False,
-        "measured": "gate 10/10 (guided generation, seed 4561)", "randomize": TWIST_RANDOMIZE},
-    ("twist_on", "screw_bottle"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": FULL_TURN, "grasp": False,
-        "measured": "gate 10/10 (guided generation, seed 4562)", "randomize": TWIST_RANDOMIZE},
-    ("twist_on", "screw_canister"): {"pos_m": (0.12, 0.0), "yaw_deg": 0.0, "start": FULL_TURN, "grasp": False,
-        "measured": "gate 10/10 (guided generation, seed 4563)", "randomize": TWIST_RANDOMIZE},
-    # the models of gendex_envs/assets/articulated_more.py, each at its nearest sibling's layout (not composed where
-    # the sibling's composed place was not measured on it)
-    ("open", "trash_can_medium"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                   "measured": "gate 10/10 (guided generation, seed 4522)", "composed": False},
-    ("open", "box_with_lid_medium"): {"pos_m": (0.5, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
-                                      "measured": "gate 10/10 (guided generation, seed 4524)", "fixed": False,
-                                      "composed": False},
-    ("close", "box_with_lid_medium"): {"pos_m": (0.45, -0.15), "yaw_deg": 75.0, "start": 1.8, "grasp": False,
-                                       "measured": "gate 10/10 (guided generation, seed 4523)"},
-    ("close", "laptop_14in"): {"pos_m": (0.45, 0.0), "yaw_deg": 0.0, "start": 1.5, "grasp": False,
-                               "measured": "gate 10/10 (guided generation, seed 4525)"},
-    ("close", "microwave_large"): {"pos_m": (0.6, 0.25), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                   "measured": "gate 10/10 (guided generation, seed 4526)"},
-    ("close", "drawer_chest_2_wide"): {"pos_m": (0.637, 0.0), "yaw_deg": 0.0, "start": 0.18, "grasp": True,
-                                       "measured": "gate 10/10 (guided generation, seed 4551)",
-                                       "randomize": {"xy_m": [0.03, 0.05], "yaw_deg": 8.0}},
-    # bottom-hinged doors lying open, shut at the compact oven's layout (a little further out)
-    ("close", "oven_standard"): {"pos_m": (0.45, 0.313), "yaw_deg": 0.0, "start": 1.57, "grasp": False,
-                                 "measured": "gate 10/10 (guided generation, seed 4564)", "composed": False},
-    ("close", "dishwasher_plain"): {"pos_m": (0.45, 0.313), "yaw_deg": 0.0, "start": 1.57, "grasp": False,
-                                    "measured": "gate 10/10 (guided generation, seed 4571)", "composed": False},
-    ("close", "dishwasher_rack"): {"pos_m": (0.45, 0.313), "yaw_deg": 0.0, "start": 1.57, "grasp": False,
-                                   "measured": "gate 10/10 (guided generation, seed 4572)", "composed": False},
-    # a bottom-hinged door opened by the hook near the robot, where OpenOvenCompact-v2 has its oven, to half its
-    # opening (asked for 80 %, the arm reached no pose over the arc's end: 9 of 20 attempts, seeds 4591, 4595)
-    ("open", "oven_standard"): {"pos_m": (0.40, 0.29), "yaw_deg": 0.0, "start": 0.0, "grasp": True,
-                                "measured": "gate 10/10 to half open (guided generation, seed 4565)",
-                                "composed": False},
-    ("open", "dishwasher_plain"): {"pos_m": (0.40, 0.29), "yaw_deg": 0.0, "start": 0.0, "grasp": True,
-                                   "measured": "gate 10/10 to half open (guided generation, seed 4581)",
-                                   "composed": False},
-    ("open", "dishwasher_rack"): {"pos_m": (0.40, 0.29), "yaw_deg": 0.0, "start": 0.0, "grasp": True,
-                                  "measured": "gate 10/10 to half open (guided generation, seed 4582)",
-                                  "composed": False},
-    ("close", "refrigerator_right_hinge"): {"pos_m": (0.65, -0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                            "measured": "gate 10/10 (guided generation, seed 4573)"},
-    ("close", "cabinet_tall"): {"pos_m": (0.643, 0.31), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
-                                "measured": "gate 10/10 (guided generation, seed 4534)"},
 }
 """Articulated objects the offline author closes, opens by pressing (lids), turns on or turns off (``turn_off``: the
 lever starts open, the task shuts it), with a layout the skill was
@@ -165,5 +120,45 @@ needs no entry. Tried and left out: opening the small lidded box by its lid (no 
 twists a knob: ``unsupported``) and lifting the lift-lever faucet's lever
 (the pressing hand slips off it: 0/3 at four gates). A request for a variant not listed gets a listed variant of the
 same object as a recorded substitution."""
+def _as(layout: dict[str, Any], measured: str, **changes: Any) -> dict[str, Any]:
+    """``layout`` (a sibling model's, or a shared one) with this model's own record and ``changes``."""
+    return {**layout, "measured": measured, **changes}
+
+
+_GUIDED = "gate 10/10 (guided generation, seed {})"
+_HALF = "gate 10/10 to half open (guided generation, seed {})"
+_SHUT_BOTTOM_DOOR = {"pos_m": (0.45, 0.313), "yaw_deg": 0.0, "start": 1.57, "grasp": False, "composed": False}
+"""A bottom-hinged door (standard oven, dishwasher) lying open, shut at the compact oven's layout a little further
+out."""
+_OPEN_BOTTOM_DOOR = {"pos_m": (0.40, 0.29), "yaw_deg": 0.0, "start": 0.0, "grasp": True, "composed": False}
+"""... opened by the hook near the robot, where OpenOvenCompact-v2 has its oven, to half its opening (asked for 80 %,
+the arm reached no pose over the arc's end in 9 of 20 attempts, seeds 4591, 4595)."""
+_L = ARTICULATED_LAYOUTS
+ARTICULATED_LAYOUTS |= {
+    # caps screwed back on from a full turn off (the joint's open end), at the unscrewing layouts
+    ("twist_on", "screw_jar"): _as(_L["twist", "screw_jar"], _GUIDED.format(4561), start=FULL_TURN),
+    ("twist_on", "screw_bottle"): _as(_L["twist", "screw_bottle"], _GUIDED.format(4562), start=FULL_TURN),
+    ("twist_on", "screw_canister"): _as(_L["twist", "screw_canister"], _GUIDED.format(4563), start=FULL_TURN),
+    # the models of gendex_envs/assets/articulated_more.py, each at its nearest sibling's layout (not composed where
+    # the sibling's composed place was not measured on it)
+    ("open", "trash_can_medium"): {"pos_m": (0.55, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                                   "measured": _GUIDED.format(4522), "composed": False},
+    ("open", "box_with_lid_medium"): {"pos_m": (0.5, 0.0), "yaw_deg": 0.0, "start": 0.0, "grasp": False,
+                                      "measured": _GUIDED.format(4524), "fixed": False, "composed": False},
+    ("close", "box_with_lid_medium"): _as(_L["close", "box_with_lid_large"], _GUIDED.format(4523)),
+    ("close", "laptop_14in"): _as(_L["close", "laptop_13in"], _GUIDED.format(4525)),
+    ("close", "microwave_large"): _as(_L["close", "microwave_standard"], _GUIDED.format(4526)),
+    ("close", "drawer_chest_2_wide"): _as(_L["close", "drawer_chest_2"], _GUIDED.format(4551)),
+    ("close", "oven_standard"): _as(_SHUT_BOTTOM_DOOR, _GUIDED.format(4564)),
+    ("close", "dishwasher_plain"): _as(_SHUT_BOTTOM_DOOR, _GUIDED.format(4571)),
+    ("close", "dishwasher_rack"): _as(_SHUT_BOTTOM_DOOR, _GUIDED.format(4572)),
+    ("open", "oven_standard"): _as(_OPEN_BOTTOM_DOOR, _HALF.format(4565)),
+    ("open", "dishwasher_plain"): _as(_OPEN_BOTTOM_DOOR, _HALF.format(4581)),
+    ("open", "dishwasher_rack"): _as(_OPEN_BOTTOM_DOOR, _HALF.format(4582)),
+    ("close", "refrigerator_right_hinge"): {"pos_m": (0.65, -0.3), "yaw_deg": 0.0, "start": 0.6, "grasp": False,
+                                            "measured": _GUIDED.format(4573)},
+    ("close", "cabinet_tall"): _as(_L["close", "cabinet_left_hinge"], _GUIDED.format(4534)),
+}
+
 LAYOUT_JITTER_M = 0.02
 """How far a layout's nominal place is jittered per proposal (each side)."""

@@ -558,8 +558,8 @@ class OfflineBackend:
                                        f"way falls); '{mentions[0]['phrase']}' ({a['id']}) opens by its {_part(a)}")
             proposal = self._open_task(a, None if amount is None else joint_fraction(amount, a))
         elif skill in JOINT_SKILLS:
-            act = ("turn_off" if skill == "turn" and reading.get("direction") == "off" else "twist_on"
-                   if skill == "twist" and reading.get("direction") == "on" else skill)
+            act = {("turn", "off"): "turn_off", ("twist", "on"): "twist_on"}.get((skill, reading.get("direction")),
+                                                                                 skill)
             if amount is not None and act != "turn":
                 raise InstructionError(f"the offline author opens only doors and drawers part way (by their handle: "
                                        f"a lid let go part way falls); it cannot {act} "

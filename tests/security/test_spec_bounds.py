@@ -63,10 +63,10 @@ def test_version_folder_pattern_refuses_lookalikes(bad):
 
 def test_bounds_are_far_above_every_committed_task():
     """The bounds leave a wide margin over the committed library (largest values: |pos| 0.8 m, randomization
-    0.13 m, yaw range 180 deg, joint state 1.8). The committed files are read with libyaml (trusted, and ~20x
-    faster than the bounded loader, so the test stays cheap as the library grows); that every version still loads
-    through the bounded loader is ``gendex check``'s (``tests/sim/test_check.py``: the sample and the changed
-    versions by default, every version under ``--slow``)."""
+    0.13 m, yaw range 180 deg, joint state 6.28: a cap a full turn off). The committed files are read with libyaml
+    (trusted, and ~20x faster than the bounded loader, so the test stays cheap as the library grows); that every
+    version still loads through the bounded loader is ``gendex check``'s (``tests/sim/test_check.py``: the sample
+    and the changed versions by default, every version under ``--slow``)."""
     import yaml
 
     specs = sorted(REPO_TASKS_DIR.glob("*/v*/task.yaml"))
