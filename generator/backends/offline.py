@@ -29,6 +29,7 @@ validators as a model's:
 
 from __future__ import annotations
 
+import hashlib
 import json
 import zlib
 
@@ -120,6 +121,9 @@ PROPOSAL_DRAWS = 4
 (:meth:`generator.reword.ProposalWording.least_alike`)."""
 COMPOSED_WEIGHT = 2.0
 """How much likelier a composed task is drawn than the tasks of any one skill."""
+OPTIONS_KEPT = 4
+"""(seed, assets) whose task options (:meth:`OfflineBackend.task_options`) a process keeps written."""
+_OPTIONS: dict[tuple[int, str], list[tuple[str, dict]]] = {}
 STACK_GAP_M = 0.03
 """A stacked block rests on its base when it is this close above the base's top (the ``over`` band's width)."""
 HANDOVER_XY_M = 0.08
@@ -191,7 +195,17 @@ class OfflineBackend:
         return np.random.default_rng([self.seed, zlib.crc32(name.encode())])
 
     def task_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
-        """Every task this grammar can write from ``assets``, each with its task skill."""
+        """Every task this grammar can write from ``assets``, each with its task skill. The list depends on the seed
+        (its wordings) and the assets alone, and takes seconds to write (thousands of composed tasks): it is kept
+        for the last few (seed, assets), and its proposals are shared, to be read, not changed."""
+        key = (self.seed, hashlib.sha256(json.dumps(assets, sort_keys=True, default=str).encode()).hexdigest())
+        if key not in _OPTIONS:
+            while len(_OPTIONS) >= OPTIONS_KEPT:
+                _OPTIONS.pop(next(iter(_OPTIONS)))
+            _OPTIONS[key] = self._all_options(assets)
+        return list(_OPTIONS[key])
+
+    def _all_options(self, assets: list[dict]) -> list[tuple[str, dict]]:
         g = [a for a in assets if graspable(a)]
         m = [a for a in g if carried(a)]  # carried to a place; g are lifted
         c = [a for a in assets if container(a)]
