@@ -47,18 +47,25 @@ def _main(verbose: bool = typer.Option(False, "--verbose", "-v", help="Log debug
     logging.getLogger("gymnasium_robotics").setLevel(logging.ERROR)
 
 
-
-
 @app.command("list")
-def list_tasks() -> None:
+def list_tasks(pattern: str = typer.Argument("", help="Only the IDs that contain this text (any case), e.g. "
+                                                      "'Drawer' or 'PutAppleBowl-v1'."),
+               latest: bool = typer.Option(False, "--latest", help="Only the latest version of each task.")) -> None:
     """List the registered task versions (Gymnasium IDs): instruction, objects, stages, policies, origin."""
     from gendex_envs.errors import GenDexError
     from gendex_envs.registry import registered_tasks
+    from generator.stats import latest_versions
 
     tasks = registered_tasks()
     if not tasks:
         typer.echo("no tasks registered (looked in generated_tasks/ and $GENDEX_TASKS_PATH)")
         return
+    if latest:
+        tasks = latest_versions(tasks)
+    tasks = {env_id: v for env_id, v in tasks.items() if pattern.lower() in env_id.lower()}
+    if not tasks:
+        typer.echo(f"no registered task ID contains {pattern!r}", err=True)
+        raise typer.Exit(2)
     for env_id, version in sorted(tasks.items()):
         try:
             spec = version.spec

@@ -38,7 +38,7 @@ def test_train_then_promote_makes_a_new_version_and_keeps_the_old_one(task_copy,
         assert v1.version == 1 and v1.policy("lift_bottle").model.read_bytes() == r.policy.model.read_bytes()
         assert v1.start_states("lift_bottle") is not None
         assert v1.provenance()["promotion"]["runs"] == [str(run)]
-        listing = CliRunner().invoke(app, ["list"])
+        listing = CliRunner().invoke(app, ["list", "ScratchBottle"])
         assert "GenDex/ScratchBottle-v1" in listing.output and "promoted from GenDex/ScratchBottle-v0" in listing.output
 
         # v1's executor runs the promoted policy; v0's runs the scripted lift

@@ -59,11 +59,20 @@ def test_cli_render_unknown_task_is_a_clear_error(tmp_path):
     assert not list(tmp_path.iterdir())
 
 
-def test_cli_list_shows_tasks():
-    result = CliRunner().invoke(app, ["list"])
-    assert result.exit_code == 0
+def test_cli_list_shows_the_tasks_asked_for():
+    """``gendex list PATTERN`` lists the IDs containing PATTERN (any case), ``--latest`` the newest of each task;
+    a pattern no ID contains exits 2 saying so (every version is listed without a pattern: ``test_promote``)."""
     for env_id in REFERENCE_TASKS:
-        assert env_id in result.output
+        result = CliRunner().invoke(app, ["list", env_id.split("/")[1].lower()])
+        assert result.exit_code == 0 and env_id in result.output
+        assert result.output.count("GenDex/") == 1, result.output  # the reference tasks' IDs are no others' prefix
+    name = REFERENCE_TASKS[0].split("/")[1].rsplit("-v", 1)[0]
+    every = CliRunner().invoke(app, ["list", name + "-v"]).output
+    newest = CliRunner().invoke(app, ["list", name + "-v", "--latest"]).output
+    assert every.count("GenDex/") > 1 and newest.count("GenDex/") == 1
+    assert max(every.split(), key=lambda w: (w.startswith("GenDex/"), w)) in newest
+    missing = CliRunner().invoke(app, ["list", "NoSuchTaskAnywhere"])
+    assert missing.exit_code == 2 and "no registered task ID contains 'NoSuchTaskAnywhere'" in missing.output
 
 
 def test_named_colours_show_in_the_views(task_version):
