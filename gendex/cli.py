@@ -23,6 +23,7 @@ from gendex.cli_common import die as _die
 from gendex.cli_common import refuse_request as _refuse
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
+from gendex.cli_list import list_command
 from gendex.cli_store import store_app
 from gendex.cli_trust import trust_command
 from gendex_envs.registry import REFERENCE_TASKS
@@ -32,6 +33,7 @@ app = typer.Typer(add_completion=False, no_args_is_help=True,
 app.add_typer(dataset_app, name="dataset")
 app.add_typer(bc_app, name="bc")
 app.command("eval")(eval_command)
+app.command("list")(list_command)
 app.add_typer(leaderboard_app, name="leaderboard")
 app.command("trust")(trust_command)
 app.command("check")(check_command)
@@ -45,49 +47,6 @@ def _main(verbose: bool = typer.Option(False, "--verbose", "-v", help="Log debug
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s", datefmt="%H:%M:%S")
     # gymnasium-robotics prints a deprecation notice for unrelated Adroit envs on import; ManiSkill logs on its own
     logging.getLogger("gymnasium_robotics").setLevel(logging.ERROR)
-
-
-@app.command("list")
-def list_tasks(pattern: str = typer.Argument("", help="Only the IDs that contain this text (any case), e.g. "
-                                                      "'Drawer' or 'PutAppleBowl-v1'."),
-               latest: bool = typer.Option(False, "--latest", help="Only the latest version of each task.")) -> None:
-    """List the registered task versions (Gymnasium IDs): instruction, objects, stages, policies, origin."""
-    from gendex_envs.errors import GenDexError
-    from gendex_envs.registry import registered_tasks
-    from generator.stats import latest_versions
-
-    tasks = registered_tasks()
-    if not tasks:
-        typer.echo("no tasks registered (looked in generated_tasks/ and $GENDEX_TASKS_PATH)")
-        return
-    if latest:
-        tasks = latest_versions(tasks)
-    tasks = {env_id: v for env_id, v in tasks.items() if pattern.lower() in env_id.lower()}
-    if not tasks:
-        typer.echo(f"no registered task ID contains {pattern!r}", err=True)
-        raise typer.Exit(2)
-    for env_id, version in sorted(tasks.items()):
-        try:
-            spec = version.spec
-        except GenDexError as exc:
-            typer.echo(f"{env_id}\n    INVALID: {exc}")
-            continue
-        stages = " -> ".join(f"{s.name}[{s.skill}, {s.method}:{s.control_joint}]" for s in spec.stages)
-        objects = ", ".join(f"{o.name}({o.asset})" for o in spec.objects)
-        policies = ", ".join(version.artifacts.policy_stages()) or "none"
-        origin = version.provenance()
-        made = ("reworded from " + origin["reword"]["source"] if "reword" in origin
-                else "promoted from " + origin["promotion"]["source"] if "promotion" in origin
-                else "revised from " + origin["revision"]["source"] if "revision" in origin
-                else f"generated ({origin['generation']['backend']})" if "generation" in origin else "hand-written")
-        gate = origin.get("solvability")
-        solved = ("not measured by the solvability gate" if gate is None else
-                  f"{gate['successes']}/{gate['attempts']} solved by the {gate['solver_version']} on seeds "
-                  f"{gate['seeds'][0]}..{gate['seeds'][-1]}"
-                  + (f", {gate['env_steps_per_success']:.0f} env steps per success"
-                     if gate.get("env_steps_per_success") else ""))
-        typer.echo(f"{env_id}\n    {spec.instruction}\n    objects:  {objects}\n    stages:   {stages}\n"
-                   f"    policies: {policies}; {made}\n    solved:   {solved}\n    folder:   {version.root}")
 
 
 @app.command()
