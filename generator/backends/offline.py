@@ -421,8 +421,9 @@ class OfflineBackend:
             steps.append(_step("grasp", n, "hand", "Hook the fingers around the handle."))
         verb, doing, success, text = joint_goal(skill, a, n, part)
         steps.append(_step(verb, n, "both", doing))
-        name = (_camel("turn", a["id"], "off") if skill == "turn_off" else _camel("unscrew", n) if skill == "twist"
-                else _camel("screw", "on", n) if skill == "twist_on" else _camel(skill, a["id"]))
+        model = a["id"].removeprefix("screw_")  # screw_jar_small: UnscrewJarSmall, not a second UnscrewJar
+        name = (_camel("turn", a["id"], "off") if skill == "turn_off" else _camel("unscrew", model) if skill == "twist"
+                else _camel("screw", "on", model) if skill == "twist_on" else _camel(skill, a["id"]))
         return {
             "name": name, "description": phrase(f"press_{a['category']}" if skill == "press" else _kind(skill, a),
                                                 a, self._words(name)),
