@@ -112,8 +112,8 @@ MAX_ANGLE_DEG = 360.0
 ``robot.base_yaw_deg``."""
 MAX_JOINT_POSITION = 40.0
 """Bound on an initial joint position (``joint_state``, rad or m): about six turns of a screw cap; the committed
-library's largest is 6.28 (a cap a full turn off its thread). The env
-also checks each one against its joint's limits when it builds the scene (the asset is known only there)."""
+library's largest is 6.28 (a cap a full turn off its thread). The env also checks each one against its joint's
+limits when it builds the scene (the asset is known only there)."""
 MAX_TABLE_M = 50.0
 """Bound (m) on the table's size and height; the committed tables are 1.6 m x 1.2 m, 0.76 m high."""
 

@@ -229,3 +229,21 @@ def test_a_ball_resting_upside_down_on_the_board_is_on_it(make_env):
     near = next(c for c in u.task_spec.success.conditions if c.type == "near")
     assert (torch.linalg.norm(ball.pose.p - board.pose.p, dim=-1) > near.max_dist_m).all(), "the origin is over it"
     assert conditions_hold(u, (near,)).all(), f"ball at {ball.pose.p} {ball.pose.q}, board at {board.pose.p}"
+
+
+@pytest.mark.parametrize("value", [30.0, -39.0])
+def test_a_start_joint_position_within_the_spec_bound_but_past_the_joints_limits_is_refused(task_version, value):
+    """The spec's bound (MAX_JOINT_POSITION, 40: a screw cap may start turns off) is far looser than a drawer's
+    0.3 m slide: the env refuses the position against the joint's own limits, naming them, before anything moves."""
+    from gendex_envs.errors import TaskSpecError
+    from gendex_envs.spec import MAX_JOINT_POSITION, parse_task_spec, spec_to_dict
+    from gendex_envs.task_env import TaskEnv
+
+    raw = spec_to_dict(task_version("CloseDrawer").spec)
+    [drawer] = [o for o in raw["objects"] if o.get("joint_state")]
+    joint = next(iter(drawer["joint_state"]))
+    drawer["joint_state"][joint] = value
+    assert abs(value) <= MAX_JOINT_POSITION  # the spec itself takes it
+    limits = r"is outside the joint limits \[0\.0000, 0\.3000\]"
+    with pytest.raises(TaskSpecError, match=rf"joint_state\.{joint}={value} {limits}"):
+        TaskEnv(task_spec=parse_task_spec(raw), render_backend="none")
