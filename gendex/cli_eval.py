@@ -44,6 +44,7 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
     reason."""
     import dataclasses
 
+    from gendex.eval.eval_info import summary
     from gendex.eval.suite import load_suite
     from gendex.eval.suite_run import EvalError, run_suite
     from gendex_envs.errors import GenDexError
@@ -67,17 +68,29 @@ def eval_command(suite: str = typer.Option(..., "--suite", help="A suite in suit
         info = run_suite(s, policy, policy_factory, out, episodes=episodes,
                          backend=backend_of(workers, ray, ray_address),
                          training_seeds=trained_on, videos=videos, progress=show,
-                         allow_changed_tasks=allow_changed_tasks)
+                         allow_changed_tasks=allow_changed_tasks, groups=skill_groups(s.tasks))
     except (GenDexError, ValueError) as exc:
         die(exc)
-    for task, t in info["per_task"].items():
+    result = summary(info)
+    for task, t in result.per_task.items():
         lo, hi = t["wilson95"]
-        typer.echo(f"{task}: {t['successes']}/{t['episodes']} = {t['pc_success']:.0f} % (95 % CI {lo:.0f}-{hi:.0f}), "
-                   f"success once {t['pc_success_once']:.0f} %, mean length {t['mean_length']:.0f}")
-    a = info["aggregated"]
+        typer.echo(f"{task} ({t['group']}): {t['successes']}/{t['episodes']} = {t['pc_success']:.0f} % (95 % CI "
+                   f"{lo:.0f}-{hi:.0f}), success once {t['pc_success_once']:.0f} %, mean length {t['mean_length']:.0f}")
+    for group, g in info["per_group"].items():
+        typer.echo(f"  group {group}: {g['pc_success']:.0f} % of {g['n_episodes']} episodes")
+    a = result.overall
     typer.echo(f"{s.name} / {policy}: {a['pc_success']:.1f} % of {a['episodes']} episodes (95 % CI "
                f"{a['wilson95'][0]:.1f}-{a['wilson95'][1]:.1f}), mean over tasks {a['mean_task_pc_success']:.1f} %; "
                f"{out / 'eval_info.json'}")
+
+
+def skill_groups(tasks) -> dict[str, str]:
+    """Task id -> its group in an eval result: the skills it exercises, joined by ``+`` (``close_door+put_in``), as
+    ``gendex stats`` counts them (:func:`generator.stats.task_skills`)."""
+    from gendex_envs.registry import resolve_task
+    from generator.stats import task_skills
+
+    return {t: "+".join(task_skills(resolve_task(t).spec)) or "other" for t in tasks}
 
 
 leaderboard_app = typer.Typer(no_args_is_help=True, help="The leaderboard: result files in leaderboard/<suite>/, "
@@ -90,6 +103,9 @@ def leaderboard_add(result: Path = typer.Argument(..., help="A gendex eval resul
                     code: str = typer.Option(..., "--code", help="Link to the method's code."),
                     kind: str = typer.Option(..., "--kind", help="baseline | oracle | imitation | reinforcement | "
                                                                  "other"),
+                    sees_state: bool = typer.Option(..., "--sees-simulator-state/--no-simulator-state",
+                                                    help="Whether the policy reads the simulator's object state "
+                                                         "(poses, the planner's world) besides cameras and joints."),
                     training_data: str = typer.Option("none", "--training-data"),
                     notes: str = typer.Option("", "--notes"),
                     date: str = typer.Option(None, "--date", help="YYYY-MM-DD (default: today)")) -> None:
@@ -112,13 +128,17 @@ def leaderboard_add(result: Path = typer.Argument(..., help="A gendex eval resul
             raise ValueError(f"{path}: suite {str(suite)[:80]!r} is not a suite in {SUITES_DIR}")
         entry = {"method": method, "authors": authors, "code": code, "policy_kind": kind,
                  "training_data": training_data, "date": date or datetime.date.today().isoformat(),
-                 "policy": info["policy"], "notes": notes, "eval_info": info}
+                 "policy": info["policy"], "sees_simulator_state": sees_state, "notes": notes, "eval_info": info}
         dest = LEADERBOARD_DIR / suite / (re.sub(r"[^a-z0-9]+", "-", method.lower()).strip("-") + ".json")
+        before = dest.read_bytes() if dest.is_file() else None
         write_json(dest, entry, indent=1)
         try:
             load_entries(suite)
-        except GenDexError:
-            dest.unlink()
+        except GenDexError:  # the board is left as it was: the earlier result of this name, or none
+            if before is None:
+                dest.unlink()
+            else:
+                dest.write_bytes(before)
             raise
     except (GenDexError, OSError, KeyError, ValueError) as exc:
         die(exc)

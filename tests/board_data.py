@@ -11,20 +11,22 @@ from gendex.eval.suite_run import eval_info
 SUITE = "gendex-ref-v1"
 
 
-def synthetic_info(rates: dict[str, int], episodes: int = 10, suite_name: str = SUITE) -> dict:
+def synthetic_info(rates: dict[str, int], episodes: int = 10, suite_name: str = SUITE,
+                   groups: dict[str, str] | None = None) -> dict:
     """eval_info of a made-up run: ``rates[task]`` successes of ``episodes`` on every task of the suite (as
-    committed: with their digests)."""
+    committed: with their digests); ``groups``: each task's group (its skills)."""
     suite = load_suite(suite_name)
     seeds = suite.seeds(episodes)
     rows = [{"task": t, "seed": s, "sum_reward": 1.0, "max_reward": 0.5, "success_at_end": k < rates[t],
              "success_once": k < rates[t] + 1, "length": 100 + k, "failure": None}
             for t in suite.tasks for k, s in enumerate(seeds)]
-    return eval_info(suite, "random", rows, seeds, 12.0, task_digests=suite_task_digests(suite))
+    return eval_info(suite, "random", rows, seeds, 12.0, task_digests=suite_task_digests(suite), groups=groups)
 
 
 def entry(method: str, info: dict, **changes) -> dict:
     return {"method": method, "authors": "GenDex", "code": "https://example.org/gendex", "policy_kind": "baseline",
-            "training_data": "none", "date": "2026-11-25", "policy": info["policy"], "eval_info": info, **changes}
+            "training_data": "none", "date": "2026-11-25", "policy": info["policy"], "sees_simulator_state": False,
+            "eval_info": info, **changes}
 
 
 def write(root: Path, name: str, data: dict, suite: str = SUITE) -> Path:

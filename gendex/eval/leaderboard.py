@@ -2,15 +2,18 @@
 
 A result file is a JSON object: ``method``, ``authors``, ``code`` (a link), ``policy_kind`` (one of
 :data:`KINDS`), ``training_data`` (what it learned from, or "none"), ``date`` (YYYY-MM-DD), ``policy`` (the
-``--policy`` spec it was run with) and ``eval_info``: what ``gendex eval`` wrote. :func:`load_entries` refuses a
+``--policy`` spec it was run with), ``sees_simulator_state`` (whether the policy reads the simulator's object state
+besides cameras and joints) and ``eval_info``: what ``gendex eval`` wrote, in lerobot 0.4's layout or, for results
+filed before it, the earlier one (:mod:`gendex.eval.eval_info` reads and checks both). :func:`load_entries` refuses a
 file with a missing or unknown field, another suite's result, or numbers that do not add up; a result whose suite
 hash differs from the suite file's is kept but marked stale (the suite changed since). A result must record the digest
 of each task's files (``eval_info["task_digests"]``, written by ``gendex eval``), and each must equal the suite's
 (the task version as committed, :func:`~gendex.eval.suite.suite_task_digests`): :class:`ResultDigestError` otherwise,
 so a score made on a copy with another reward or spec under a suite's task id is refused.
 
-:func:`build_site` writes ``index.html`` and a page per suite: a table sortable by any column (click its header),
-each method's success with its 95 % Wilson interval, and a per-task breakdown that opens under its row; links to
+:func:`build_site` writes ``index.html`` and a page per suite (newest suite versions first): a table sortable by any
+column (click its header), each method's success with its 95 % Wilson interval, a column per skill (the episodes of
+the tasks exercising it, from the result's task groups), and a per-task breakdown that opens under its row; links to
 the result files (copied next to the pages) and to videos where a result has them. :func:`markdown` gives the same
 tables for ``docs/leaderboard.md``.
 """
@@ -25,6 +28,9 @@ from pathlib import Path
 
 import dacite
 
+from gendex.eval.eval_info import Summary, skill_rates, summary
+from gendex.eval.eval_info import problems as eval_problems
+from gendex.eval.metrics import wilson
 from gendex.eval.suite import Suite, load_suite, suite_task_digests
 from gendex_envs.errors import GenDexError
 from gendex_envs.typed_yaml import parse_json_bounded
@@ -59,6 +65,9 @@ class Entry:
     date: str
     policy: str
     eval_info: dict
+    sees_simulator_state: bool
+    """Whether the policy reads the simulator's state beyond the robot's own (object poses, the planner's world):
+    such a method is not comparable with one that sees only cameras and joint state."""
     notes: str = ""
     file: str = field(default="")
     """The result file's name (set when loaded)."""
@@ -66,12 +75,24 @@ class Entry:
     """True when it was evaluated on another version of the suite file (its hash differs)."""
 
     @property
+    def summary(self) -> Summary:
+        return summary(self.eval_info)
+
+    @property
     def aggregated(self) -> dict:
-        return self.eval_info["aggregated"]
+        """``episodes``, ``successes``, ``pc_success``, ``wilson95`` over the whole result (either layout)."""
+        return self.summary.overall
 
     @property
     def per_task(self) -> dict:
-        return self.eval_info["per_task"]
+        """Task -> ``episodes``, ``successes``, ``pc_success``, ``wilson95``, ``pc_success_once``, ``mean_length``,
+        ``seeds``, ``group`` (either layout)."""
+        return self.summary.per_task
+
+    @property
+    def skills(self) -> dict[str, tuple[int, int]]:
+        """Skill -> (successes, episodes) over the tasks exercising it (results that record task groups)."""
+        return skill_rates(self.summary)
 
 
 def _check(e: Entry, suite: Suite, path: Path) -> list[str]:
@@ -83,37 +104,18 @@ def _check(e: Entry, suite: Suite, path: Path) -> list[str]:
     if not e.code.startswith(("https://", "http://", "./", "../")):
         problems.append(f"code {e.code!r} is not a link")
     info = e.eval_info
-    for key in ("suite", "per_task", "aggregated", "per_episode"):
-        if key not in info:
-            problems.append(f"eval_info has no {key!r}: use the eval_info.json gendex eval writes")
+    problems += eval_problems(info)
     if problems:
         return problems
-    if info["suite"]["name"] != suite.name:
-        problems.append(f"it is a result on suite {info['suite']['name']!r}, filed under {suite.name!r}")
-    unknown = sorted(set(info["per_task"]) - set(suite.tasks))
+    if info["suite"].get("name") != suite.name:
+        problems.append(f"it is a result on suite {info['suite'].get('name')!r}, filed under {suite.name!r}")
+    tasks = summary(info).per_task
+    unknown = sorted(set(tasks) - set(suite.tasks))
     if unknown:
         problems.append(f"tasks {unknown} are not in suite {suite.name}")
-    missing = sorted(set(suite.tasks) - set(info["per_task"]))
+    missing = sorted(set(suite.tasks) - set(tasks))
     if missing:
         problems.append(f"tasks {missing} of suite {suite.name} have no result: a result covers every task")
-    total = [0, 0]
-    for task, t in info["per_task"].items():
-        counts = [t.get(k) if isinstance(t, dict) else None for k in ("successes", "episodes", "pc_success")]
-        if not (all(isinstance(c, int) and not isinstance(c, bool) for c in counts[:2])
-                and isinstance(counts[2], int | float) and not isinstance(counts[2], bool)):
-            problems.append(f"{task}: successes and episodes must be integers and pc_success a number")
-            continue
-        successes, episodes, pc = counts
-        if episodes < 1:
-            problems.append(f"{task}: {episodes} episodes; a result has at least one episode per task")
-        elif not 0 <= successes <= episodes or abs(100.0 * successes / episodes - pc) > 1e-6:
-            problems.append(f"{task}: {successes} of {episodes} is not {pc} %")
-        total = [total[0] + successes, total[1] + episodes]
-    agg = info["aggregated"]
-    claimed = agg.get("pc_success") if isinstance(agg, dict) else None
-    if not problems and (not isinstance(claimed, int | float) or abs(100.0 * total[0] / total[1] - claimed) > 1e-6):
-        problems.append(f"aggregated pc_success {str(claimed)[:40]} is not the tasks' {total[0]} of {total[1]} "
-                        f"episodes ({100.0 * total[0] / total[1]:.4g} %)")
     return problems
 
 
@@ -151,8 +153,16 @@ def load_entries(suite_name: str, root: Path = LEADERBOARD_DIR) -> list[Entry]:
     return sorted(out, key=lambda e: -e.aggregated["pc_success"])
 
 
+def _newest_first(name: str) -> tuple[int, str]:
+    m = re.search(r"-v(\d+)$", name)
+    return (-int(m.group(1)) if m else 0, name)
+
+
 def suites_with_results(root: Path = LEADERBOARD_DIR) -> list[str]:
-    return sorted(p.name for p in root.iterdir() if p.is_dir() and any(p.glob("*.json"))) if root.is_dir() else []
+    """The suites with results, the newest suite versions first (``gendex-ref-v2`` before ``gendex-lib-v1``)."""
+    if not root.is_dir():
+        return []
+    return sorted((p.name for p in root.iterdir() if p.is_dir() and any(p.glob("*.json"))), key=_newest_first)
 
 
 # --------------------------------------------------------------------------------------------- rendering
@@ -199,11 +209,26 @@ def _page(title: str, body: str) -> str:
             f"<style>{_STYLE}</style></head><body>\n{body}\n<script>{_SCRIPT}</script></body></html>\n")
 
 
+def _skills(entries: list[Entry]) -> list[str]:
+    """The skills the results record, in the order their tasks first name them."""
+    return list(dict.fromkeys(k for e in entries for k in e.skills))
+
+
+def _skill_cell(e: Entry, skill: str) -> tuple[str, str]:
+    if skill not in e.skills:
+        return "-1", "—"
+    k, n = e.skills[skill]
+    lo, hi = wilson(k, n)
+    return f"{100.0 * k / n:.4f}", (f'{100.0 * k / n:.0f} <span class="ci">[{100 * lo:.0f}, {100 * hi:.0f}]</span>')
+
+
 def _suite_page(suite: Suite, entries: list[Entry]) -> str:
-    cols = [("method", "Method"), ("kind", "Kind"), ("success", f"Success ({suite.metric}, %)"),
-            ("once", "Success once (%)"), ("episodes", "Episodes"), ("length", "Mean length"),
-            ("data", "Training data"), ("date", "Date")]
-    head = "".join(f'<th data-key="{k}">{_e(v)}</th>' for k, v in cols) + "<th>Details</th>"
+    skills = _skills(entries)
+    cols = [("method", "Method"), ("kind", "Kind"), ("state", "Sees sim state"),
+            ("success", f"Success ({suite.metric}, %)"), ("once", "Success once (%)"),
+            *[(f"skill-{k}", k.replace("_", " ")) for k in skills],
+            ("episodes", "Episodes"), ("length", "Mean length"), ("data", "Training data"), ("date", "Date")]
+    head = "".join(f'<th data-key="{_e(k)}">{_e(v)}</th>' for k, v in cols) + "<th>Details</th>"
     rows = []
     for i, e in enumerate(entries):
         a = e.aggregated
@@ -212,11 +237,13 @@ def _suite_page(suite: Suite, entries: list[Entry]) -> str:
         length = sum(t["mean_length"] * t["episodes"] for t in e.per_task.values()) / max(1, a["episodes"])
         stale = ' <span class="stale" title="evaluated on another version of the suite">(stale)</span>' \
             if e.stale else ""
+        state = "yes" if e.sees_simulator_state else "no"
         cells = [(e.method, f'<a href="{_e(e.code)}">{_e(e.method)}</a>{stale}<br><span class="ci">{_e(e.authors)}'
                             f"</span>"),
-                 (e.policy_kind, _e(e.policy_kind)),
+                 (e.policy_kind, _e(e.policy_kind)), (state, state),
                  (f"{a['pc_success']:.4f}", f'{a["pc_success"]:.1f} <span class="ci">[{lo:.1f}, {hi:.1f}]</span>'),
-                 (f"{once:.4f}", f"{once:.1f}"), (a["episodes"], a["episodes"]), (f"{length:.4f}", f"{length:.0f}"),
+                 (f"{once:.4f}", f"{once:.1f}"), *[_skill_cell(e, k) for k in skills],
+                 (a["episodes"], a["episodes"]), (f"{length:.4f}", f"{length:.0f}"),
                  (e.training_data, _e(e.training_data)), (e.date, _e(e.date))]
         tds = "".join(f'<td data-value="{_e(v)}">{h}</td>' for v, h in cells)
         detail = f"detail-{i}"
@@ -224,21 +251,30 @@ def _suite_page(suite: Suite, entries: list[Entry]) -> str:
                 f'<a href="results/{_e(suite.name)}/{_e(e.file)}">json</a></td>')
         rows.append(f'<tr class="entry" data-detail="{detail}">{tds}</tr>')
         task_rows = "".join(
-            f"<tr><td>{_e(t)}</td><td>{r['successes']}/{r['episodes']}</td><td>{r['pc_success']:.1f} "
+            f"<tr><td>{_e(t)}</td><td>{_e(r['group'] or '')}</td><td>{r['successes']}/{r['episodes']}</td>"
+            f"<td>{r['pc_success']:.1f} "
             f'<span class="ci">[{r["wilson95"][0]:.1f}, {r["wilson95"][1]:.1f}]</span> '
             f'<span class="bar" style="width:{r["pc_success"]:.0f}px"></span></td>'
             f"<td>{r['pc_success_once']:.1f}</td><td>{r['mean_length']:.0f}</td></tr>"
             for t, r in e.per_task.items())
-        videos = "".join(f'<a href="{_e(v)}">{_e(Path(v).name)}</a> ' for v in e.eval_info.get("video_paths", []))
+        videos = "".join(f'<a href="{_e(v)}">{_e(Path(v).name)}</a> ' for v in _video_paths(e.eval_info))
         rows.append(f'<tr class="breakdown" id="{detail}"><td colspan="{len(cols) + 1}"><table class="tasks">'
-                    f"<tr><th>Task</th><th>Successes</th><th>Success (%) [95 % CI]</th><th>Once (%)</th>"
-                    f"<th>Mean length</th></tr>{task_rows}</table>{videos}</td></tr>")
+                    f"<tr><th>Task</th><th>Skills</th><th>Successes</th><th>Success (%) [95 % CI]</th>"
+                    f"<th>Once (%)</th><th>Mean length</th></tr>{task_rows}</table>{videos}</td></tr>")
     body = (f'<p><a href="index.html">All suites</a></p><h1>{_e(suite.name)}</h1><p>{_e(suite.description)}</p>'
             f"<p>{len(suite.tasks)} tasks, {suite.episodes} episodes each on seeds {suite.seed}.., metric "
             f"<code>{_e(suite.metric)}</code>, suite file SHA-256 <code>{suite.hash[:16]}…</code>. Intervals are "
-            f"95 % Wilson score intervals. Click a column to sort.</p>"
+            f"95 % Wilson score intervals; a skill's column pools the episodes of the tasks exercising it. "
+            f"<em>Sees sim state</em>: the policy reads the simulator's object state, not only cameras and joints. "
+            f"Click a column to sort.</p>"
             f'<table class="board" id="board"><thead><tr>{head}</tr></thead><tbody>{"".join(rows)}</tbody></table>')
     return _page(f"GenDex leaderboard: {suite.name}", body)
+
+
+def _video_paths(info: dict) -> list[str]:
+    if "overall" in info:
+        return list(info["overall"].get("video_paths", []))
+    return list(info.get("video_paths", []))
 
 
 def build_site(out: Path, root: Path = LEADERBOARD_DIR) -> list[Path]:
@@ -280,20 +316,31 @@ def markdown(root: Path = LEADERBOARD_DIR) -> str:
              "Written by `gendex leaderboard build` from the result files in [`leaderboard/`](../leaderboard). Success "
              "is the suite's metric (`success_at_end`) in percent with its 95 % Wilson interval; the rate of "
              "episodes that succeeded at any step (`success_once`) is beside it. `gendex eval --suite NAME --policy "
-             "SPEC` makes a result; see [the benchmark](benchmark.md).", ""]
+             "SPEC` makes a result; see [the benchmark](benchmark.md). *Sees sim state*: the policy reads the "
+             "simulator's object state (poses, the planner's world), not only cameras and joint state; compare like "
+             "with like. Suites are listed newest version first.", ""]
     for name in suites_with_results(root):
         suite, entries = load_suite(name), load_entries(name, root)
         lines += [f"## {name}", "", suite.description, "",
                   f"{len(suite.tasks)} tasks × {suite.episodes} episodes, seeds {suite.seed}.., suite SHA-256 "
                   f"`{suite.hash[:16]}…`.", "",
-                  "| method | kind | success % [95 % CI] | once % | episodes | training data | policy |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| method | kind | sees sim state | success % [95 % CI] | once % | episodes | training data | "
+                  "policy |",
+                  "|---|---|---|---|---|---|---|---|"]
         for e in entries:
             a = e.aggregated
             once = sum(t["pc_success_once"] * t["episodes"] for t in e.per_task.values()) / max(1, a["episodes"])
-            lines.append(f"| {e.method}{' (stale)' if e.stale else ''} | {e.policy_kind} | {a['pc_success']:.1f} "
+            lines.append(f"| {e.method}{' (stale)' if e.stale else ''} | {e.policy_kind} | "
+                         f"{'yes' if e.sees_simulator_state else 'no'} | {a['pc_success']:.1f} "
                          f"[{a['wilson95'][0]:.1f}, {a['wilson95'][1]:.1f}] | {once:.1f} | {_episodes(e, suite)} | "
                          f"{e.training_data} | `{e.policy}` |")
+        skills = _skills(entries)
+        if skills:
+            lines += ["", "Per skill (success %, the episodes of the tasks exercising it):", "",
+                      "| method | " + " | ".join(k.replace("_", " ") for k in skills) + " |",
+                      "|---|" + "---|" * len(skills)]
+            lines += [f"| {e.method} | " + " | ".join(_skill_cell(e, k)[1].split(" <")[0] for k in skills) + " |"
+                      for e in entries]
         notes = [f"- **{e.method}**: {e.notes}" for e in entries if e.notes]
         if notes:
             lines += ["", *notes]

@@ -3,18 +3,11 @@
 Every finished episode is appended to ``<out>/episodes.jsonl`` (one JSON object per line); a run that was stopped
 goes on with the (task, seed) pairs it lacks. With ``workers > 1`` the tasks are shared among that many processes
 (each with its env and its own policy, built from the policy's spec string). At the end ``<out>/eval_info.json``
-holds:
-
-- ``per_episode``: LeRobot's fields (``episode_ix``, ``sum_reward``, ``max_reward``, ``success``: the suite's
-  metric, ``seed``) plus the task, ``success_once``, ``success_at_end``, length and any failure reason;
-- ``per_task``: episodes, successes, ``pc_success`` with its 95 % Wilson interval, ``success_once``, mean episode
-  length, env steps, failures;
-- ``aggregated``: LeRobot's ``avg_sum_reward``, ``avg_max_reward``, ``pc_success`` (over all episodes, with its
-  interval), ``eval_s``, ``eval_ep_s``; and the mean of the per-task rates;
-- the suite's name, hash and metric, the policy spec, the GenDex version, and the video files if any were written;
-- ``task_digests``: the digest of each task's files as they ran (:meth:`~gendex_envs.task_version.TaskVersion.
-  file_digest`). A run whose tasks' files differ from the suite's (the committed versions) is refused unless
-  ``allow_changed_tasks``; the leaderboard refuses such a result.
+holds the result in lerobot 0.4's layout (``per_task``, ``per_group``, ``overall``) with GenDex's extras: Wilson
+intervals, every episode's seed, length and failure, the suite's name, hash and seeds, the policy spec, the GenDex
+version (:mod:`gendex.eval.eval_info`), and ``task_digests``: the digest of each task's files as they ran
+(:meth:`~gendex_envs.task_version.TaskVersion.file_digest`). A run whose tasks' files differ from the suite's (the
+committed versions) is refused unless ``allow_changed_tasks``; the leaderboard refuses such a result.
 """
 
 from __future__ import annotations
@@ -26,9 +19,7 @@ from collections.abc import Callable
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-import numpy as np
-
-from gendex.eval.metrics import wilson
+from gendex.eval.eval_info import build as build_info
 from gendex.eval.runner import EpisodeResult, evaluate_task
 from gendex.eval.suite import Suite, check_task_digests, ran_task_digests
 from gendex.fanout import Backend, ordered_map
@@ -88,14 +79,15 @@ def _task_job(job: tuple) -> list[dict]:
 def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episodes: int | None = None,
               workers: int = 1, training_seeds: list[int] | None = None, videos: int = 0,
               progress: Callable[[EpisodeResult | dict], None] | None = None, backend: Backend | None = None,
-              allow_changed_tasks: bool = False) -> dict:
+              allow_changed_tasks: bool = False, groups: dict[str, str] | None = None) -> dict:
     """Evaluate the policy ``spec`` (made by ``resolver(spec)()``) on ``suite``; returns and writes eval_info.
     The tasks registered under the suite's ids must have the suite's files (the committed versions, by digest):
     :class:`~gendex.eval.suite.TaskDigestError` otherwise, unless ``allow_changed_tasks`` (the digests that ran are
     recorded either way).
     ``videos``: the first k episodes of each task are also recorded (``<out>/videos/``). ``backend``
     (:class:`gendex.fanout.Backend`; default ``workers`` local processes) shares the tasks among workers; a
-    task's episodes are kept when its job returns, so a worker killed on Ray has the task re-run, not doubled."""
+    task's episodes are kept when its job returns, so a worker killed on Ray has the task re-run, not doubled.
+    ``groups``: each task's group in the result (its skills; default the suite's name)."""
     backend = backend or Backend.from_options(workers)
     seeds = suite.seeds(episodes)
     leaked = sorted(set(seeds) & set(training_seeds or ()))
@@ -133,56 +125,18 @@ def run_suite(suite: Suite, spec: str, resolver: Resolver, out: Path, *, episode
             for done in ordered_map(_task_worker, jobs, backend, ahead=len(jobs)):
                 for row in done:
                     keep(row)
-    info = eval_info(suite, spec, rows, seeds, time.perf_counter() - t0, task_digests=digests)
+    info = eval_info(suite, spec, rows, seeds, time.perf_counter() - t0, task_digests=digests, groups=groups)
     (out / EVAL_INFO).write_text(json.dumps(info, indent=1) + "\n")
     return info
 
 
 def eval_info(suite: Suite, spec: str, rows: list[dict], seeds: list[int], seconds: float,
-              task_digests: dict[str, str] | None = None) -> dict:
-    """The eval_info.json of ``rows`` (episode dicts), in the suite's task order and seed order; ``task_digests``:
-    the digest of each task's files as they ran (:func:`~gendex.eval.suite.ran_task_digests`)."""
-    order = {t: i for i, t in enumerate(suite.tasks)}
-    rows = sorted((r for r in rows if r["task"] in order and r["seed"] in set(seeds)),
-                  key=lambda r: (order[r["task"]], r["seed"]))
-    metric = suite.metric
-    per_episode = [{"episode_ix": i, "task": r["task"], "seed": r["seed"], "sum_reward": r["sum_reward"],
-                    "max_reward": r["max_reward"], "success": bool(r[metric]), "success_once": r["success_once"],
-                    "success_at_end": r["success_at_end"], "length": r["length"], "failure": r["failure"]}
-                   for i, r in enumerate(rows)]
-    per_task = {}
-    for task in suite.tasks:
-        mine = [r for r in per_episode if r["task"] == task]
-        if not mine:
-            continue
-        k, n = sum(r["success"] for r in mine), len(mine)
-        lo, hi = wilson(k, n)
-        fails: dict[str, int] = {}
-        for r in mine:
-            if r["failure"]:
-                fails[r["failure"]] = fails.get(r["failure"], 0) + 1
-        per_task[task] = {"episodes": n, "successes": k, "pc_success": 100.0 * k / n,
-                          "wilson95": [100.0 * lo, 100.0 * hi],
-                          "pc_success_once": 100.0 * sum(r["success_once"] for r in mine) / n,
-                          "mean_length": float(np.mean([r["length"] for r in mine])),
-                          "env_steps": int(sum(r["length"] for r in mine)), "policy_failures": fails}
-    n = len(per_episode)
-    k = sum(r["success"] for r in per_episode)
-    lo, hi = wilson(k, n)
-    aggregated = {"avg_sum_reward": float(np.mean([r["sum_reward"] for r in per_episode])) if n else 0.0,
-                  "avg_max_reward": float(np.mean([r["max_reward"] for r in per_episode])) if n else 0.0,
-                  "pc_success": 100.0 * k / n if n else 0.0, "wilson95": [100.0 * lo, 100.0 * hi],
-                  "mean_task_pc_success": float(np.mean([t["pc_success"] for t in per_task.values()]))
-                  if per_task else 0.0,
-                  "episodes": n, "env_steps": int(sum(r["length"] for r in per_episode)),
-                  "eval_s": round(seconds, 1), "eval_ep_s": round(seconds / n, 2) if n else 0.0}
-    complete = all(per_task.get(t, {}).get("episodes") == suite.episodes for t in suite.tasks)
-    return {"suite": {"name": suite.name, "hash": suite.hash, "metric": metric, "episodes_per_task": len(seeds),
-                      "seeds": [seeds[0], seeds[-1]], "complete": complete},
-            "policy": spec, "gendex_version": _gendex_version(), "per_episode": per_episode, "per_task": per_task,
-            "aggregated": aggregated, "video_paths": [r["video"] for r in rows if r.get("video")],
-            **({"task_digests": {t: task_digests[t] for t in suite.tasks if t in task_digests}}
-               if task_digests is not None else {})}
+              task_digests: dict[str, str] | None = None, groups: dict[str, str] | None = None) -> dict:
+    """The eval_info.json of ``rows`` (episode dicts), in the suite's task order and seed order, in lerobot 0.4's
+    layout (:func:`gendex.eval.eval_info.build`); ``task_digests``: the digest of each task's files as they ran
+    (:func:`~gendex.eval.suite.ran_task_digests`); ``groups``: each task's group (its skills)."""
+    return build_info(suite, spec, rows, seeds, seconds, gendex_version=_gendex_version(), task_digests=task_digests,
+                      groups=groups)
 
 
 __all__ = ["EPISODES_FILE", "EVAL_INFO", "EvalError", "eval_info", "run_suite"]

@@ -65,8 +65,9 @@ def test_a_suite_run_resumes_where_it_stopped_and_refuses_seeds_a_policy_learned
     suite = _tiny_suite(tmp_path)
     out = tmp_path / "run"
     first = run_suite(suite, "hold", resolve_policy, out)
-    assert [e["seed"] for e in first["per_episode"]] == [3_000_000, 3_000_001]
-    assert first["suite"]["complete"] and first["per_task"]["GenDex/PutAppleBowl-v1"]["episodes"] == 2
+    [task] = first["per_task"]
+    assert task["task_id"] == "GenDex/PutAppleBowl-v1" and task["metrics"]["seeds"] == [3_000_000, 3_000_001]
+    assert first["suite"]["complete"] and task["episodes"] == 2 and first["overall"]["n_episodes"] == 2
     from gendex_envs.registry import committed_version
 
     digest = committed_version("GenDex/PutAppleBowl-v1").file_digest()
@@ -77,7 +78,7 @@ def test_a_suite_run_resumes_where_it_stopped_and_refuses_seeds_a_policy_learned
     seen = []
     again = run_suite(suite, "hold", resolve_policy, out, progress=seen.append)
     assert [r["seed"] for r in seen] == [3_000_001]  # only the missing episode ran
-    assert again["per_episode"] == first["per_episode"]  # and it came out the same
+    assert again["per_task"] == first["per_task"]  # and it came out the same
     with pytest.raises(EvalError, match="holds an evaluation of hold"):
         run_suite(suite, "random", resolve_policy, out)
     with pytest.raises(EvalError, match="trained on seeds \\[3000001\\]"):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 import pytest
 from board_data import SUITE, entry, synthetic_info, write
 
@@ -33,17 +31,69 @@ def test_a_bad_suite_is_refused(tmp_path):
     assert "versioned GenDex ids" in str(e.value)
 
 
-def test_eval_info_has_lerobots_fields_and_wilson_intervals_per_task():
-    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v2": 10, "GenDex/OpenCabinet-v1": 0})
-    ep = info["per_episode"][0]
-    assert {"episode_ix", "sum_reward", "max_reward", "success", "seed"} <= set(ep)
-    assert {"avg_sum_reward", "avg_max_reward", "pc_success", "eval_s", "eval_ep_s"} <= set(info["aggregated"])
-    t = info["per_task"]["GenDex/PutAppleBowl-v1"]
-    assert t["successes"] == 7 and t["pc_success"] == 70.0
-    assert t["wilson95"] == pytest.approx([100 * x for x in wilson(7, 10)])
-    assert info["aggregated"]["pc_success"] == pytest.approx(100 * 17 / 30)
+REF_GROUPS = {"GenDex/PutAppleBowl-v1": "put_in", "GenDex/PickUpBottle-v2": "lift",
+              "GenDex/OpenCabinet-v1": "open_door"}
+
+
+def test_eval_info_is_in_lerobot_04s_layout_with_wilson_intervals_per_task_and_group():
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v2": 10, "GenDex/OpenCabinet-v1": 0},
+                          groups={**REF_GROUPS, "GenDex/OpenCabinet-v1": "lift"})
+    assert info["layout"] == "lerobot-0.4" and "per_episode" not in info and "aggregated" not in info
+    first = info["per_task"][0]
+    assert {"task_group", "task_id", "metrics"} <= set(first)
+    assert {"sum_rewards", "max_rewards", "successes", "video_paths"} <= set(first["metrics"])  # lerobot's keys
+    assert first["task_id"] == "GenDex/PutAppleBowl-v1" and first["task_group"] == "put_in"
+    assert first["metrics"]["successes"] == [True] * 7 + [False] * 3 and first["n_successes"] == 7
+    assert first["metrics"]["seeds"][:3] == [2_000_000, 2_000_001, 2_000_002]
+    assert first["wilson95"] == pytest.approx([100 * x for x in wilson(7, 10)])
+    assert {"avg_sum_reward", "avg_max_reward", "pc_success", "n_episodes", "eval_s", "eval_ep_s",
+            "video_paths"} <= set(info["overall"])
+    assert info["overall"]["pc_success"] == pytest.approx(100 * 17 / 30) and info["overall"]["n_episodes"] == 30
+    assert info["per_group"]["lift"]["pc_success"] == pytest.approx(50.0)  # bottle 10/10 + cabinet 0/10
+    assert info["per_group"]["lift"]["tasks"] == ["GenDex/PickUpBottle-v2", "GenDex/OpenCabinet-v1"]
+    assert info["per_group"]["put_in"]["wilson95"] == pytest.approx([100 * x for x in wilson(7, 10)])
     assert info["suite"]["complete"] is False  # 10 of the suite's 50 episodes per task
-    assert [e["seed"] for e in info["per_episode"][:3]] == [2_000_000, 2_000_001, 2_000_002]
+
+
+def _new_layout_forgeries():
+    def count(d):
+        d["per_task"][0]["n_successes"] = 9
+
+    def rate(d):
+        d["per_task"][0]["pc_success"] = 90.0
+
+    def flip(d):  # a failed episode turned into a success, the counts left as they were
+        d["per_task"][0]["metrics"]["successes"][-1] = True
+
+    def overall(d):
+        d["overall"]["pc_success"] = 100.0
+
+    def group(d):
+        d["per_group"]["put_in"]["pc_success"] = 100.0
+
+    def drop(d):  # the hardest task left out, every sum made to agree
+        d["per_task"] = [t for t in d["per_task"] if t["task_id"] != "GenDex/OpenCabinet-v1"]
+        del d["per_group"]["open_door"]
+        d["overall"].update(pc_success=85.0, n_episodes=20)
+
+    def short(d):
+        d["per_task"][1]["metrics"]["seeds"].pop()
+
+    return [("n_successes 9 is not the 7", count), ("7 of 10 is not 90.0 %", rate),
+            ("n_successes 7 is not the 8", flip), ("overall pc_success 100.0", overall),
+            ("group 'put_in'", group), ("have no result", drop), ("per-episode lists hold", short)]
+
+
+@pytest.mark.parametrize("match, forge", _new_layout_forgeries(), ids=lambda x: x if isinstance(x, str) else "")
+def test_a_new_layout_result_whose_numbers_do_not_add_up_is_refused_by_name(tmp_path, match, forge):
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v2": 10, "GenDex/OpenCabinet-v1": 0},
+                          groups=REF_GROUPS)
+    write(tmp_path, "ok", entry("Honest", info))
+    assert [e.aggregated["pc_success"] for e in load_entries(SUITE, tmp_path)] == [pytest.approx(100 * 17 / 30)]
+    forge(info)
+    write(tmp_path, "ok", entry("Forged", info))
+    with pytest.raises(LeaderboardError, match=match):
+        load_entries(SUITE, tmp_path)
 
 
 def test_result_files_are_validated(tmp_path):
@@ -56,15 +106,30 @@ def test_result_files_are_validated(tmp_path):
     write(tmp_path, "bad", entry("X", info, colour="red"))
     with pytest.raises(LeaderboardError, match="colour"):
         load_entries(SUITE, tmp_path)
-    broken = json.loads(json.dumps(info))
-    broken["per_task"]["GenDex/PutAppleBowl-v1"]["successes"] = 9
-    write(tmp_path, "bad", entry("X", broken))
-    with pytest.raises(LeaderboardError, match="9 of 10 is not 30.0 %"):
+    unflagged = entry("X", info)
+    del unflagged["sees_simulator_state"]
+    write(tmp_path, "bad", unflagged)
+    with pytest.raises(LeaderboardError, match="sees_simulator_state"):
         load_entries(SUITE, tmp_path)
     other = synthetic_info({t: 1 for t in load_suite("gendex-skills-v1").tasks}, suite_name="gendex-skills-v1")
     write(tmp_path, "bad", entry("X", other))
     with pytest.raises(LeaderboardError, match="result on suite 'gendex-skills-v1', filed under 'gendex-ref-v1'"):
         load_entries(SUITE, tmp_path)
+
+
+def test_per_skill_columns_pool_the_tasks_of_each_skill(tmp_path):
+    groups = {"GenDex/PutAppleBowl-v1": "put_in", "GenDex/PickUpBottle-v2": "lift",
+              "GenDex/OpenCabinet-v1": "open_door+lift"}
+    info = synthetic_info({"GenDex/PutAppleBowl-v1": 7, "GenDex/PickUpBottle-v2": 10, "GenDex/OpenCabinet-v1": 2},
+                          groups=groups)
+    write(tmp_path / "board", "ok", entry("Skilled", info, sees_simulator_state=True))
+    [e] = load_entries(SUITE, tmp_path / "board")
+    assert e.skills == {"put_in": (7, 10), "lift": (12, 20), "open_door": (2, 10)}
+    build_site(tmp_path / "site", tmp_path / "board")
+    page = (tmp_path / "site" / f"{SUITE}.html").read_text()
+    assert 'data-key="skill-lift"' in page and 'data-value="60.0000"' in page and ">yes<" in page
+    md = markdown(tmp_path / "board")
+    assert "| method | put in | lift | open door |" in md and "| Skilled | 70 | 60 | 20 |" in md
 
 
 def test_a_result_on_another_version_of_the_suite_is_marked_stale(tmp_path):
@@ -85,7 +150,7 @@ def test_site_and_markdown_hold_every_result_best_first(tmp_path):
     assert page.index("Strong") < page.index("Middle") < page.index("Weak")
     assert (tmp_path / "site" / "results" / SUITE / "strong.json").is_file()
     md = markdown(root)
-    assert "| Strong | baseline | 90.0 [" in md and "`GenDex/OpenCabinet-v1`" in md
+    assert "| Strong | baseline | no | 90.0 [" in md and "`GenDex/OpenCabinet-v1`" in md
 
 
 def test_the_committed_board_is_valid_current_and_written_into_the_docs():
@@ -100,8 +165,6 @@ def test_the_committed_board_is_valid_current_and_written_into_the_docs():
         entries = load_entries(name)
         assert entries and not [e.file for e in entries if e.stale]
         for e in entries:
-            rows = e.eval_info["per_episode"]
-            for task in e.per_task:
-                seeds = [r["seed"] for r in rows if r["task"] == task]
-                assert seeds == list(range(suite.seed, suite.seed + len(seeds))), (e.file, task)
+            for task, t in e.per_task.items():
+                assert t["seeds"] == list(range(suite.seed, suite.seed + t["episodes"])), (e.file, task)
     assert (REPO_ROOT / "docs" / "leaderboard.md").read_text() == markdown(LEADERBOARD_DIR)

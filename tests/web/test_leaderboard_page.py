@@ -64,3 +64,28 @@ def test_the_board_loads_sorts_and_opens_a_per_task_breakdown(tmp_path, browser)
     row.find_element(By.CSS_SELECTOR, "button.toggle").click()
     assert detail.is_displayed() and "GenDex/OpenCabinet-v1" in detail.text and "9/10" in detail.text
     assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
+
+
+def test_the_per_skill_columns_sort_in_the_browser(tmp_path, browser):
+    from selenium.webdriver.common.by import By
+
+    root = tmp_path / "board"
+    groups = {"GenDex/PutAppleBowl-v1": "put_in", "GenDex/PickUpBottle-v2": "lift",
+              "GenDex/OpenCabinet-v1": "open_door"}
+    # overall order Even > Lifter > Putter, but per skill each leads its own column
+    for name, rates in (("lifter", (1, 10, 1)), ("putter", (9, 1, 1)), ("even", (6, 6, 6))):
+        info = synthetic_info(dict(zip(groups, rates, strict=True)), groups=groups)
+        write(root, name, entry(name.title(), info))
+    build_site(tmp_path / "site", root)
+    browser.get((tmp_path / "site" / f"{SUITE}.html").as_uri())
+
+    def methods():
+        return [r.find_element(By.TAG_NAME, "a").text for r in browser.find_elements(By.CSS_SELECTOR, "tr.entry")]
+
+    assert methods() == ["Even", "Lifter", "Putter"]
+    for skill, best in (("lift", "Lifter"), ("put_in", "Putter"), ("open_door", "Even")):
+        th = browser.find_element(By.CSS_SELECTOR, f'th[data-key="skill-{skill}"]')
+        th.click()  # ascending
+        th.click()  # descending: the best at this skill first
+        assert methods()[0] == best and "sorted-desc" in th.get_attribute("class"), (skill, methods())
+    assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
