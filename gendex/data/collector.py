@@ -61,6 +61,9 @@ class CollectConfig:
     """Camera images are ``resolution`` x ``resolution`` (the env's ``sensor_resolution``)."""
     video_codec: str | None = DEFAULT_CODEC
     """Camera images as MP4 videos with this encoder (LeRobot v3.0's ``videos/``), or None: PNG in the parquet."""
+    conventions: int = 1
+    """The LeRobot dataset's stats (:class:`~gendex.data.lerobot_v3.LeRobotV3Writer`): 1 as the published datasets,
+    2 lerobot 0.4's (with the quantiles q01 ... q99)."""
 
     def env_kwargs(self) -> dict:
         """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""
@@ -121,7 +124,8 @@ def _open_exporters(cfg: CollectConfig, env: gym.Env) -> dict[str, object]:
             cfg.out / "lerobot", fps=int(u.control_freq), robot_type="ur10e_shadowhand",
             state_names=observation.robot_state_names(env), action_names=action_names,
             environment_state_names=observation.environment_state_names(env),
-            cameras={c: (res, res) for c in cfg.cameras} or None, video_codec=cfg.video_codec)
+            cameras={c: (res, res) for c in cfg.cameras} or None, video_codec=cfg.video_codec,
+            conventions=cfg.conventions)
     if "h5" in cfg.formats:
         writers["h5"] = TrajectoryWriter(cfg.out / "trajectories", **env_info(env))
     return writers

@@ -1,8 +1,8 @@
 """Published datasets: a manifest per dataset in ``datasets/``, and building, verifying, pushing and pulling them.
 
 A manifest (``datasets/<name>.yaml``) says what a dataset is: its tasks with episodes and seeds per task, the
-solver, cameras, resolution and video codec, the GenDex version, and the SHA-256 of every file of the built
-dataset. From it,
+solver, cameras, resolution and video codec, the stats' ``conventions`` (1, the default: as published; 2: lerobot
+0.4's, with quantiles), the GenDex version, and the SHA-256 of every file of the built dataset. From it,
 
 - :func:`build` collects each task with ``gendex.data.collector`` into ``<out>/<task>/`` (a LeRobot v3.0 dataset
   in ``lerobot/`` with its card; resumable: a killed build goes on where it stopped; ``workers`` processes per task)
@@ -14,8 +14,9 @@ dataset. From it,
   (:class:`HubRemote`, ``huggingface_hub``) or a folder (:class:`FolderRemote`, a file-backed stand-in with the
   same interface, which the tests use: this machine has no network). A one-task dataset is pushed with its LeRobot
   dataset at the repo's root (``LeRobotDataset(repo_id)`` loads it; its card carries the ``LeRobot`` tag) and the
-  repo gets the ``v3.0`` git tag lerobot looks for; several tasks go in ``<task>/`` folders. A pull restores the
-  build's layout, so the copy verifies against the manifest.
+  ``v3.0`` git tag lerobot loads it at is put on the commit just pushed (moved there from an earlier push's);
+  several tasks go in ``<task>/`` folders. A pull restores the build's layout, so the copy verifies against the
+  manifest.
 
 Checksums cover every file of each task's ``lerobot/`` folder (data, meta, videos, card) and ``gendex_dataset.json``;
 the collector's bookkeeping (``collect_state.json``, which holds wall-clock time) is left out.
@@ -96,6 +97,10 @@ class DatasetManifest:
     cameras: tuple[str, ...] = ()
     resolution: int = 128
     video_codec: str | None = "libsvtav1"
+    conventions: int = 1
+    """The LeRobot conventions of the built dataset's stats: 1 (the default, what the published manifests build)
+    min/max/mean/std/count; 2 lerobot 0.4's, also the quantiles q01/q10/q50/q90/q99 (:mod:`gendex.data.lerobot_v3`).
+    Written to the manifest file and the build record only when it is not 1, so those stay as published."""
     checksums: dict[str, str] = field(default_factory=dict)
     """Path in the built dataset -> SHA-256 (hex) of its bytes; empty until a build was recorded."""
     built_with: BuiltWith | None = None
@@ -107,6 +112,7 @@ class DatasetManifest:
 
 
 def _check(m: DatasetManifest) -> DatasetManifest:
+    from gendex.data.lerobot_files import CONVENTIONS
     from gendex.solve import SOLVERS
     from gendex_envs.video import CODECS
 
@@ -125,6 +131,9 @@ def _check(m: DatasetManifest) -> DatasetManifest:
         problems.append(f"solver {m.solver!r} is not one of {sorted(SOLVERS)}")
     if m.video_codec is not None and m.video_codec not in CODECS:
         problems.append(f"video_codec {m.video_codec!r} is not one of {sorted(CODECS)} or null")
+    if type(m.conventions) is not int or m.conventions not in CONVENTIONS:
+        problems.append(f"conventions {m.conventions!r} is not one of {list(CONVENTIONS)} (1: stats as published; "
+                        "2: lerobot 0.4's, with quantiles)")
     if problems:
         raise DatasetError(f"dataset manifest {m.name!r}: " + "; ".join(problems))
     return m
@@ -160,6 +169,8 @@ def save_manifest(m: DatasetManifest, path: Path) -> None:
     raw["checksums"] = dict(sorted(m.checksums.items()))
     if m.built_with is None:
         raw.pop("built_with")
+    if m.conventions == 1:  # the default: the published manifests do not name it
+        raw.pop("conventions")
     header = (f"# GenDex dataset manifest: `gendex dataset build {m.name}` collects it, `gendex dataset verify`\n"
               "# checks a copy against the checksums (written by `gendex dataset build --record`). See\n"
               "# docs/datasets.md.\n")
@@ -228,6 +239,8 @@ def build(manifest: DatasetManifest, out: Path, *, workers: int = 1,
     out.mkdir(parents=True, exist_ok=True)
     record = {"manifest": manifest.name, "description": manifest.description, "gendex_version":
               manifest.gendex_version, "solver": manifest.solver, "tasks": []}
+    if manifest.conventions != 1:  # the default is left out, so a published build record stays the same bytes
+        record["conventions"] = manifest.conventions
     backend = numerics.pinned_backend(backend or Backend.from_options(workers))
     with session(backend):
         for t in manifest.tasks:
@@ -247,7 +260,7 @@ def _build_task(manifest: DatasetManifest, t: DatasetTask, out: Path, backend: B
     cfg = CollectConfig(task_id=version.env_id, num_success=t.episodes, out=out / manifest.folder(t),
                         formats=("lerobot",), cameras=manifest.cameras, seed=t.seed, max_attempts=t.max_attempts,
                         resolution=manifest.resolution, video_codec=manifest.video_codec,
-                        **SOLVER_ENV_KWARGS[manifest.solver])
+                        conventions=manifest.conventions, **SOLVER_ENV_KWARGS[manifest.solver])
     state = collect(cfg, SOLVERS[manifest.solver],
                     None if progress is None else lambda s, name=t.task: progress(name, s.successes, s.attempts),
                     backend=backend)
@@ -285,7 +298,9 @@ class Remote(Protocol):
 
 class HubRemote:
     """The Hugging Face Hub through ``huggingface_hub``: a dataset repo (created if needed), the whole folder in one
-    commit, the repo tagged. ``endpoint``/``token`` as ``HfApi`` takes them (default: the environment's)."""
+    commit, and each tag put on that commit (a tag left by an earlier push is moved: lerobot loads a dataset at its
+    ``v3.0`` tag, so a tag left behind would serve the old files). ``endpoint``/``token`` as ``HfApi`` takes them
+    (default: the environment's)."""
 
     def __init__(self, endpoint: str | None = None, token: str | None = None, api=None):
         from huggingface_hub import HfApi
@@ -296,9 +311,16 @@ class HubRemote:
         self.api.create_repo(repo_id, repo_type="dataset", exist_ok=True)
         info = self.api.upload_folder(repo_id=repo_id, repo_type="dataset", folder_path=str(root),
                                       commit_message=f"GenDex dataset {repo_id}")
+        revision = info.oid  # the commit just made (or, when nothing changed, the commit that holds these files)
+        existing = {ref.name: ref.target_commit for ref in self.api.list_repo_refs(repo_id, repo_type="dataset").tags}
         for tag in tags:
-            self.api.create_tag(repo_id, tag=tag, repo_type="dataset", exist_ok=True)
-        return str(getattr(info, "commit_url", repo_id))
+            if existing.get(tag) == revision:
+                continue
+            if tag in existing:
+                log.info("moving tag %s of %s from %s to %s", tag, repo_id, existing[tag], revision)
+                self.api.delete_tag(repo_id, tag=tag, repo_type="dataset")
+            self.api.create_tag(repo_id, tag=tag, revision=revision, repo_type="dataset")
+        return str(info.commit_url)
 
     def pull(self, repo_id: str, out: Path) -> Path:
         """Download the repo's files at one revision, after its listing passed :func:`check_listing` (so an
@@ -313,7 +335,10 @@ class HubRemote:
 
 
 class FolderRemote:
-    """A folder standing in for the Hub: ``<folder>/<org>/<name>/`` holds the pushed files and a ``.tags`` file."""
+    """A folder standing in for the Hub: ``<folder>/<org>/<name>/`` holds the files of the last push and a ``.tags``
+    file, JSON mapping each tag to the revision it is on. A revision is the SHA-256 of the pushed files' paths and
+    checksums (:meth:`revision`), so, as on the Hub, a push of changed files makes a new revision and moves the tags
+    to it, and a push of the same files keeps both."""
 
     def __init__(self, folder: Path):
         self.folder = Path(folder)
@@ -325,10 +350,26 @@ class FolderRemote:
 
     def push(self, root: Path, repo_id: str, tags: tuple[str, ...]) -> str:
         dest = self._repo(repo_id)
+        old = self.tags(repo_id)
         with atomic_dir(dest, replace=True) as tmp:
             shutil.copytree(root, tmp, dirs_exist_ok=True)
-            (tmp / ".tags").write_text("\n".join(tags) + "\n")
+            revision = _revision(tmp)
+            (tmp / ".tags").write_text(json.dumps(old | dict.fromkeys(tags, revision), indent=1, sort_keys=True) + "\n")
         return str(dest)
+
+    def tags(self, repo_id: str) -> dict[str, str]:
+        """Tag -> the revision it is on (empty for a repo not pushed yet)."""
+        path = self._repo(repo_id) / ".tags"
+        if not path.is_file():
+            return {}
+        try:
+            return dict(json.loads(path.read_text()))
+        except ValueError:  # written before tags had revisions: a tag name a line, its revision unknown
+            return dict.fromkeys(path.read_text().split(), "")
+
+    def revision(self, repo_id: str) -> str:
+        """The revision of the repo's files as they are now (its head)."""
+        return _revision(self._repo(repo_id))
 
     def pull(self, repo_id: str, out: Path) -> Path:
         src = self._repo(repo_id)
@@ -337,6 +378,11 @@ class FolderRemote:
         regular_files_only(src)  # a link is not followed, a pipe not read
         shutil.copytree(src, out, ignore=shutil.ignore_patterns(".tags"), dirs_exist_ok=True, symlinks=True)
         return Path(out)
+
+
+def _revision(folder: Path) -> str:
+    """:class:`FolderRemote`'s revision id of the files in ``folder``: SHA-256 of their paths and checksums."""
+    return hashlib.sha256(json.dumps(checksums(folder), sort_keys=True).encode()).hexdigest()
 
 
 REPO_TAGS = ("v3.0",)

@@ -25,10 +25,23 @@ DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 JOURNAL_PATH = "meta/.commit.json"
 STAT_NAMES = ("min", "max", "mean", "std", "count")
+QUANTILES = {"q01": 0.01, "q10": 0.10, "q50": 0.50, "q90": 0.90, "q99": 0.99}
+"""lerobot 0.4's quantile stats (``compute_stats.DEFAULT_QUANTILES``, keyed ``q{int(q * 100):02d}``)."""
+CONVENTIONS = (1, 2)
+"""How a dataset's stats are written: 1 as the published GenDex datasets (``STAT_NAMES``), 2 as lerobot 0.4 writes
+them (``STAT_NAMES`` and the ``QUANTILES``, which pi0.5's quantile normalisation needs)."""
 
 
 class LeRobotDatasetError(EpisodeError):
     """A dataset root cannot be written as asked: it holds an incompatible or inconsistent dataset."""
+
+
+def stat_names(conventions: int) -> tuple[str, ...]:
+    """The stats of each feature a dataset of ``conventions`` holds, in the order they are written."""
+    if type(conventions) is not int or conventions not in CONVENTIONS:
+        raise LeRobotDatasetError(f"conventions {conventions!r} is not one of {list(CONVENTIONS)} (1: min/max/mean/"
+                                  f"std/count as published; 2: lerobot 0.4's, with the quantiles {list(QUANTILES)})")
+    return STAT_NAMES + (tuple(QUANTILES) if conventions == 2 else ())
 
 
 # --------------------------------------------------------------------------------------------- atomic files
@@ -83,22 +96,36 @@ def _recover(root: Path) -> None:
 
 
 # --------------------------------------------------------------------------------------------- stats
-def _array_stats(x: np.ndarray) -> dict[str, np.ndarray]:
+def _quantiles(x: np.ndarray) -> dict[str, np.ndarray]:
+    """The :data:`QUANTILES` of ``x`` along its first axis, exactly (numpy's linear interpolation between the sorted
+    values; lerobot estimates them from a histogram)."""
+    values = np.quantile(x, list(QUANTILES.values()), axis=0)
+    return {name: np.asarray(v, np.float64) for name, v in zip(QUANTILES, values, strict=True)}
+
+
+def _array_stats(x: np.ndarray, quantiles: bool = False) -> dict[str, np.ndarray]:
+    """Per-dimension stats of ``x`` ([T] or [T, D]) over its frames; with ``quantiles`` the :data:`QUANTILES` too."""
     x = np.asarray(x, dtype=np.float64)
     x = x[:, None] if x.ndim == 1 else x
-    return {"min": x.min(0), "max": x.max(0), "mean": x.mean(0), "std": x.std(0), "count": np.array([len(x)])}
+    out = {"min": x.min(0), "max": x.max(0), "mean": x.mean(0), "std": x.std(0), "count": np.array([len(x)])}
+    return (out | _quantiles(x)) if quantiles else out
 
 
-def _image_stats(images: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-channel stats of uint8 [T, H, W, 3] images scaled to [0, 1], shaped [3, 1, 1] as lerobot's."""
+def _image_stats(images: np.ndarray, quantiles: bool = False) -> dict[str, np.ndarray]:
+    """Per-channel stats of uint8 [T, H, W, 3] images scaled to [0, 1], shaped [3, 1, 1] as lerobot's; with
+    ``quantiles`` the :data:`QUANTILES` of each channel's pixels too."""
     flat = images.reshape(-1, 3)
     out = {"min": flat.min(0) / 255.0, "max": flat.max(0) / 255.0,
            "mean": flat.mean(0, dtype=np.float64) / 255.0, "std": flat.std(0, dtype=np.float64) / 255.0}
-    return {**{k: v.astype(np.float64).reshape(3, 1, 1) for k, v in out.items()}, "count": np.array([len(images)])}
+    out = {**{k: v.astype(np.float64).reshape(3, 1, 1) for k, v in out.items()}, "count": np.array([len(images)])}
+    if quantiles:
+        out |= {k: (v / 255.0).reshape(3, 1, 1) for k, v in _quantiles(flat).items()}
+    return out
 
 
 def _aggregate(stats_list: list[dict[str, dict[str, np.ndarray]]]) -> dict[str, dict[str, np.ndarray]]:
-    """Merge per-episode stats: min/max over episodes, count-weighted mean and (parallel-algorithm) variance."""
+    """Merge per-episode stats: min/max over episodes, count-weighted mean and (parallel-algorithm) variance, and
+    each quantile the stats hold as the count-weighted mean of the episodes' (as lerobot 0.4 aggregates them)."""
     out = {}
     for key in stats_list[0]:
         ss = [s[key] for s in stats_list]
@@ -112,6 +139,8 @@ def _aggregate(stats_list: list[dict[str, dict[str, np.ndarray]]]) -> dict[str, 
         out[key] = {"min": np.min(np.stack([np.asarray(s["min"], np.float64) for s in ss]), 0),
                     "max": np.max(np.stack([np.asarray(s["max"], np.float64) for s in ss]), 0),
                     "mean": mean, "std": np.sqrt(np.maximum(variance, 0.0)), "count": np.array([int(total)])}
+        for q in (q for q in ss[0] if q in QUANTILES):
+            out[key][q] = (np.stack([np.asarray(s[q], np.float64) for s in ss]) * w).sum(0) / total
     return out
 
 

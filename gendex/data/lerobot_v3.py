@@ -3,7 +3,8 @@
 Layout (as lerobot's ``LeRobotDataset`` reads it)::
 
     meta/info.json                               codebase_version "v3.0", totals, features, path templates
-    meta/stats.json                              per feature min/max/mean/std/count (images: per channel, [3,1,1])
+    meta/stats.json                              per feature min/max/mean/std/count (images: per channel, [3,1,1]);
+                                                 with ``conventions=2`` also the quantiles q01/q10/q50/q90/q99
     meta/tasks.parquet                           task_index column; the task string is the pandas index
     meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``)
     data/chunk-CCC/file-FFF.parquet              one row per action (frame); images as struct<bytes PNG, path>
@@ -37,6 +38,13 @@ is cleared. So:
   packet by packet) and appends the journaled episodes again. The files it ends with are the bytes an uninterrupted
   writer writes.
 
+``conventions`` (:data:`~gendex.data.lerobot_files.CONVENTIONS`) chooses the stats: 1 (the default) writes
+min/max/mean/std/count, as the published GenDex datasets hold them; 2 writes lerobot 0.4's stats, those and the
+quantiles q01, q10, q50, q90 and q99 (pi0.5 normalises state and action by q01/q99): each episode's exact quantiles
+per dimension (images: per channel over every pixel, scaled to [0, 1]) in its episode row, and in ``stats.json`` their
+count-weighted mean over the episodes, as lerobot aggregates them. A root is appended to only with the conventions
+it was written with.
+
 One writer per root at a time.
 """
 
@@ -53,7 +61,9 @@ import pyarrow.parquet as pq
 
 from gendex.data.episode import Episode, EpisodeError
 from gendex.data.lerobot_files import (
+    CONVENTIONS,
     DATA_PATH,
+    QUANTILES,
     STAT_NAMES,
     VIDEO_PATH,
     LeRobotDatasetError,
@@ -74,6 +84,7 @@ from gendex.data.lerobot_files import (
     _tmp,
     _vectors,
     _write_json,
+    stat_names,
 )
 from gendex_envs.atomic_io import write_bytes, write_text
 from gendex_envs.video import CODECS, PIX_FMT, encode
@@ -109,7 +120,8 @@ class LeRobotV3Writer:
 
     ``cameras`` maps camera name -> (height, width); those images are stored as ``observation.images.<name>``.
     ``data_files_size_in_mb`` / ``video_files_size_in_mb`` are the sizes at which a new data / video file is started
-    (lerobot's defaults: 100 MB and 500 MB). The dataset is complete and readable after :meth:`close`; episodes added
+    (lerobot's defaults: 100 MB and 500 MB). ``conventions`` chooses the stats (1: as published; 2: lerobot 0.4's,
+    with quantiles; see the module doc). The dataset is complete and readable after :meth:`close`; episodes added
     since the last close are kept in a journal, so a killed writer loses none of them (see the module doc).
     """
 
@@ -118,7 +130,7 @@ class LeRobotV3Writer:
                  environment_state_names: list[str] | None = None, video_codec: str | None = None,
                  chunks_size: int = 1000, data_files_size_in_mb: float = 100,
                  video_files_size_in_mb: float = DEFAULT_VIDEO_FILE_SIZE_IN_MB,
-                 codebase_version: str = CODEBASE_VERSION):
+                 codebase_version: str = CODEBASE_VERSION, conventions: int = 1):
         if codebase_version != CODEBASE_VERSION:
             raise LeRobotDatasetError(f"codebase_version {codebase_version!r} is not supported; only "
                                       f"{CODEBASE_VERSION!r} is")
@@ -126,6 +138,8 @@ class LeRobotV3Writer:
             raise LeRobotDatasetError(f"fps ({fps}), chunks_size ({chunks_size}), data_files_size_in_mb "
                                       f"({data_files_size_in_mb}) and video_files_size_in_mb "
                                       f"({video_files_size_in_mb}) must be positive")
+        self.stat_names = stat_names(conventions)  # checks conventions
+        self.conventions = conventions
         self.root = Path(root)
         self.fps, self.robot_type = int(fps), robot_type
         self.state_names, self.action_names = list(state_names), list(action_names)
@@ -218,6 +232,9 @@ class LeRobotV3Writer:
         self.video_files_size_in_mb = info.get("video_files_size_in_mb", DEFAULT_VIDEO_FILE_SIZE_IN_MB)
         for path in sorted(self.root.glob("meta/episodes/chunk-*/file-*.parquet")):
             self._rows.extend(pq.read_table(path).to_pylist())
+        if self._rows:
+            self._check_stat_names({s for s in (*STAT_NAMES, *QUANTILES) if f"stats/action/{s}" in self._rows[0]},
+                                   "its episodes parquet")
         if (self.root / TASKS_PATH).exists():
             t = pq.read_table(self.root / TASKS_PATH)
             self._tasks = dict(zip(t["task"].to_pylist(), t["task_index"].to_pylist(), strict=True))
@@ -235,6 +252,17 @@ class LeRobotV3Writer:
             self._reopen(self._rows[-1])
         log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
                  len(self._tasks))
+
+    def _check_stat_names(self, theirs: set[str], where: str) -> None:
+        if theirs != set(self.stat_names):
+            conventions = [c for c in CONVENTIONS if set(stat_names(c)) == theirs]
+            known = (*STAT_NAMES, *QUANTILES)
+            named = [s for s in known if s in theirs] + sorted(theirs - set(known))
+            raise LeRobotDatasetError(
+                f"{self.root}: {where} holds the stats {', '.join(named)}"
+                f"{f' (conventions {conventions[0]})' if conventions else ''}; this writer has conventions "
+                f"{self.conventions} ({', '.join(self.stat_names)}): append only with the conventions the dataset "
+                f"was written with, or write to a new root")
 
     def _reopen(self, last: dict) -> None:
         """Continue the last data and video files: their content is copied to new open files (row group by row
@@ -281,6 +309,8 @@ class LeRobotV3Writer:
             with pa.ipc.open_file(entries[e]) as reader:
                 table = reader.read_all()
             meta = json.loads(table.schema.metadata[b"gendex"])
+            for d in meta["stats"].values():
+                self._check_stat_names(set(d), f"its journal entry {entries[e].name}")
             stats = {k: {s: np.asarray(v) for s, v in d.items()} for k, d in meta["stats"].items()}
             self._append(table.replace_schema_metadata(None), meta["instruction"], stats, self._segments(e))
             replayed += 1
@@ -293,7 +323,7 @@ class LeRobotV3Writer:
                 if ft["dtype"] == "video"}
 
     def _row_stats(self, row: dict) -> dict[str, dict[str, np.ndarray]]:
-        return {k: {s: np.asarray(row[f"stats/{k}/{s}"]) for s in STAT_NAMES} for k in self.features}
+        return {k: {s: np.asarray(row[f"stats/{k}/{s}"]) for s in self.stat_names} for k in self.features}
 
     def _validate(self, ep: Episode) -> None:
         who = f"episode of {ep.task_id} (seed {ep.seed})"
@@ -349,18 +379,18 @@ class LeRobotV3Writer:
                    "task_index": np.full(t, task_index, np.int64)}
         if self.environment_state_names:
             numeric["observation.environment_state"] = np.asarray(ep.environment_state[:t], np.float32)
-        columns, ep_stats, videos = {}, {}, {}
+        columns, ep_stats, videos, quantiles = {}, {}, {}, self.conventions == 2
         for key, ft in self.features.items():
             if ft["dtype"] == "video":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
-                ep_stats[key], videos[key] = _image_stats(images), images
+                ep_stats[key], videos[key] = _image_stats(images, quantiles), images
             elif ft["dtype"] == "image":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
-                columns[key], ep_stats[key] = _png_column(images), _image_stats(images)
+                columns[key], ep_stats[key] = _png_column(images), _image_stats(images, quantiles)
             else:
                 arr = numeric[key]
                 columns[key] = _vectors(arr) if arr.ndim == 2 else pa.array(arr, _ARROW[ft["dtype"]])
-                ep_stats[key] = _array_stats(arr)
+                ep_stats[key] = _array_stats(arr, quantiles)
         table = pa.table(columns)
         # the journal entry: each camera's frames as their own video, then the rows and stats (its commit point)
         segments = self._segments(e)
