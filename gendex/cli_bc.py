@@ -70,6 +70,47 @@ def bc_train(dataset: Path = typer.Argument(..., help="A LeRobot dataset folder 
         die(exc)
 
 
+def embed_instructions(texts: list[str]):
+    """all-MiniLM-L6-v2 embeddings of ``texts`` (the model the generator measures instruction diversity with)."""
+    from generator.embedding import embed
+
+    return embed(texts)[0]
+
+
+def dataset_folders(paths: list[Path]) -> list[Path]:
+    """Each path as given, or, for a dataset build (``gendex_dataset.json`` in it), every task folder of it."""
+    out = []
+    for p in paths:
+        if (p / "gendex_dataset.json").is_file():
+            out += sorted(d for d in p.iterdir() if (d / "lerobot" / "meta" / "info.json").is_file())
+        else:
+            out.append(p)
+    return out
+
+
+@bc_app.command("train-multitask")
+def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot datasets of one task each, or "
+                                                                        "dataset builds (every task in them)."),
+                       out: Path = typer.Option(..., "--out", help="Folder for bc.pt and its record."),
+                       demos: int = typer.Option(None, "--demos", min=1, help="First N episodes of each task."),
+                       steps: int = typer.Option(40_000, "--steps", min=1, help="Gradient steps."),
+                       chunk: int = typer.Option(10, "--chunk", min=1, help="Actions predicted per step."),
+                       seed: int = typer.Option(0, "--seed")) -> None:
+    """Train one language-conditioned policy on many tasks (state + environment state + the instruction's MiniLM
+    embedding); evaluate it with gendex eval --policy bc:OUT/bc.pt."""
+    from gendex.imitation.multitask import MultiTaskConfig, train
+    from gendex_envs.errors import GenDexError
+
+    try:
+        folders = dataset_folders(datasets)
+        typer.echo(f"training on {len(folders)} datasets", err=True)
+        path = train(folders, out, embed_instructions, demos, MultiTaskConfig(chunk=chunk, steps=steps, seed=seed),
+                     progress=lambda s, loss: typer.echo(f"  step {s}: loss {loss:.4f}", err=True))
+        typer.echo(f"wrote {path}")
+    except (GenDexError, ValueError, OSError) as exc:
+        die(exc)
+
+
 @bc_app.command("eval")
 def bc_eval(ckpt: Path = typer.Argument(..., help="A bc.pt checkpoint."),
             episodes: int = typer.Option(50, "--episodes", min=1),

@@ -14,10 +14,11 @@ def policy_factory(spec: str):
     """What ``--policy SPEC`` builds: ``bc:PATH`` (a behaviour-cloning checkpoint) or a built-in / module policy
     (:func:`gendex.eval.policies.resolve_policy`). Top-level, so worker processes can resolve the spec themselves."""
     if spec.startswith("bc:"):
+        from gendex.cli_bc import embed_instructions
         from gendex.imitation.bc import load_policy
 
         paths = spec.removeprefix("bc:")
-        return lambda: load_policy(paths)
+        return lambda: load_policy(paths, embed_instructions)
     from gendex.eval.policies import resolve_policy
 
     return resolve_policy(spec)

@@ -377,10 +377,13 @@ class BCPolicy:
         self.t = 0
         self.pending: list[tuple[int, np.ndarray]] = []  # (step it was predicted at, [chunk, A])
 
+    def features(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        """[1, inputs]: what the network reads at this step (before normalization)."""
+        return _inputs(obs[STATE][None], obs[ENVIRONMENT_STATE][None], np.array([self.t], np.float32))
+
     @torch.no_grad()
     def act(self, obs: dict[str, np.ndarray]) -> np.ndarray:
-        x = _inputs(obs[STATE][None], obs[ENVIRONMENT_STATE][None], np.array([self.t], np.float32))
-        pred = self.model(torch.as_tensor(self.x(x))).numpy().reshape(self.chunk, -1)
+        pred = self.model(torch.as_tensor(self.x(self.features(obs)))).numpy().reshape(self.chunk, -1)
         self.pending = [(t0, c) for t0, c in self.pending if self.t - t0 < self.chunk] + [(self.t, pred)]
         ages = np.array([self.t - t0 for t0, _ in self.pending], np.float32)
         w = np.exp(-self.decay * ages)
@@ -423,11 +426,16 @@ class BCPolicies:
         return self.active.act(obs)
 
 
-def load_policy(spec: str) -> BCPolicy | BCPolicies:
-    """``PATH`` (one checkpoint) or ``PATH,PATH,...`` (one per task), as ``--policy bc:...`` gives them."""
+def load_policy(spec: str, embed: Callable[[list[str]], np.ndarray] | None = None) -> BCPolicy | BCPolicies:
+    """``PATH`` (one checkpoint, single- or multi-task) or ``PATH,PATH,...`` (one per task), as ``--policy bc:...``
+    gives them; ``embed``: a multi-task policy's encoder for an instruction it did not learn."""
     paths = [s for s in spec.split(",") if s]
     if not paths:
         raise PolicyTaskError("bc: needs a checkpoint path (bc:PATH or bc:PATH,PATH,...)")
+    if len(paths) == 1 and load_checkpoint(paths[0]).get("kind") == "multitask":
+        from gendex.imitation.multitask import MultiTaskPolicy
+
+        return MultiTaskPolicy(paths[0], embed)
     return BCPolicy(paths[0]) if len(paths) == 1 else BCPolicies(paths)
 
 

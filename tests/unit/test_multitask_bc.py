@@ -1,0 +1,118 @@
+"""The multi-task, language-conditioned BC baseline on synthetic LeRobot datasets (no simulator): one policy learns
+two tasks whose observations look alike and whose experts act oppositely, so it must read the instruction."""
+
+from __future__ import annotations
+
+import json
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from gendex.data.episode import Episode
+from gendex.data.lerobot_v3 import LeRobotV3Writer
+from gendex.imitation.bc import load_policy
+from gendex.imitation.frames import DatasetReadError
+from gendex.imitation.multitask import MultiTaskConfig, MultiTaskPolicy, PolicyTaskError, train
+from gendex_envs.observation import ENVIRONMENT_STATE, STATE
+
+S, A = 4, 2
+TASKS = {"GenDex/ToyToward-v0": ("move toward the block", 1.0, 3), "GenDex/ToyAway-v0": ("move away from the block",
+                                                                                           -1.0, 5)}
+
+
+def fake_embed(texts: list[str]) -> np.ndarray:
+    """A stand-in sentence encoder: a fixed unit vector per text (no language model in unit tests)."""
+    out = []
+    for text in texts:
+        v = np.random.default_rng(sum(map(ord, text))).normal(size=16)
+        out.append(v / np.linalg.norm(v))
+    return np.asarray(out, np.float32)
+
+
+def _episode(task: str, seed: int, t: int = 12) -> Episode:
+    text, sign, k = TASKS[task]
+    rng = np.random.default_rng(seed)
+    world = np.repeat(rng.uniform(-1, 1, (1, k)), t + 1, 0).astype(np.float32)
+    steps = np.arange(t, dtype=np.float32)[:, None]
+    return Episode(task_id=task, instruction=text, seed=seed, control_mode="pd_joint_pos", control_joint="both",
+                   fps=20, state=rng.normal(size=(t + 1, S)).astype(np.float32) * 0.01,
+                   action=(sign * (world[:t, :A] + 0.1 * steps)).astype(np.float32), reward=np.zeros(t, np.float32),
+                   success=np.r_[np.zeros(t - 1, bool), True], fail=np.zeros(t, bool),
+                   env_states=np.zeros((t + 1, 2), np.float32), environment_state=world,
+                   environment_state_names=tuple(f"w{i}" for i in range(k)))
+
+
+def _dataset(root, task: str, action_names=None) -> None:
+    k = TASKS[task][2]
+    with LeRobotV3Writer(root, fps=20, robot_type="toy", state_names=[f"s{i}" for i in range(S)],
+                         action_names=action_names or [f"a{i}" for i in range(A)],
+                         environment_state_names=[f"w{i}" for i in range(k)]) as w:
+        for seed in range(30):
+            w.add_episode(_episode(task, seed))
+    (root / "meta" / "gendex.json").write_text(json.dumps({"task_id": task, "env_kwargs": {
+        "control_mode": "pd_joint_pos", "reconfiguration_freq": 1}, "episode_seeds": list(range(30))}))
+
+
+@pytest.fixture
+def datasets(tmp_path):
+    paths = []
+    for i, task in enumerate(TASKS):
+        _dataset(tmp_path / f"d{i}" / "lerobot", task)
+        paths.append(tmp_path / f"d{i}")
+    return paths
+
+
+def _env(instruction: str):
+    return SimpleNamespace(unwrapped=SimpleNamespace(task_spec=SimpleNamespace(instruction=instruction)),
+                           action_space=gym.spaces.Box(-10, 10, (A,), np.float32))
+
+
+def _error(policy, task: str, instruction: str | None = None) -> float:
+    policy.bind(_env(instruction or TASKS[task][0]))
+    errs = []
+    for seed in range(100, 106):  # episodes it never saw
+        ep = _episode(task, seed)
+        policy.reset()
+        for t in range(ep.length):
+            a = policy.act({STATE: ep.state[t], ENVIRONMENT_STATE: ep.environment_state[t]})
+            errs.append(np.abs(a - ep.action[t]).max())
+    return float(np.mean(errs))
+
+
+def test_one_policy_learns_both_tasks_by_their_instructions(datasets, tmp_path):
+    path = train(datasets, tmp_path / "mt", fake_embed, config=MultiTaskConfig(chunk=4, steps=800, hidden=128,
+                                                                               layers=2, obs_noise=0.0, batch=128))
+    policy = load_policy(str(path))
+    assert isinstance(policy, MultiTaskPolicy) and policy.world_dim == 5
+    assert policy.tasks == {t: v[0] for t, v in TASKS.items()} and policy.training_seeds == list(range(30))
+    record = json.loads((tmp_path / "mt" / "bc.json").read_text())
+    assert [s for s, _ in record["curve"]] == [800] and record["curve"][0][1] == record["final_loss"]
+    for task in TASKS:
+        assert _error(policy, task) < 0.3, task  # the actions span about 3 units
+    # told the other task's instruction, it does the other task: the instruction is what it acts on
+    assert _error(policy, "GenDex/ToyToward-v0", TASKS["GenDex/ToyAway-v0"][0]) > 1.0
+
+
+def test_an_instruction_it_did_not_learn_needs_an_encoder(datasets, tmp_path):
+    path = train(datasets, tmp_path / "mt", fake_embed, config=MultiTaskConfig(chunk=2, steps=5, hidden=16,
+                                                                               layers=1))
+    with pytest.raises(PolicyTaskError, match="did not learn 'push the block'"):
+        MultiTaskPolicy(path).bind(_env("push the block"))
+    policy = MultiTaskPolicy(path, fake_embed)
+    policy.bind(_env("push the block"))
+    policy.reset()
+    assert policy.act({STATE: np.zeros(S, np.float32), ENVIRONMENT_STATE: np.zeros(3, np.float32)}).shape == (A,)
+    with pytest.raises(PolicyTaskError, match="environment state has 6 values; the policy learned at most 5"):
+        policy.act({STATE: np.zeros(S, np.float32), ENVIRONMENT_STATE: np.zeros(6, np.float32)})
+
+
+def test_datasets_of_other_robots_or_the_same_task_twice_are_refused(datasets, tmp_path):
+    other = tmp_path / "other" / "lerobot"
+    _dataset(other, "GenDex/ToyAway-v0", action_names=["b0", "b1"])
+    with pytest.raises(DatasetReadError, match="differ in action names"):
+        train([datasets[0], other.parent], tmp_path / "x", fake_embed, config=MultiTaskConfig(steps=1))
+    with pytest.raises(DatasetReadError, match="given twice"):
+        train([datasets[0], datasets[0]], tmp_path / "x", fake_embed, config=MultiTaskConfig(steps=1))
+    assert not (tmp_path / "x").exists()  # nothing written for a refused training
