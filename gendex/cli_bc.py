@@ -95,17 +95,28 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
                        demos: int = typer.Option(None, "--demos", min=1, help="First N episodes of each task."),
                        steps: int = typer.Option(40_000, "--steps", min=1, help="Gradient steps."),
                        chunk: int = typer.Option(10, "--chunk", min=1, help="Actions predicted per step."),
+                       camera: str = typer.Option(None, "--camera", help="Learn from this camera's frames and the "
+                                                                         "joint state instead of the object poses."),
+                       image_size: int = typer.Option(64, "--image-size", min=8, max=512,
+                                                      help="With --camera: frames resized to this size."),
                        seed: int = typer.Option(0, "--seed")) -> None:
-    """Train one language-conditioned policy on many tasks (state + environment state + the instruction's MiniLM
-    embedding); evaluate it with gendex eval --policy bc:OUT/bc.pt."""
-    from gendex.imitation.multitask import MultiTaskConfig, train
+    """Train one language-conditioned policy on many tasks (state + environment state, or with --camera the
+    camera's frames + joint state, and the instruction's MiniLM embedding); evaluate it with gendex eval --policy
+    bc:OUT/bc.pt."""
+    from gendex.imitation import multitask, pixels
     from gendex_envs.errors import GenDexError
 
     try:
         folders = dataset_folders(datasets)
         typer.echo(f"training on {len(folders)} datasets", err=True)
-        path = train(folders, out, embed_instructions, demos, MultiTaskConfig(chunk=chunk, steps=steps, seed=seed),
-                     progress=lambda s, loss: typer.echo(f"  step {s}: loss {loss:.4f}", err=True))
+        show = lambda s, loss: typer.echo(f"  step {s}: loss {loss:.4f}", err=True)  # noqa: E731
+        if camera is None:
+            path = multitask.train(folders, out, embed_instructions, demos,
+                                   multitask.MultiTaskConfig(chunk=chunk, steps=steps, seed=seed), progress=show)
+        else:
+            path = pixels.train(folders, out, embed_instructions, demos,
+                                pixels.PixelConfig(camera=camera, image_size=image_size, chunk=chunk, steps=steps,
+                                                   seed=seed), progress=show)
         typer.echo(f"wrote {path}")
     except (GenDexError, ValueError, OSError) as exc:
         die(exc)

@@ -75,6 +75,23 @@ def make_eval_env(task: str, env_kwargs: dict | None = None, max_episode_steps: 
     return LeRobotObservation(gym.make(task, **kwargs))
 
 
+OBSERVATION_KWARGS = {"obs_mode": ("state", "rgb"), "sensor_resolution": range(8, 513)}
+"""What a policy may ask the evaluation env to observe (``policy.observation_kwargs``): cameras and their size. These
+change what the env renders, never its physics; nothing else a policy asks for reaches ``gym.make``."""
+
+
+def observation_kwargs(policy) -> dict:
+    """The policy's ``observation_kwargs`` (e.g. a pixel policy's camera rendering), checked against
+    :data:`OBSERVATION_KWARGS`; ValueError naming what is not allowed."""
+    asked = getattr(policy, "observation_kwargs", None) or {}
+    bad = {k: v for k, v in asked.items() if k not in OBSERVATION_KWARGS or v not in OBSERVATION_KWARGS[k]
+           or type(v) is bool}
+    if bad:
+        raise ValueError(f"the policy asks the env for {bad}; a policy may only set obs_mode (state, rgb) and "
+                         "sensor_resolution (8..512)")
+    return dict(asked)
+
+
 def _check_action(action: Any, space: gym.spaces.Box) -> tuple[np.ndarray | None, str | None]:
     try:
         a = np.asarray(action, dtype=np.float32).reshape(space.shape)
@@ -148,9 +165,10 @@ def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[
     the first ``videos`` episodes are also written as ``<video_dir>/<task name>_<seed>.mp4``."""
     from gendex_envs.video import encode
 
-    env = make_eval_env(task, env_kwargs, max_episode_steps, render=videos > 0)
+    policy = make_policy()
+    env = make_eval_env(task, {**(env_kwargs or {}), **observation_kwargs(policy)}, max_episode_steps,
+                        render=videos > 0)
     try:
-        policy = make_policy()
         try:
             bind(policy, env)
         except Exception as exc:  # the policy cannot act here: each episode fails with the reason
@@ -179,5 +197,5 @@ def evaluate_task(task: str, make_policy: Callable[[], Policy], seeds: Iterable[
         env.close()
 
 
-__all__ = ["ACTION_TOL", "EpisodeResult", "Policy", "PolicyFault", "evaluate_episode", "evaluate_task",
-           "make_eval_env"]
+__all__ = ["ACTION_TOL", "OBSERVATION_KWARGS", "EpisodeResult", "Policy", "PolicyFault", "evaluate_episode",
+           "evaluate_task", "make_eval_env", "observation_kwargs"]

@@ -383,7 +383,11 @@ class BCPolicy:
 
     @torch.no_grad()
     def act(self, obs: dict[str, np.ndarray]) -> np.ndarray:
-        pred = self.model(torch.as_tensor(self.x(self.features(obs)))).numpy().reshape(self.chunk, -1)
+        return self._ensemble(self.model(torch.as_tensor(self.x(self.features(obs)))).numpy().reshape(self.chunk, -1))
+
+    def _ensemble(self, pred: np.ndarray) -> np.ndarray:
+        """The action of this step from every kept chunk's prediction for it (temporal ensembling; module doc),
+        ``pred`` being this step's [chunk, A] prediction (normalized)."""
         self.pending = [(t0, c) for t0, c in self.pending if self.t - t0 < self.chunk] + [(self.t, pred)]
         ages = np.array([self.t - t0 for t0, _ in self.pending], np.float32)
         w = np.exp(-self.decay * ages)
@@ -432,10 +436,15 @@ def load_policy(spec: str, embed: Callable[[list[str]], np.ndarray] | None = Non
     paths = [s for s in spec.split(",") if s]
     if not paths:
         raise PolicyTaskError("bc: needs a checkpoint path (bc:PATH or bc:PATH,PATH,...)")
-    if len(paths) == 1 and load_checkpoint(paths[0]).get("kind") == "multitask":
+    kind = load_checkpoint(paths[0]).get("kind") if len(paths) == 1 else None
+    if kind == "multitask":
         from gendex.imitation.multitask import MultiTaskPolicy
 
         return MultiTaskPolicy(paths[0], embed)
+    if kind == "pixels":
+        from gendex.imitation.pixels import PixelPolicy
+
+        return PixelPolicy(paths[0], embed)
     return BCPolicy(paths[0]) if len(paths) == 1 else BCPolicies(paths)
 
 

@@ -78,4 +78,44 @@ def load_frames(path: Path | str, episodes: int | None = None) -> Frames:
                   names={k: feats[k]["names"] for k in (STATE, ENVIRONMENT_STATE, "action")}, info=info)
 
 
-__all__ = ["DatasetReadError", "Frames", "load_frames", "lerobot_root"]
+def load_images(path: Path | str, camera: str, episodes: int | None = None, size: int | None = None) -> np.ndarray:
+    """[F, size, size, 3] uint8: camera ``camera``'s frame for every row :func:`load_frames` gives (same
+    ``episodes``, same order), decoded from the dataset's videos (each episode's frames located by its row in the
+    episodes parquet) and, when ``size`` differs from the recorded resolution, resized by area averaging."""
+    from PIL import Image
+
+    from gendex_envs.video import decode
+
+    root = lerobot_root(path)
+    info = json.loads((root / "meta" / "info.json").read_text())
+    key = f"observation.images.{camera}"
+    feat = info["features"].get(key)
+    if feat is None or feat.get("dtype") != "video":
+        have = sorted(k.removeprefix("observation.images.") for k, f in info["features"].items()
+                      if k.startswith("observation.images.") and f.get("dtype") == "video")
+        raise DatasetReadError(f"{root} has no video of camera {camera!r} (cameras: {have or 'none'}); collect with "
+                               f"--cameras {camera}")
+    fps = info["fps"]
+    rows = pa.concat_tables([pq.read_table(f) for f in sorted(root.glob("meta/episodes/chunk-*/file-*.parquet"))])
+    eps = rows.to_pylist()
+    total = len(eps) if episodes is None else episodes
+    cache: dict[tuple[int, int], np.ndarray] = {}
+    out = []
+    for row in sorted(eps, key=lambda r: r["episode_index"])[:total]:
+        where = (row[f"videos/{key}/chunk_index"], row[f"videos/{key}/file_index"])
+        if where not in cache:
+            cache.clear()  # files are read in order: one decoded file at a time
+            cache[where] = decode(root / info["video_path"].format(video_key=key, chunk_index=where[0],
+                                                                   file_index=where[1]))
+        first = round(row[f"videos/{key}/from_timestamp"] * fps)
+        frames = cache[where][first:first + row["length"]]
+        if len(frames) != row["length"]:
+            raise DatasetReadError(f"{root}: episode {row['episode_index']} has {row['length']} rows but its video "
+                                   f"holds {len(frames)} frames from {first}")
+        if size is not None and frames.shape[1:3] != (size, size):
+            frames = np.stack([np.asarray(Image.fromarray(f).resize((size, size), Image.BOX)) for f in frames])
+        out.append(frames)
+    return np.concatenate(out)
+
+
+__all__ = ["DatasetReadError", "Frames", "load_frames", "load_images", "lerobot_root"]
