@@ -249,9 +249,17 @@ class RigidPrimitives:
             budget = max(c.max_trials, c.thin_trials)
         elif c.max_trials and set(families) == {"pinch"}:
             budget = max(c.max_trials, c.pinch_trials)
+        # none of the budget held: an object that pinches goes on with its pinches alone, up to pinch_trials (the
+        # cheese wedge: 3 of 20 fresh seeds ran out of 10 trials, pinch and top alike), unless it has a ring (a flat
+        # tool is dragged to the table's edge instead); an attempt that held within the budget is unchanged
+        more = (c.pinch_trials if c.max_trials and "pinch" in families and budget < c.pinch_trials
+                and find_ring(self.shape(name)) is None else budget)
+        pinch_only = False
         # a sponge to wipe with is pinched: held palm down, the wrist is too low to press it flat (5 of 20 seeds)
         wiping = set_on is not None and "wipe_area" in env.asset_record(set_on).tags
         for plan in (p for p in synth.candidates() if not (wiping and p.kind == "top")):
+            if pinch_only and plan.kind != "pinch":
+                continue
             open_q = m.with_hand(q0, plan.open_hand)
             q_pre = m.ik.solve(plan.pregrasp, open_q, restarts=20, valid=m.collision.is_free)
             q_at = None if q_pre is None else m.ik.solve(plan.palm, q_pre, restarts=0)
@@ -270,6 +278,10 @@ class RigidPrimitives:
                 if tried(helped, q_helped):
                     return helped, q_helped
             if len(results) - helped_trials >= budget:
+                if budget < more and not fallback and not any(r.held for r in results):
+                    log.info("no grasp of %r held in %d trials: trying its pinches, up to %d", name, budget, more)
+                    budget, pinch_only = more, True
+                    continue
                 break
         if fallback:
             _, result, q = min(fallback, key=lambda f: f[0])

@@ -20,8 +20,8 @@ from gendex.solve.rigid import RigidConfig, RigidPrimitives
 from gendex_envs.errors import ExecutionError
 
 
-def _plan(i: int) -> GraspPlan:
-    return GraspPlan(f"candidate-{i}", sapien.Pose([0.5, 0.0, 0.1]), np.array([0.0, 0.0, -1.0]))
+def _plan(i: int, kind: str | None = None) -> GraspPlan:
+    return GraspPlan(kind or f"candidate-{i}", sapien.Pose([0.5, 0.0, 0.1]), np.array([0.0, 0.0, -1.0]))
 
 
 def _held(plan: GraspPlan, pushed_m: float = 0.0, spread: float = 1.0) -> TrialResult:
@@ -52,10 +52,12 @@ class _Trials:
         return self.outcomes[len(self.tried) - 1](plan)
 
 
-def _choose(monkeypatch, outcomes, set_on=None, fits=None, families=("top",), config=None):
-    """``outcomes[i](plan)``: the trial result of candidate i. Returns (chosen plan, plans tried)."""
-    plans = tuple(_plan(i) for i in range(len(outcomes)))
+def _choose(monkeypatch, outcomes, set_on=None, fits=None, families=("top",), config=None, kinds=None, ring=False):
+    """``outcomes[i](plan)``: the trial result of candidate i (of kind ``kinds[i]``; default ``candidate-i``);
+    ``ring``: the object is a ringed flat tool. Returns (chosen plan, plans tried)."""
+    plans = tuple(_plan(i, kinds[i] if kinds else None) for i in range(len(outcomes)))
     monkeypatch.setattr(rigid, "GraspSynthesizer", lambda *a, **kw: _Synth(plans=plans, families=families))
+    monkeypatch.setattr(rigid, "find_ring", lambda shape: object() if ring else None)
     monkeypatch.setattr(rigid, "object_heading", lambda *a: 0.0)
     monkeypatch.setattr(rigid, "px_bodies", lambda obj: [types.SimpleNamespace(mass=0.1)])
     monkeypatch.setattr(rigid, "fits_on", lambda shape, target: fits)
@@ -114,7 +116,7 @@ def test_a_shoved_trial_says_so():
     assert _held(plan, pushed_m=SHOVED_M + 1e-4).shoved and not _held(plan, pushed_m=SHOVED_M).shoved
 
 
-@pytest.mark.parametrize("families, budget", [(("top", "pinch"), 10), (("pinch",), 30), (("pinch", "tip"), 48)])
+@pytest.mark.parametrize("families, budget", [(("top", "side"), 10), (("pinch",), 30), (("pinch", "tip"), 48)])
 def test_a_ball_only_a_pinch_holds_gets_more_trials(monkeypatch, families, budget):
     """Budgets: 10 trials; 30 where a precision pinch is the only grasp (a golf ball's near misses push it while
     closing); 48 where fingertip pinches at the table join in."""
@@ -122,3 +124,31 @@ def test_a_ball_only_a_pinch_holds_gets_more_trials(monkeypatch, families, budge
     with pytest.raises(ExecutionError) as err:
         _choose(monkeypatch, [_dropped] * 60, families=families, config=config)
     assert err.value.cause == "grasp_failed" and len(err.value.tried) == budget
+
+
+KINDS = ["top", "pinch"] * 30
+"""Candidates alternating between a top grasp and a pinch, as the synthesizer ranks an object with both."""
+
+
+def test_when_none_of_the_budget_held_the_pinches_go_on_up_to_pinch_trials(monkeypatch):
+    """The cheese wedge (top and pinch grasps) ran out of its 10 trials on 3 of 20 fresh seeds; its pinches go on,
+    to 30 trials in all, and the first that holds is taken."""
+    config = RigidConfig(max_trials=10, pinch_trials=30, thin_trials=48)
+    outcomes = [_dropped] * 60
+    with pytest.raises(ExecutionError) as err:
+        _choose(monkeypatch, outcomes, families=("top", "pinch"), config=config, kinds=KINDS)
+    tried = err.value.tried
+    assert len(tried) == 30 and [p.kind for p in tried[10:]] == ["pinch"] * 20  # only pinches after the first ten
+    outcomes[16] = _held  # the 17th trial (the scripted outcomes go by trial) holds
+    plan, tried = _choose(monkeypatch, outcomes, families=("top", "pinch"), config=config, kinds=KINDS)
+    assert plan is tried[-1] and len(tried) == 17 and plan.kind == "pinch"
+
+
+def test_an_attempt_that_held_within_the_budget_or_a_ringed_tool_gets_no_more_trials(monkeypatch):
+    config = RigidConfig(max_trials=10, pinch_trials=30, thin_trials=48)
+    shoved = [_dropped] * 9 + [lambda p: _held(p, pushed_m=SHOVED_M + 0.01)] + [_held] * 50
+    plan, tried = _choose(monkeypatch, shoved, families=("top", "pinch"), config=config, kinds=KINDS)
+    assert len(tried) == 10 and plan is tried[-1]  # the shoved hold of the tenth trial is the fallback, as before
+    with pytest.raises(ExecutionError) as err:  # a flat tool with a ring is dragged to the edge instead
+        _choose(monkeypatch, [_dropped] * 60, families=("top", "pinch"), config=config, kinds=KINDS, ring=True)
+    assert len(err.value.tried) == 10
