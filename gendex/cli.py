@@ -182,6 +182,14 @@ def _render_views(env_id: str, out: Path, seed: int, montage: bool = False, scen
 
 
 @app.command()
+def scenes() -> None:
+    """List what a task's scene section can name: styles, surface materials, backgrounds, structures, paints."""
+    from gendex_envs.assets.scenery_catalog import guide
+
+    typer.echo(guide())
+
+
+@app.command()
 def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"),
            out: Path = typer.Option(Path("out/render"), "--out", help="Folder for the PNGs."),
            seed: int = typer.Option(0, help="Reset seed (object placement; the scene's appearance draw)."),

@@ -333,6 +333,12 @@ def plaster(rng, shape) -> np.ndarray:
     return img
 
 
+def night_window(rng: np.random.Generator, shape: tuple[int, int]) -> np.ndarray:
+    img = paint(rng, shape, hex_color("#c8c2b8"))
+    window(img, rng, at(2.2), 0.1, at(0.85), 0.9, "night", frame_color=(0.25, 0.25, 0.27), panes=4)
+    return img
+
+
 P = functools.partial
 H = hex_color
 BACKGROUNDS: dict[str, BackgroundDef] = {b.name: b for b in (
@@ -379,16 +385,9 @@ BACKGROUNDS: dict[str, BackgroundDef] = {b.name: b for b in (
                   "studio"),
     BackgroundDef("classroom_chalkboard", "a chalkboard with chalk marks", chalkboard, "other"),
     BackgroundDef("plaster_white", "plain white plaster", plaster, "other"),
-    BackgroundDef("city_night_window", "a window onto a city at night",
-                  lambda rng, shape: _night(rng, shape), "other"),
+    BackgroundDef("city_night_window", "a window onto a city at night", night_window, "other"),
 )}
 """Every background image by name."""
-
-
-def _night(rng: np.random.Generator, shape: tuple[int, int]) -> np.ndarray:
-    img = paint(rng, shape, hex_color("#c8c2b8"))
-    window(img, rng, at(2.2), 0.1, at(0.85), 0.9, "night", frame_color=(0.25, 0.25, 0.27), panes=4)
-    return img
 
 
 @functools.cache

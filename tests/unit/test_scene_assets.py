@@ -2,6 +2,7 @@
 something to see where the cameras look; structures are sound boxes painted from known paints."""
 
 import hashlib
+import json
 
 import numpy as np
 import pytest
@@ -72,3 +73,18 @@ def test_structures_are_sound_and_painted_from_known_paints():
     glass = [p for s in STRUCTURES.values() for p in s.parts if p.role == "glass"]
     assert glass and not any(p.collision for p in glass)  # panes are seen, never touched
 
+
+
+def test_the_committed_catalog_is_the_codes():
+    """gendex_envs/assets/data/scenery/catalog.json records every asset with its generator, parameters and licence;
+    regenerate it with ``python -m gendex_envs.assets.scenery_catalog`` after changing an asset."""
+    from gendex_envs.assets.scenery_catalog import OUT, catalog_text
+
+    assert (OUT / "catalog.json").read_text() == catalog_text()
+    assert "Apache" in (OUT / "LICENSE").read_text()
+    record = json.loads(catalog_text())
+    assert [m["name"] for m in record["materials"]["entries"]] == list(MATERIALS)
+    assert [b["name"] for b in record["backgrounds"]["entries"]] == list(BACKGROUNDS)
+    assert [s["name"] for s in record["structures"]] == list(STRUCTURES)
+    assert all(e["licence"] == "Apache-2.0" for e in record["materials"]["entries"] + record["backgrounds"]["entries"]
+               + record["structures"])
