@@ -187,8 +187,7 @@ class Scenery:
         self._materials = []
         if not env.scene.can_render():
             return
-        self._fixed = {role: sapien.render.RenderMaterial(base_color=[*rgb, 0.35 if role == "glass" else 1.0],
-                                                          roughness=rough, metallic=metal)
+        self._fixed = {role: sapien.render.RenderMaterial(base_color=[*rgb, 1.0], roughness=rough, metallic=metal)
                        for role, (rgb, rough, metal) in ROLE_COLORS.items()}
         self._fixed["leg"] = sapien.render.RenderMaterial(base_color=TABLE_LEG_RGBA)
         nominal = draw_appearance(self.scene, 0, randomize=False)

@@ -29,7 +29,7 @@ ROLE_COLORS: dict[str, tuple[Color, float, float]] = {
     "top": (hex_color("#2f3033"), 0.3, 0.0),
     "metal": (hex_color("#b9bcbf"), 0.3, 1.0),
     "dark": (hex_color("#202124"), 0.6, 0.0),
-    "glass": (hex_color("#a9c6d6"), 0.05, 0.0),
+    "glass": (hex_color("#b4cdd9"), 0.05, 0.3),  # drawn opaque: a pale pane (SAPIEN's rasteriser shows alpha dark)
     "wood": (hex_color("#c8955f"), 0.6, 0.0),
     "white": (hex_color("#f4f4f2"), 0.3, 0.0),
 }
@@ -158,7 +158,7 @@ def _dish_rack() -> tuple[Part, ...]:
 
 def _monitor() -> tuple[Part, ...]:
     return (_box((0.2, 0.24, 0.02), (0.03, 0.0, 0.01), "dark"), _box((0.04, 0.06, 0.26), (0.05, 0.0, 0.15), "dark"),
-            _box((0.03, 0.62, 0.37), (0.02, 0.0, 0.36)), _box((0.002, 0.58, 0.33), (0.004, 0.0, 0.36), "glass",
+            _box((0.03, 0.62, 0.37), (0.02, 0.0, 0.36)), _box((0.002, 0.58, 0.33), (0.004, 0.0, 0.36), "dark",
                                                              collision=False))
 
 

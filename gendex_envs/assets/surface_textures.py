@@ -4,7 +4,7 @@ cloth and more, each a seeded numpy texture (:mod:`gendex_envs.assets.texture_no
 :data:`MATERIALS` maps a material name (what a task's ``scene.surface.materials`` and ``scene.floor.materials``
 list) to its :class:`MaterialDef`; :func:`material_image` renders one (memoised per process). Textures tile
 seamlessly and cover :data:`PERIOD_M` of the surface per repeat. All of it is GenDex's own work (Apache-2.0),
-generated at run time: no image files, nothing downloaded (``gendex_envs/assets/data/scenery/manifest.json`` records
+generated at run time: no image files, nothing downloaded (``gendex_envs/assets/data/scenery/catalog.json`` records
 the catalog and its licence).
 """
 
