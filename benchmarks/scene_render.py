@@ -12,7 +12,8 @@ observation of four cameras) and the ratio to the plain env. The issue's target:
 **Background difference.** For each style, ``--pairs`` pairs of seeds (0 and 1, 2 and 3, ...) with appearance
 randomization on and off: the mean absolute difference (0-255 levels) of each view over the pixels both seeds show
 scenery (the scenery's segmentation ids; robot and objects masked out). With ``--components``, the kitchen style
-again with only the camera jitter, only the lights, or only the textures left to vary. The test's threshold
+again without camera jitter, and with only the camera jitter, only the lights, or only the textures left to vary.
+The test's threshold
 (``tests/sim/test_scenes.py``) comes from these figures.
 
 ``--sheet PATH`` also writes the picture of ``docs/scenes.md``: each style at two seeds, left-overhead view.
@@ -51,7 +52,8 @@ FIXED = {"surface": {"materials": ["oak"]}, "floor": {"materials": ["tile_checke
          "background": {"images": ["kitchen_subway_white"]}}
 STEADY_LIGHT = {"ambient": [0.3, 0.3], "lights": [{"direction": [0.5, -1, -1]}, {"direction": [0, 0, -1]}]}
 STILL = {"position_m": 0.0, "rotation_deg": 0.0}
-COMPONENTS = {"camera jitter only": {"style": "kitchen", **FIXED, "lighting": STEADY_LIGHT},
+COMPONENTS = {"no camera jitter": {"style": "kitchen", "camera_jitter": STILL},  # the test's setting
+              "camera jitter only": {"style": "kitchen", **FIXED, "lighting": STEADY_LIGHT},
               "lights only": {"style": "kitchen", **FIXED, "camera_jitter": STILL},
               "textures only": {"style": "kitchen", "lighting": STEADY_LIGHT, "camera_jitter": STILL}}
 
