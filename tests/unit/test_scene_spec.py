@@ -2,6 +2,8 @@
 is a TaskSpecError naming the field and what is allowed."""
 
 import copy
+import re
+from pathlib import Path
 
 import pytest
 import yaml
@@ -126,3 +128,12 @@ def test_the_env_argument_takes_a_style_a_mapping_or_a_spec():
         parse_scene("garage")
     with pytest.raises(TaskSpecError, match=r"a scene is a style name, a mapping or a SceneSpec; got 3 \(int\)"):
         parse_scene(3)
+
+
+def test_the_docs_scene_example_is_valid():
+    doc = (Path(__file__).parents[2] / "docs" / "scenes.md").read_text()
+    block = re.search(r"```yaml\n(.*?)```", doc, re.S)
+    assert block is not None
+    resolved = resolve_scene(parse_scene(yaml.safe_load(block.group(1))["scene"], source="docs/scenes.md"))
+    assert resolved.style == "kitchen" and resolved.structures == ()
+    assert resolved.surface.materials == ("marble_white", "butcher_block")
