@@ -158,14 +158,15 @@ def _save_png(rgb, path: Path) -> Path:
     return path
 
 
-def _render_views(env_id: str, out: Path, seed: int, montage: bool = False) -> dict[str, Path]:
+def _render_views(env_id: str, out: Path, seed: int, montage: bool = False, scene: str | None = None
+                  ) -> dict[str, Path]:
     import gymnasium as gym
     import numpy as np
 
     from gendex_envs.registry import resolve_task
 
     env_id = resolve_task(env_id).env_id
-    env = gym.make(env_id, render_mode="rgb_array")
+    env = gym.make(env_id, render_mode="rgb_array", **({"scene": scene} if scene else {}))
     try:
         env.reset(seed=seed)
         views = env.unwrapped.render_views()
@@ -181,16 +182,26 @@ def _render_views(env_id: str, out: Path, seed: int, montage: bool = False) -> d
 
 
 @app.command()
+def scenes() -> None:
+    """List what a task's scene section can name: styles, surface materials, backgrounds, structures, paints."""
+    from gendex_envs.assets.scenery_catalog import guide
+
+    typer.echo(guide())
+
+
+@app.command()
 def render(task_id: str = typer.Argument(..., help="e.g. GenDex/PutAppleBowl-v0"),
            out: Path = typer.Option(Path("out/render"), "--out", help="Folder for the PNGs."),
-           seed: int = typer.Option(0, help="Reset seed (object randomization)."),
-           montage: bool = typer.Option(False, help="Also write the three views side by side.")) -> None:
+           seed: int = typer.Option(0, help="Reset seed (object placement; the scene's appearance draw)."),
+           montage: bool = typer.Option(False, help="Also write the three views side by side."),
+           scene: str = typer.Option("", "--scene", help="Show the task in this scene style (kitchen, lab, ...: "
+                                     "`gendex scenes`) instead of its own scene.")) -> None:
     """Render a task's three views (left-overhead, right-overhead, top-down) to PNG."""
     import gendex_envs  # noqa: F401
     from gendex_envs.errors import GenDexError
 
     try:
-        paths = _render_views(task_id, out, seed, montage)
+        paths = _render_views(task_id, out, seed, montage, scene or None)
     except GenDexError as exc:
         _die(exc)
     for name, path in paths.items():

@@ -38,6 +38,7 @@ from gendex_envs.conditions import (  # noqa: F401 - the spec's names for them
     condition_problems,
 )
 from gendex_envs.errors import StageError, TaskSpecError, suggest
+from gendex_envs.scene_spec import SceneSpec, scene_problems
 from gendex_envs.typed_yaml import (
     MAX_CONDITIONS,
     MAX_INPUT_BYTES,
@@ -47,6 +48,7 @@ from gendex_envs.typed_yaml import (
     MAX_STAGES,
     MAX_STEPS,
     MAX_STRING_CHARS,
+    bounded_field,
     build,
     join_path,
     load_yaml_bounded,
@@ -118,12 +120,6 @@ MAX_TABLE_M = 50.0
 """Bound (m) on the table's size and height; the committed tables are 1.6 m x 1.2 m, 0.76 m high."""
 
 
-def _bounded(limit: int, items: str, why: str, **kwargs: Any) -> Any:
-    """A dataclass field whose list or mapping may hold at most ``limit`` entries, checked (by
-    :func:`~gendex_envs.typed_yaml.build`) before any entry is built."""
-    return field(metadata={"max_items": limit, "items": items, "why": why}, **kwargs)
-
-
 @dataclass(frozen=True, kw_only=True)
 class TableSpec:
     """The table; its top is the world plane z = 0."""
@@ -176,7 +172,7 @@ class ObjectSpec:
     """Orientation quaternion (w, x, y, z); its norm must be within QUAT_NORM_TOL of 1 (not normalised)."""
     fixed: bool = False
     """True for objects that never move (e.g. a cabinet body)."""
-    joint_state: dict[str, float] = _bounded(MAX_JOINT_STATES, "joint states", "MAX_JOINT_STATES",
+    joint_state: dict[str, float] = bounded_field(MAX_JOINT_STATES, "joint states", "MAX_JOINT_STATES",
                                              default_factory=dict)
     """Initial joint positions by joint name, for articulated assets only."""
     randomize: RandomizeSpec = field(default_factory=RandomizeSpec)
@@ -222,7 +218,7 @@ class StageSpec:
     """Number of control steps of the stage, >= 1."""
     target: str | None = None
     """Optional name of the object the stage acts on."""
-    success: tuple[ConditionSpec, ...] | None = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS",
+    success: tuple[ConditionSpec, ...] | None = bounded_field(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS",
                                                          default=None)
     """When the stage has done its job (all must hold); None: when the task's success holds."""
 
@@ -233,7 +229,7 @@ class SequenceStepSpec:
 
     description: str
     """Non-empty natural-language description of the step ("the apple has been lifted")."""
-    conditions: tuple[ConditionSpec, ...] = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
+    conditions: tuple[ConditionSpec, ...] = bounded_field(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
     """At least one condition; the step is done once all hold (for ``hold_steps``) after the previous step was done."""
     hold_steps: int = 0
     """Number of consecutive steps the conditions must hold, >= 0."""
@@ -245,11 +241,11 @@ class SuccessSpec:
 
     description: str
     """Non-empty natural-language description of success."""
-    conditions: tuple[ConditionSpec, ...] = _bounded(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
+    conditions: tuple[ConditionSpec, ...] = bounded_field(MAX_CONDITIONS, "conditions", "MAX_CONDITIONS")
     """At least one condition; all must hold."""
     hold_steps: int = 0
     """Number of consecutive steps the conditions must hold, >= 0."""
-    sequence: tuple[SequenceStepSpec, ...] | None = _bounded(MAX_STAGES, "sequence steps", "MAX_STAGES",
+    sequence: tuple[SequenceStepSpec, ...] | None = bounded_field(MAX_STAGES, "sequence steps", "MAX_STAGES",
                                                              default=None)
     """Steps that must happen in this order before ``conditions`` count ("A, then B, then C": A and B here, C in
     ``conditions``); a step, once done, stays done. None: no order, only ``conditions``."""
@@ -267,17 +263,19 @@ class TaskSpec:
     """The table."""
     robot: RobotSpec = field(default_factory=RobotSpec)
     """The robot."""
-    objects: tuple[ObjectSpec, ...] = _bounded(MAX_OBJECTS, "objects",
+    objects: tuple[ObjectSpec, ...] = bounded_field(MAX_OBJECTS, "objects",
                                                "MAX_OBJECTS: SAPIEN crashes past its material limit")
     """Objects in the scene, at least one and at most MAX_OBJECTS; names unique."""
     goal: GoalSpec | None = None
     """Optional goal site."""
-    stages: tuple[StageSpec, ...] = _bounded(MAX_STAGES, "stages", "MAX_STAGES")
+    stages: tuple[StageSpec, ...] = bounded_field(MAX_STAGES, "stages", "MAX_STAGES")
     """Stages in execution order, at least one and at most MAX_STAGES."""
     success: SuccessSpec
     """Success criterion."""
     max_episode_steps: int = 200
     """Episode length limit in control steps, >= 1."""
+    scene: SceneSpec | None = None
+    """What the place looks like (:mod:`gendex_envs.scene_spec`); None: the plain table, floor and lights."""
 
     def object(self, name: str) -> ObjectSpec:
         """Return the object called ``name``; TaskSpecError (with suggestions) if there is none."""
@@ -415,6 +413,8 @@ def _semantic_problems(spec: TaskSpec, known_assets: Collection[str] | None) -> 
             p.append(f"{path} = {quote(value)} names a distractor (objects with distractor: true take part in no stage "
                      "or condition); name a task object or drop the distractor flag")
 
+    if spec.scene is not None:
+        p += scene_problems(spec.scene, "scene", tuple(names))
     need(len(spec.stages) >= 1, "stages", [], "at least one stage is required")
     stage_names: set[str] = set()
     for i, s in enumerate(spec.stages):

@@ -27,6 +27,9 @@ Members that reward code may use (all batched over ``num_envs``, tensors on ``en
 * ``env.task_spec`` — the loaded :class:`~gendex_envs.spec.TaskSpec` (``env.spec`` is Gymnasium's EnvSpec).
 * ``env.spec_success()`` [N] bool — the task's success conditions hold now (no ``hold_steps``, no ``fail``).
 * ``env.table_height`` (0.0: the table top is the plane z = 0).
+
+``env.appearance`` (not for reward code): what each env's episode looks like, drawn from a ``scene`` section
+(:mod:`gendex_envs.scene`); ``scene=`` overrides the task's scene, ``randomize_appearance=False`` keeps it nominal.
 """
 
 from __future__ import annotations
@@ -49,7 +52,7 @@ from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, 
 
 from gendex_envs import guard
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
-from gendex_envs.assets.catalog import DYNAMIC_FRICTION_RATIO, AssetRecord, get_asset, lowest_point_z
+from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
 from gendex_envs.detents import Detents
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
@@ -61,6 +64,7 @@ from gendex_envs.placement import Footprint, Item, place, starts_in
 from gendex_envs.reward_checks import RESERVED_OBS_KEYS, check_obs_extra, check_reward
 from gendex_envs.reward_module import RewardModule, load_reward_module
 from gendex_envs.reward_view import reward_info
+from gendex_envs.scene import Scenery, build_table_and_ground
 from gendex_envs.spec import StageSpec, TaskSpec, resolve_stage
 from gendex_envs.start_states import StartStates
 from gendex_envs.success import Judge, SuccessTracker, conditions_hold
@@ -114,6 +118,8 @@ class TaskEnv(BaseEnv):
         trust_remote_code: run the task's reward code without the runtime guard's audit hook even though its folder
             is not the repository's (:mod:`gendex_envs.guard`; like ``transformers``' flag of the same name). The
             restricted builtins and the read-only view apply either way.
+        scene: a scene style name or ``scene`` section (mapping) to use instead of the task's own; None: the task's.
+        randomize_appearance: draw each episode's look from its seed (default); False: the scene's nominal look.
     """
 
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
@@ -123,7 +129,7 @@ class TaskEnv(BaseEnv):
                  control_joint: str | None = None, stage: str | int | None = None,
                  start_states: StartStates | str | Path | None = None, view_resolution: int = 512,
                  sensor_resolution: int = 128, gym_api: bool | None = None, trust_remote_code: bool = False,
-                 **kwargs):
+                 scene=None, randomize_appearance: bool = True, **kwargs):
         if (task is None) == (task_spec is None):
             raise TaskSpecError("TaskEnv needs exactly one of task (a task version or its folder) or task_spec "
                                 "(a spec held in memory)")
@@ -132,6 +138,8 @@ class TaskEnv(BaseEnv):
                                          else TaskVersion.at(task))
         """The task version this env runs; None for an in-memory spec."""
         self.task_spec: TaskSpec = self.task.spec if self.task is not None else task_spec
+        self.scenery = Scenery.of_task(self.task_spec.scene, scene, randomize_appearance)
+        """The task's room, lights, structures and appearance draws (:mod:`gendex_envs.scene`); None: plain look."""
         if trust_remote_code and self.task is not None:
             guard.trust(self.task.root)
         self.stage_index: int | None = None
@@ -242,22 +250,7 @@ class TaskEnv(BaseEnv):
                                      build_separate=build_separate, control_joint=self.control_joint)
 
     def _load_scene(self, options: dict):
-        table = self.task_spec.table
-        sx, sy = table.size_m
-        b = self.scene.create_actor_builder()
-        top = sapien.Pose(p=[0.0, 0.0, -0.025])
-        mat = sapien.physx.PhysxMaterial(table.friction, DYNAMIC_FRICTION_RATIO * table.friction, 0.0)
-        b.add_box_collision(top, [sx / 2, sy / 2, 0.025], material=mat)
-        b.add_box_visual(top, [sx / 2, sy / 2, 0.025],
-                         material=sapien.render.RenderMaterial(base_color=[0.72, 0.62, 0.5, 1.0], roughness=0.8))
-        for lx in (-1, 1):  # legs: visual only, they never touch anything
-            for ly in (-1, 1):
-                leg = sapien.Pose(p=[lx * (sx / 2 - 0.05), ly * (sy / 2 - 0.05), -table.height_m / 2])
-                b.add_box_visual(leg, [0.03, 0.03, table.height_m / 2],
-                                 material=sapien.render.RenderMaterial(base_color=[0.35, 0.3, 0.25, 1.0]))
-        b.initial_pose = sapien.Pose()
-        self.table = b.build_static("table")
-        self.ground = self._build_ground(-table.height_m)
+        self.table, self.ground = build_table_and_ground(self.scene, self.task_spec.table, self.scenery is None)
 
         self.objects.clear()
         self.articulations.clear()
@@ -292,14 +285,18 @@ class TaskEnv(BaseEnv):
             gb.initial_pose = sapien.Pose(p=list(self.task_spec.goal.pos_m))
             self.goal_site = gb.build_kinematic("goal_site")
             self._hidden_objects.append(self.goal_site)
+        if self.scenery is not None:
+            self.scenery.build(self, self._layout)
 
-    def _build_ground(self, z: float) -> Actor:
-        b = self.scene.create_actor_builder()
-        b.add_plane_collision(sapien.Pose(p=[0, 0, z], q=[0.7071068, 0, -0.7071068, 0]))
-        b.add_box_visual(sapien.Pose(p=[0, 0, z - 0.005]), [4.0, 4.0, 0.005],
-                         material=sapien.render.RenderMaterial(base_color=[0.55, 0.57, 0.6, 1.0]))
-        b.initial_pose = sapien.Pose()
-        return b.build_static("ground")
+    def _load_lighting(self, options: dict):
+        if self.scenery is None:
+            return super()._load_lighting(options)
+        self.scenery.load_lighting(self)
+
+    @property
+    def appearance(self) -> list[dict]:
+        """[num_envs] what each env's current episode looks like (JSON-able; ``{}`` for a task without a scene)."""
+        return self.scenery.appearance(self.num_envs) if self.scenery else [{} for _ in range(self.num_envs)]
 
     def _spec_pose(self, obj) -> tuple[np.ndarray, np.ndarray]:
         """World position (origin z lifted so the lowest point sits ``pos_m[2]`` above the table) and quaternion."""
@@ -463,6 +460,8 @@ class TaskEnv(BaseEnv):
                 self._obj_reset_quat[name][env_idx] = entity.pose.q[env_idx]
             self.success_tracker.reset(env_idx)
             self.wipes.reset(env_idx)
+        if self.scenery is not None:
+            self.scenery.apply(self, env_idx, self._episode_seed)
 
     # ------------------------------------------------------------------ API for reward code
     def obj_pose(self, name: str) -> Pose:

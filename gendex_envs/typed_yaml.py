@@ -336,6 +336,12 @@ def spec_error(source: str, problems: list[str]) -> TaskSpecError:
                          + more)
 
 
+def bounded_field(limit: int, items: str, why: str, **kwargs: Any) -> Any:
+    """A dataclass field whose list or mapping may hold at most ``limit`` entries, checked (by :func:`build`) before
+    any entry is built; ``items`` names them and ``why`` names the bound in the error."""
+    return dataclasses.field(metadata={"max_items": limit, "items": items, "why": why}, **kwargs)
+
+
 def join_path(path: str, name: str) -> str:
     return f"{path}.{name}" if path else name
 

@@ -55,3 +55,21 @@ def test_blind_replay_benchmark_replays_a_recorded_success_open_loop(repo_root):
     m = re.search(r"PickUpBottle-v1: blind replay of seed (\d+)'s success \((\d+) actions\): (\d+)/1", out.stdout)
     assert m, out.stdout
     assert m.group(1) == "0" and int(m.group(2)) > 0 and m.group(3) == "1", out.stdout
+
+
+def test_scene_render_benchmark_times_both_looks_and_sees_appearance_only_when_drawn(repo_root):
+    """One round of the scene benchmark: both envs are timed, and over the scenery two seeds differ with
+    randomization on and not at all with it off."""
+    import argparse
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("scene_bench", repo_root / "benchmarks" / "scene_render.py")
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    args = argparse.Namespace(task="GenDex/PutAppleBowl-v1", styles=["kitchen"], repeats=1, frames=1, sensor_px=32,
+                              pairs=1, components=False, argv=[])
+    record = bench.run(args)
+    times = record["render_time"]["median"]["view_s"]
+    assert set(times) == {"none", "kitchen"} and all(t > 0 for t in times.values())
+    on, off = record["difference"]["kitchen/on"][0], record["difference"]["kitchen/off"][0]
+    assert all(v == 0.0 for v in off["mad"].values()) and all(v > 5.0 for v in on["mad"].values()), record
