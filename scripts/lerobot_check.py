@@ -1,6 +1,8 @@
 """Run INSIDE the lerobot side venv (scripts/lerobot_venv.sh), not the project's: load GenDex datasets with lerobot's
-own LeRobotDataset, decode a frame of each video feature, and ask lerobot's ACT config whether it accepts the
-dataset's features. Prints one JSON object per dataset; exits 0 unless a dataset fails to load.
+own LeRobotDataset, decode a frame of each video feature, ask lerobot's ACT config whether it accepts the
+dataset's features, and normalise a frame's state and action as pi0.5 does (lerobot's NormalizerProcessorStep in
+QUANTILES mode, from the dataset's stats: it needs q01 and q99). Prints one JSON object per dataset; exits 0 unless a
+dataset fails to load.
 
     .venv-lerobot/bin/python scripts/lerobot_check.py DATASET_ROOT [DATASET_ROOT ...]
 """
@@ -34,7 +36,31 @@ def check(root: str) -> dict:
         out["act"] = "accepted"
     except ValueError as exc:
         out["act"] = f"refused: {exc}"
+    out["pi05_norm"] = _pi05_normalisation(ds, features, item)
     return out
+
+
+def _pi05_normalisation(ds, features, item) -> str:
+    """What pi0.5's normalisation (state and action by quantiles, images as they are) says to the dataset's stats:
+    ``accepted (...)`` with the range of the normalised values, or ``refused: <lerobot's error>``."""
+    import torch
+    from lerobot.configs.types import FeatureType, NormalizationMode
+    from lerobot.processor.converters import create_transition
+    from lerobot.processor.core import TransitionKey
+    from lerobot.processor.normalize_processor import NormalizerProcessorStep
+
+    norm_map = {FeatureType.STATE: NormalizationMode.QUANTILES, FeatureType.ACTION: NormalizationMode.QUANTILES,
+                FeatureType.VISUAL: NormalizationMode.IDENTITY, FeatureType.ENV: NormalizationMode.QUANTILES}
+    step = NormalizerProcessorStep.from_lerobot_dataset(ds, features, norm_map)
+    obs = {k: item[k][None] for k, f in features.items() if f.type is FeatureType.STATE or f.type is FeatureType.ENV}
+    try:
+        out = step(create_transition(observation=obs, action=item["action"][None]))
+    except ValueError as exc:
+        return f"refused: {exc}"
+    values = torch.cat([v.flatten() for v in [*out[TransitionKey.OBSERVATION].values(), out[TransitionKey.ACTION]]])
+    if not bool(torch.isfinite(values).all()):
+        return "refused: non-finite normalised values"
+    return f"accepted (normalised values in [{float(values.min()):.2f}, {float(values.max()):.2f}])"
 
 
 def main() -> int:

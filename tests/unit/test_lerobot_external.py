@@ -36,12 +36,12 @@ def _episode(seed: int, t: int = 6) -> Episode:
                    images={"left_overhead": frames})
 
 
-def _write(root: Path, world: bool, video: bool) -> Path:
+def _write(root: Path, world: bool, video: bool, conventions: int = 1) -> Path:
     with LeRobotV3Writer(root, fps=20, robot_type="ur10e_shadowhand", state_names=[f"q{i}" for i in range(6)],
                          action_names=["a0", "a1", "a2"],
                          environment_state_names=list(_episode(0).environment_state_names) if world else None,
                          cameras={"left_overhead": (32, 32)} if video else None,
-                         video_codec="libsvtav1" if video else None) as w:
+                         video_codec="libsvtav1" if video else None, conventions=conventions) as w:
         for seed in range(2):
             w.add_episode(_episode(seed))
     return root
@@ -52,7 +52,7 @@ def test_lerobot_loads_every_kind_of_gendex_dataset_and_act_accepts_world_or_vid
     python = subprocess.run(["bash", str(ROOT / "scripts" / "lerobot_venv.sh")], capture_output=True, text=True,
                             check=True).stdout.strip().splitlines()[-1]
     roots = [_write(tmp_path / "state", False, False), _write(tmp_path / "world", True, False),
-             _write(tmp_path / "video", True, True)]
+             _write(tmp_path / "video", True, True), _write(tmp_path / "quantiles", True, True, conventions=2)]
     run = subprocess.run([python, str(ROOT / "scripts" / "lerobot_check.py"), *map(str, roots)], capture_output=True,
                          text=True, timeout=600)
     reports = {Path(r["root"]).name: r for r in map(json.loads, run.stdout.splitlines())}
@@ -63,3 +63,7 @@ def test_lerobot_loads_every_kind_of_gendex_dataset_and_act_accepts_world_or_vid
     assert reports["state"]["act"].startswith("refused") and "environment state" in reports["state"]["act"]
     assert reports["world"]["act"] == "accepted" and reports["video"]["act"] == "accepted"
     assert reports["video"]["decoded"] == {"observation.images.left_overhead": [3, 32, 32]}
+    # pi0.5 normalises state and action by the 1st and 99th percentiles: conventions 2's stats have them, 1's do not
+    assert reports["quantiles"]["pi05_norm"].startswith("accepted"), reports["quantiles"]
+    assert reports["video"]["pi05_norm"].startswith("refused") and "q01" in reports["video"]["pi05_norm"]
+    assert reports["quantiles"]["frames"] == 12 and reports["quantiles"]["act"] == "accepted"
