@@ -84,3 +84,17 @@ def test_beyond_the_reach_or_beside_the_table_a_structure_may_stand(specs):
         report, found = _room(specs["PutAppleBowl"], scene)
         assert found == [], [v.message for v in found]
         assert report.measurements["structure_room"]["thing"]["in_arm_room_m"] == 0.0
+
+
+def test_the_simulator_check_does_not_build_a_scene_whose_structures_leave_no_room(specs, monkeypatch):
+    """The env refuses a structure on an object's start region: the simulator check reports the static findings and
+    builds nothing."""
+    import generator.critic.physical_sim as sim
+
+    def no_env(*args, **kwargs):
+        raise AssertionError("the scene was built")
+
+    monkeypatch.setattr(sim, "_sim_checks", no_env)
+    report = sim.check_scene(_with(specs["PutAppleBowl"], _one("shelf", pos_m=[0.1, 0.0, 0.0])))
+    assert report.mode == "sim" and not report.ok
+    assert {v.other for v in report.by_check("structure_room")} == {"structure:thing", "apple", "bowl"}
