@@ -35,6 +35,7 @@ from gendex_envs.assets.structures import PAINTS, ROLE_COLORS, STRUCTURES, Struc
 from gendex_envs.assets.surface_textures import MATERIALS, PERIOD_M, material_image, mean_color
 from gendex_envs.errors import TaskSpecError
 from gendex_envs.placement import Item
+from gendex_envs.scene_geometry import ROBOT_BASE_HALF_M, STRUCTURE_GAP_M, structure_pose
 from gendex_envs.scene_spec import ResolvedScene, SceneSpec, StructureSpec, parse_scene, resolve_scene
 
 log = logging.getLogger(__name__)
@@ -47,10 +48,6 @@ ROOM_MIN_M = (-2.0, 2.0, 1.6)
 """Least room: walls at x = -2 and +2 m and y = +-1.6 m (the side views, at y = +-1 m, look at the far walls)."""
 ROOM_MARGIN_M = 1.0
 """Least distance from the table's edges to the walls; structures push walls further out when they need room."""
-STRUCTURE_GAP_M = 0.02
-"""Least gap between a structure and an object's start region or the robot's base."""
-ROBOT_BASE_HALF_M = 0.15
-"""Half side of the square around the arm's base no structure may enter."""
 
 
 def build_table_and_ground(scene, table, visual: bool = True) -> tuple[Actor, Actor]:
@@ -112,16 +109,10 @@ class PlacedStructure:
 
 
 def place_structures(structures: tuple[StructureSpec, ...], table) -> list[PlacedStructure]:
-    """Each structure's world pose: its anchor on the table, its offset, its base on the table top or the floor."""
-    sx, sy = table.size_m
-    anchors = {"table": (0.0, 0.0), "far_edge": (sx / 2, 0.0), "left_edge": (0.0, sy / 2), "right_edge": (0.0, -sy / 2)}
-    placed = []
-    for i, s in enumerate(structures):
-        ax, ay = anchors[s.anchor]
-        z = s.pos_m[2] - (table.height_m if s.on_floor else 0.0)
-        placed.append(PlacedStructure(i, s, STRUCTURES[s.kind], _yaw_pose((ax + s.pos_m[0], ay + s.pos_m[1], z),
-                                                                          s.yaw_deg)))
-    return placed
+    """Each structure's world pose: its anchor on the table, its offset, its base on the table top or the floor
+    (:func:`~gendex_envs.scene_geometry.structure_pose`, which the planner and the critic use too)."""
+    return [PlacedStructure(i, s, STRUCTURES[s.kind], _yaw_pose(structure_pose(s, table)[:3, 3], s.yaw_deg))
+            for i, s in enumerate(structures)]
 
 
 def _quad(center, u, v, repeat: tuple[float, float], material) -> sapien.render.RenderShapeTriangleMesh:

@@ -5,21 +5,30 @@ it gets a model that costs one forward-kinematics pass: every UR10e capsule of :
 forearm housing) is covered by spheres; a configuration is free when every sphere stays ``margin_m`` above the table
 top and outside every obstacle box. Fingers and palm are left out on purpose: they are meant to touch things.
 
+Two kinds of obstacle box: the movable ones a primitive sets for each motion (:meth:`ArmCollisionModel.set_obstacles`:
+the objects, an articulated object's links) and the *static* ones that stand for the whole episode
+(:meth:`ArmCollisionModel.set_static`: a scene's fixed structures, :func:`structure_obstacles`), which every check
+includes whatever a primitive sets.
+
 A held object is attached (:meth:`ArmCollisionModel.attach`) as spheres fixed in the palm frame, so a carry is
 planned with the object moving with the hand: it must clear the table, the other objects and the container's rim.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
 from gendex.solve.ik import ArmIK
 from gendex_envs.agents.robot_model import UR10E_LINKS
+from gendex_envs.scene_geometry import StructureBox
 
 HOUSING_RADIUS_M = 0.055
 """Radius of the sphere chain covering the Shadow forearm housing (link ``forearm`` to link ``wrist``)."""
+STRUCTURE_MARGIN_M = 0.01
+"""How much a fixed structure's boxes are inflated as obstacles (as the objects' boxes are)."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +68,9 @@ class ArmCollisionModel:
         self.table_z = table_z
         self.margin_m = margin_m
         self.boxes: list[Box] = []
+        """Obstacles of the current motion (:meth:`set_obstacles`)."""
+        self.static: list[Box] = []
+        """Obstacles of the whole episode (:meth:`set_static`: fixed structures), checked along with :attr:`boxes`."""
         t = np.linspace(0.0, 1.0, per_capsule)[:, None]
         self._spheres: list[tuple[str, np.ndarray, np.ndarray]] = []  # (link, local centres [k, 3], radii [k])
         for link in UR10E_LINKS[1:]:  # the shoulder never moves relative to the table
@@ -90,7 +102,12 @@ class ArmCollisionModel:
         return self._attached is not None
 
     def set_obstacles(self, boxes: list[Box]) -> None:
+        """The obstacles of the motions from now on, besides the static ones (which this leaves in place)."""
         self.boxes = list(boxes)
+
+    def set_static(self, boxes: list[Box]) -> None:
+        """Obstacles that stand for the whole episode (a scene's structures); every check includes them."""
+        self.static = list(boxes)
 
     def sphere_centres(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """World sphere centres [S, 3] and radii [S] at joint vector ``q``."""
@@ -114,10 +131,11 @@ class ArmCollisionModel:
         return np.concatenate(centres), np.concatenate(radii)
 
     def clearance(self, q: np.ndarray) -> float:
-        """Smallest distance (m) between a sphere and the table top or a box, minus the margin; >= 0 means free."""
+        """Smallest distance (m) between a sphere and the table top or a box (of the motion's or the static ones),
+        minus the margin; >= 0 means free."""
         c, r = self.sphere_centres(q)
         d = float(np.min(c[:, 2] - r - self.table_z))
-        for box in self.boxes:
+        for box in (*self.boxes, *self.static):
             gap = np.maximum(np.maximum(box.lo - c, c - box.hi), 0.0)
             d = min(d, float(np.min(np.linalg.norm(gap, axis=1) - r)))
         return d - self.margin_m
@@ -142,3 +160,13 @@ def box_spheres(lo: np.ndarray, hi: np.ndarray, shrink_m: float = 0.01, cell_m: 
     xs, ys = (lo[k] + shrink_m + cell[k] * (np.arange(n[k]) + 0.5) for k in range(2))
     pts = np.stack(np.meshgrid(xs, ys, z, indexing="ij"), axis=-1).reshape(-1, 3)
     return pts, np.full(len(pts), float(np.linalg.norm(cell) / 2))
+
+
+def structure_obstacles(boxes: Iterable[StructureBox], margin_m: float = STRUCTURE_MARGIN_M) -> list[Box]:
+    """Obstacle boxes of a scene's fixed structures (:func:`gendex_envs.scene_geometry.structure_boxes`), inflated
+    by ``margin_m``; a structure turned off the world's axes is covered by pieces (:func:`rotated_box_cover`)."""
+    out = []
+    for b in boxes:
+        half = np.asarray(b.size_m, dtype=float) / 2
+        out += rotated_box_cover(-half, half, b.pose, margin_m, name=f"structure:{b.structure}")
+    return out

@@ -2,9 +2,10 @@
 
 :class:`ArmHandMotion` is what every primitive is built from (the stage executor's and the articulated ones):
 planned arm motions (OMPL through :class:`~gendex.solve.planner.ArmPlanner`, collision-checked against the scene's
-objects), straight palm translations (IK per step), hand ramps with *guarded* closing (each step a finger target
-stays within :data:`~gendex.solve.grasp.GUARD_RAD` of the measured angle, so fingers stop on contact), and the
-objects' measured geometry. Each yielded action is the full ``pd_joint_pos`` / ``both`` action (every free joint).
+objects and, for a task with a ``scene``, its fixed structures: :func:`scene_obstacles`), straight palm
+translations (IK per step), hand ramps with *guarded* closing (each step a finger target stays within
+:data:`~gendex.solve.grasp.GUARD_RAD` of the measured angle, so fingers stop on contact), and the objects' measured
+geometry. Each yielded action is the full ``pd_joint_pos`` / ``both`` action (every free joint).
 
 **The episode's budget.** A motion knows the step at which the episode's time limit ends it (:meth:`set_budget`)
 and how many steps the stages after the current one are expected to need (:attr:`ArmHandMotion.reserve`). A
@@ -21,11 +22,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 import sapien
 
-from gendex.solve.collision import ArmCollisionModel, Box
+from gendex.solve.collision import ArmCollisionModel, Box, structure_obstacles
 from gendex.solve.grasp import GUARD_RAD
 from gendex.solve.ik import ArmIK
 from gendex.solve.planner import ArmPlanner, PlanningError
 from gendex_envs.errors import ExecutionError
+from gendex_envs.scene_geometry import structure_boxes
 
 if TYPE_CHECKING:  # pragma: no cover
     from gendex_envs.task_env import TaskEnv
@@ -45,6 +47,7 @@ class ArmHandMotion:
         self.env = env
         self.ik = ArmIK(env.agent)
         self.collision = ArmCollisionModel(self.ik)
+        self.collision.set_static(scene_obstacles(env))  # a scene's fixed structures, for every motion
         self.planner = ArmPlanner(self.collision, max_step_rad=max_arm_step_rad)
         self.max_arm_step_rad = max_arm_step_rad
         """Largest arm-joint change per control step of a planned motion (a uniform scale keeps a path on course)."""
@@ -298,6 +301,15 @@ class ArmHandMotion:
     def avoid_objects(self, exclude: tuple[str, ...] = ()) -> None:
         """Make every object but ``exclude`` an obstacle of planned motions (boxes inflated 1 cm)."""
         self.collision.set_obstacles(self.object_boxes(exclude))
+
+
+def scene_obstacles(env) -> list[Box]:
+    """The env's fixed structures (its scene's, or the ``scene=`` it was made with) as static planner obstacles;
+    none for an env without a scene."""
+    scenery = getattr(env, "scenery", None)
+    if scenery is None:
+        return []
+    return structure_obstacles(structure_boxes(scenery.scene.structures, env.task_spec.table))
 
 
 def resample(path: np.ndarray, pace: float) -> np.ndarray:

@@ -17,6 +17,7 @@ validators as a model's:
     a naive layout sampler: objects at random spots of the table top in front of the robot, scale 1, and in
     :data:`DISTRACTOR_P` of the scenes with movable objects one object of clutter (``distractor: true``). It checks
     nothing on purpose — choosing the best of several candidates and the critic's refinement are what make scenes sound.
+    Each is set in a place: a scene style taken in turn by task index (:mod:`generator.backends.offline_style`).
 ``plan``
     one stage per proposal step, with its skill (reach / carry -> motion planning; finger and contact work -> RL);
     the plan step adds the standard success conditions of each RL stage's skill.
@@ -615,7 +616,7 @@ class OfflineBackend:
     # ------------------------------------------------------------------ scene
     def _scene(self, request: ModelRequest, ctx: dict) -> str:
         rng = self._rng(request, ctx.get("index", 0), ctx["candidate_index"], ctx.get("attempt", 0))
-        return scene_spec(ctx["proposal"], {a["id"]: a for a in ctx["assets"]}, rng)
+        return scene_spec(ctx["proposal"], {a["id"]: a for a in ctx["assets"]}, rng, (self.seed, ctx.get("index", 0)))
 
     # ------------------------------------------------------------------ plan
     _PLAN = {"reach": ("motion_planning", "arm", 60), "carry": ("motion_planning", "arm", 60),

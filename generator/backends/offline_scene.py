@@ -1,7 +1,8 @@
 """The offline author's scene sampler: objects at random spots of the table top in front of the robot, scale 1,
 articulated objects at the layouts the solver was measured on (:data:`~generator.backends.layouts.ARTICULATED_LAYOUTS`),
 and in :data:`DISTRACTOR_P` of the scenes with movable objects one object of clutter. It checks nothing on purpose:
-choosing the best of several candidates and the critic's refinement make scenes sound."""
+choosing the best of several candidates and the critic's refinement make scenes sound. Each scene names the place
+it happens in (``scene: {style: ...}``, :mod:`generator.backends.offline_style`)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import yaml
 
 from generator.backends import placed as placed_tasks
 from generator.backends.layouts import ARTICULATED_LAYOUTS, LAYOUT_JITTER_M
+from generator.backends.offline_style import style_for
 from generator.backends.roles import (
     DRAWER_OUT_M,
     _acts,
@@ -126,8 +128,10 @@ def _spots(place: dict, inside: dict[str, str], chest: dict | None, rng: np.rand
     return placed_tasks.placed_layout(place, held, rng)
 
 
-def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator) -> str:
-    """A scene answer (a fenced YAML spec) for ``proposal``, drawn with ``rng``."""
+def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator, style_key: tuple[int, int] = (0, 0)
+               ) -> str:
+    """A scene answer (a fenced YAML spec) for ``proposal``, drawn with ``rng``, in the style of task ``style_key``
+    = (author seed, task index) (:func:`~generator.backends.offline_style.style_for`; it draws nothing from ``rng``)."""
     objects = []
     acts = _acts(proposal)
     goal = None
@@ -244,6 +248,7 @@ def scene_spec(proposal: dict, assets: dict[str, dict], rng: np.random.Generator
             "stages": stages, "success": {"description": proposal["success_text"], "conditions": conds},
             # room for a re-planned approach, a regrasp or a slow door: twice the stages' horizons
             "max_episode_steps": max(250, 2 * sum(st["horizon"] for st in stages))}
+    spec["scene"] = {"style": style_for(spec, *style_key)}
     return _fence("yaml", yaml.safe_dump(spec, sort_keys=False, default_flow_style=None, width=110))
 
 def _pour_layout(poured: dict[str, str], assets: dict[str, dict], rng: np.random.Generator) -> dict[str, list]:

@@ -99,6 +99,14 @@ def front_zone(local_lo, local_hi, rotation: np.ndarray, origin, jitter_xy: Iter
     return np.stack([world.min(axis=0) - j, world.max(axis=0) + j])
 
 
+def min_width_xy(points: np.ndarray) -> float:
+    """Smallest width of the points' horizontal projection over all directions (2 degree steps)."""
+    angles = np.radians(np.arange(0.0, 180.0, 2.0))
+    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    proj = np.asarray(points)[:, :2] @ dirs.T
+    return float((proj.max(axis=0) - proj.min(axis=0)).min())
+
+
 def _apart(lo_a, hi_a, lo_b, hi_b) -> bool:
     return bool(np.any(np.asarray(hi_a) <= np.asarray(lo_b)) or np.any(np.asarray(hi_b) <= np.asarray(lo_a)))
 

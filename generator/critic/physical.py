@@ -3,7 +3,7 @@
 Two entry points:
 
 * :func:`check_scene_static` needs no simulator (milliseconds): reach, off_table, in_front, scale, joint_state,
-  unsupported and penetration estimated from bounding boxes.
+  unsupported, the skills' and the structures' checks, and penetration estimated from bounding boxes.
 * :func:`~generator.critic.physical_sim.check_scene` (:mod:`generator.critic.physical_sim`) builds the scene in
   SAPIEN and replaces the bounding-box penetration estimate with PhysX's own contacts, then lets the scene settle
   and measures what fell or still moves.
@@ -73,6 +73,9 @@ How each check is measured (the thresholds are the module constants below):
     What a skill needs of the scene: :mod:`generator.critic.skill_checks` (an object to hand over starts clear of
     its hand-over zone, a peg of its holder, a sponge of its spill). No check measures the pieces laid in a vessel to
     pour (:mod:`gendex_envs.pouring`): they move with it.
+``structure_room`` (static)
+    A scene's fixed structures leave the arm room: none near the robot base, in the arm's room over the table or on
+    an object's start region (:mod:`generator.critic.room`). No directive moves a structure.
 """
 
 from __future__ import annotations
@@ -93,13 +96,14 @@ from gendex_envs.placement import in_drawer
 from gendex_envs.pouring import spec_fills
 from gendex_envs.spec import SCALE_RANGE, ObjectSpec, TaskSpec
 from generator.critic.directives import Directive
-from generator.critic.layout import Room, choose_move, front_zone
+from generator.critic.layout import Room, choose_move, front_zone, min_width_xy
+from generator.critic.room import structure_room
 from generator.critic.skill_checks import skill_checks
 
 log = logging.getLogger(__name__)
 
 CheckId = Literal["penetration", "floating", "unsupported", "out_of_reach", "off_table", "in_front", "scale",
-                  "joint_state", "handover", "insert", "wipe", "hang", "pour", "flip"]
+                  "joint_state", "handover", "insert", "wipe", "hang", "pour", "flip", "structure_room"]
 CHECKS: tuple[str, ...] = get_args(CheckId)
 
 # ----------------------------------------------------------------------------------------------- thresholds
@@ -293,14 +297,6 @@ def _place(obj: ObjectSpec) -> Placed:
     lo, hi, origin = _frame(obj)
     local = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     return Placed(obj, get_asset(obj.asset), local @ _rotation(obj.quat_wxyz).T + origin)
-
-
-def _min_width_xy(points: np.ndarray) -> float:
-    """Smallest width of the points' horizontal projection over all directions (2 degree steps)."""
-    angles = np.radians(np.arange(0.0, 180.0, 2.0))
-    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=1)
-    proj = points[:, :2] @ dirs.T
-    return float((proj.max(axis=0) - proj.min(axis=0)).min())
 
 
 def _footprint_inside(inner_lo, inner_hi, outer_lo, outer_hi) -> bool:
@@ -526,7 +522,7 @@ def _scale_checks(spec: TaskSpec, placed: dict[str, Placed], meas: dict, violati
     rlo, rhi = REALISTIC_SCALE_RANGE
     for name, p in placed.items():
         o, rec = p.spec, p.record
-        width = _min_width_xy(p.corners)
+        width = min_width_xy(p.corners)
         size = max(rec.size_m) * o.scale
         grasped = _grasped(spec, name) and "graspable" in rec.tags and not rec.articulated
         meas[name] = {"scale": o.scale, "min_width_m": rounded(width), "max_extent_m": rounded(size),
@@ -613,6 +609,7 @@ def static_findings(spec: TaskSpec, overlap: bool) -> tuple[list[Violation], dic
     _scale_checks(spec, placed, meas["scale"], violations)
     _joint_checks(spec, placed, meas["joint_state"], violations)
     skill_checks(spec, placed, meas, violations)  # what skills need (generator.critic.skill_checks)
+    structure_room(spec, placed, meas["structure_room"], violations)  # room for the arm (generator.critic.room)
     return violations, meas, placed, unsupported
 
 

@@ -6,8 +6,9 @@ the spec says otherwise; both keyframes share the same arm pose), replaces the b
 settle and measures what fell or still moves (the ``penetration`` and ``floating`` checks described in
 :mod:`generator.critic.physical`). The robot at rest is also measured against every randomized object at the
 extremes of its randomization (:func:`_draw_checks`, in the same env), where a draw can turn a peg or a door into
-the hand. About 0.3 s per scene once SAPIEN is loaded, the extremes 0.08 s of it (the first env of a process costs
-~3 s of imports).
+the hand. A scene whose fixed structures leave no room (the ``structure_room`` check) is not built: the env may
+refuse it, and it must change first. About 0.3 s per scene once SAPIEN is loaded, the extremes 0.08 s of it (the
+first env of a process costs ~3 s of imports).
 """
 
 from __future__ import annotations
@@ -228,7 +229,10 @@ def check_scene(spec: TaskSpec, *, seed: int = 0, settle_steps: int = SETTLE_STE
     t0 = time.perf_counter()
     violations, meas, placed, unsupported_fix = static_findings(spec, overlap=False)
     off = {v.object for v in violations if v.check == "off_table"}
-    violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
+    if any(v.check == "structure_room" for v in violations):  # the scene must change first (the env may refuse it)
+        log.info("physical check of %s: a scene structure leaves no room; not built in the simulator", spec.name)
+    else:
+        violations += _sim_checks(spec, seed, settle_steps, placed, unsupported_fix, off, meas)
     report = PhysicalReport(spec.name, "sim", ordered(violations), meas, time.perf_counter() - t0)
     log.info("physical check of %s: %d violations in %.2f s", spec.name, len(report.violations), report.seconds)
     return report

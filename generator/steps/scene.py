@@ -306,6 +306,13 @@ def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:
     return float(len(report.errors)), tuple(f"{v.check}: {v.message}" for v in report.errors)
 
 
+def scene_styles() -> str:
+    """The scene styles a scene answer may name (``plain``, the look of a task without a scene, left out)."""
+    from gendex_envs.scene_styles import DEFAULT_STYLE, STYLES
+
+    return ", ".join(name for name in STYLES if name != DEFAULT_STYLE)
+
+
 def write_scene(backend: Backend, proposal: Proposal, *, index: int = 0, n_candidates: int = N_CANDIDATES,
                 max_attempts: int = 2) -> tuple[TaskSpec, list[SceneCandidate]]:
     """Ask for ``n_candidates`` scene files and keep the best; returns it and every candidate's record."""
@@ -322,7 +329,7 @@ def write_scene(backend: Backend, proposal: Proposal, *, index: int = 0, n_candi
             answer = ask(backend, "scene", context=context, feedback=feedback, proposal_json=proposal_json,
                          reference_yaml=reference, asset_guidance=guidance(), table_size_m=list(TableSpec().size_m),
                          robot_base_m=list(RobotSpec().base_pos_m), reach_m=REACH_MAX_M, scale_range=list(SCALE_RANGE),
-                         candidate_index=k + 1, hand_span_m=HAND_SPAN_M)
+                         candidate_index=k + 1, hand_span_m=HAND_SPAN_M, scene_styles=scene_styles())
             try:
                 spec = adjust_sizes(parse_scene(answer, proposal), proposal)
             except SceneError as exc:

@@ -140,3 +140,21 @@ def test_a_structure_over_an_objects_start_region_is_refused():
     with pytest.raises(TaskSpecError, match=r"scene.structures\[0\] \(cutting_station 'board'\) .* overlaps object "
                                             r"'apple''s start region"):
         _push_apple({"structures": [{"name": "board", "kind": "cutting_station", "pos_m": [0.3, 0.12, 0.0]}]})
+
+
+def test_the_planner_of_an_env_with_a_scene_avoids_its_structures():
+    """ArmHandMotion of a kitchen env carries the kitchen's structures as static obstacles (the plain env none), and
+    the robot at rest is clear of them."""
+    from gendex.solve.motion import ArmHandMotion
+    from gendex_envs.scene_styles import STYLES
+
+    for scene, names in (("kitchen", {s.name for s in STYLES["kitchen"].structures}), (None, set())):
+        env = gym.make(TASK, control_mode="pd_joint_pos", control_joint="both", obs_mode="state",
+                       render_backend="none", scene=scene)
+        try:
+            env.reset(seed=0)
+            motion = ArmHandMotion(env.unwrapped)
+            assert {b.name.removeprefix("structure:") for b in motion.collision.static} == names
+            assert motion.collision.is_free(motion.qpos())
+        finally:
+            env.close()

@@ -100,3 +100,21 @@ def test_the_guided_prompt_describes_a_group_of_objects():
     flat = " ".join(text.split())
     assert all(f"chose {a}" in text for a in drawn) and "'all the fruit' is read as" in text
     assert "use exactly the objects the reading drew" in flat and "no other object of that kind" in flat
+
+
+def test_the_scene_prompt_offers_every_scene_style_and_its_reference_names_one():
+    """A Claude scene answer may name a style (`scene: {style: ...}`): the prompt lists every style but plain, and the
+    reference file it copies has a scene section that parses."""
+    import yaml
+
+    from gendex_envs.scene_styles import DEFAULT_STYLE, STYLES
+    from gendex_envs.spec import parse_task_spec
+    from generator.steps.scene import scene_styles
+
+    text = render("scene", proposal_json="{}", reference_yaml="-", asset_guidance="-", table_size_m=[1.6, 1.2],
+                  robot_base_m=[-0.8, 0, 0], reach_m=1.25, scale_range=[0.3, 2.0], candidate_index=1,
+                  hand_span_m=0.12, scene_styles=scene_styles())
+    assert "`scene: {style: ...}`" in text
+    assert all(name in text for name in STYLES if name != DEFAULT_STYLE) and DEFAULT_STYLE not in scene_styles()
+    spec = parse_task_spec(yaml.safe_load((PROMPTS_DIR / "reference_spec.yaml").read_text()))
+    assert spec.scene is not None and spec.scene.style in STYLES
