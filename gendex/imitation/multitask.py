@@ -118,6 +118,27 @@ def load_tasks(datasets: Sequence[Path | str], demos: int | None = None) -> list
     return out
 
 
+def embed_tasks(embed: Embed, tasks: Sequence[TaskData]) -> np.ndarray:
+    """[T, E] the embeddings of the tasks' instructions; ValueError unless one finite row per task."""
+    emb = np.asarray(embed([t.instruction for t in tasks]), np.float32)
+    if emb.ndim != 2 or len(emb) != len(tasks) or not np.isfinite(emb).all():
+        raise ValueError(f"embed gave an array of shape {emb.shape}; one finite row per instruction is needed")
+    return emb
+
+
+def instruction_embedding(policy, env) -> np.ndarray:
+    """The embedding a multi-task ``policy`` acts on in ``env``: its learned row for the env's instruction, or
+    ``policy.embed``'s for one it did not learn (:class:`PolicyTaskError` without an encoder)."""
+    text = env.unwrapped.task_spec.instruction
+    if text in policy.instructions:
+        return policy.instructions[text]
+    if policy.embed is None:
+        raise PolicyTaskError(f"multi-task policy {policy.path} did not learn {text!r} and has no embed function "
+                              f"for a new instruction; it learned {len(policy.instructions)} instructions")
+    log.info("multi-task policy %s: %r is not an instruction it learned; acting on its embedding", policy.path, text)
+    return np.asarray(policy.embed([text]), np.float32)[0]
+
+
 def _inputs(state: np.ndarray, world: np.ndarray, step: np.ndarray, emb: np.ndarray, world_dim: int) -> np.ndarray:
     """[N, S + world_dim + 1 + E]: state, the environment state zero-padded to ``world_dim``, step / 200, and the
     instruction's embedding (one row, repeated)."""
@@ -136,9 +157,7 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     """Train one policy on every dataset (the first ``demos`` episodes of each); writes ``<out>/bc.pt`` and
     ``<out>/bc.json`` (with the loss every 1 000 steps: the learning curve) and returns the checkpoint's path."""
     tasks = load_tasks(datasets, demos)
-    emb = np.asarray(embed([t.instruction for t in tasks]), np.float32)
-    if emb.ndim != 2 or len(emb) != len(tasks) or not np.isfinite(emb).all():
-        raise ValueError(f"embed gave an array of shape {emb.shape}; one finite row per instruction is needed")
+    emb = embed_tasks(embed, tasks)
     world_dim = max(t.frames.environment_state.shape[1] for t in tasks)
     xs, ys = [], []
     for t, e in zip(tasks, emb, strict=True):
@@ -244,16 +263,8 @@ class MultiTaskPolicy(BCPolicy):
 
     def bind(self, env) -> None:
         """Take the instruction of ``env``'s task and its embedding; keep the action bounds."""
+        self.emb = instruction_embedding(self, env)
         text = env.unwrapped.task_spec.instruction
-        if text in self.instructions:
-            self.emb = self.instructions[text]
-        elif self.embed is not None:
-            self.emb = np.asarray(self.embed([text]), np.float32)[0]
-            log.info("multi-task policy %s: %r is not an instruction it learned; acting on its embedding",
-                     self.path, text)
-        else:
-            raise PolicyTaskError(f"multi-task policy {self.path} did not learn {text!r} and has no embed function "
-                                  f"for a new instruction; it learned {len(self.instructions)} instructions")
         if len(self.emb) != len(next(iter(self.instructions.values()))):
             raise PolicyTaskError(f"the embedding of {text!r} has {len(self.emb)} values, not the checkpoint's")
         self.low, self.high = env.action_space.low, env.action_space.high
@@ -271,4 +282,5 @@ def is_multitask(path: Path | str) -> bool:
     return load_checkpoint(path).get("kind") == KIND
 
 
-__all__ = ["KIND", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "is_multitask", "load_tasks", "train"]
+__all__ = ["KIND", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks", "instruction_embedding",
+           "is_multitask", "load_tasks", "train"]

@@ -29,7 +29,7 @@ from torch import nn
 from gendex.imitation import bc
 from gendex.imitation.bc import _bad, _chunk_targets, _mlp
 from gendex.imitation.frames import DatasetReadError, load_images
-from gendex.imitation.multitask import Embed, PolicyTaskError, load_tasks
+from gendex.imitation.multitask import Embed, PolicyTaskError, embed_tasks, instruction_embedding, load_tasks
 from gendex_envs.observation import IMAGES, STATE
 
 log = logging.getLogger(__name__)
@@ -104,9 +104,7 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     """Train one pixel policy on every dataset (each with ``config.camera``'s video); writes ``<out>/bc.pt`` and
     ``<out>/bc.json`` (the loss every 1 000 steps) and returns the checkpoint's path."""
     tasks = load_tasks(datasets, demos)
-    emb = np.asarray(embed([t.instruction for t in tasks]), np.float32)
-    if emb.ndim != 2 or len(emb) != len(tasks) or not np.isfinite(emb).all():
-        raise ValueError(f"embed gave an array of shape {emb.shape}; one finite row per instruction is needed")
+    emb = embed_tasks(embed, tasks)
     images, lows, ys = [], [], []
     for path, t, e in zip(datasets, tasks, emb, strict=True):
         img = load_images(path, config.camera, demos, config.image_size)
@@ -214,13 +212,7 @@ class PixelPolicy(bc.BCPolicy):
         return {"obs_mode": "rgb", "sensor_resolution": self.size}
 
     def bind(self, env) -> None:
-        text = env.unwrapped.task_spec.instruction
-        if text in self.instructions:
-            self.emb = self.instructions[text]
-        elif self.embed is not None:
-            self.emb = np.asarray(self.embed([text]), np.float32)[0]
-        else:
-            raise PolicyTaskError(f"pixel policy {self.path} did not learn {text!r} and has no embed function")
+        self.emb = instruction_embedding(self, env)
         self.low, self.high = env.action_space.low, env.action_space.high
 
     @torch.no_grad()
