@@ -112,6 +112,24 @@ def _mlp(n_in: int, n_out: int, hidden: int, layers: int) -> nn.Sequential:
     return nn.Sequential(*mods, nn.Linear(hidden, n_out))
 
 
+def build_network(make: Callable[[], nn.Module], weights: dict[str, torch.Tensor], path: Path | str) -> nn.Module:
+    """The network ``make()`` builds, with a checkpoint's ``weights`` loaded strictly. Its shape is laid out on the
+    meta device first (no memory) and compared with the weights' names and shapes: a checkpoint's config sizes the
+    network, and a small hostile file whose config asks for 16 layers of 8192 units would otherwise have the loader
+    allocate gigabytes before the weights are found not to fit. :class:`PolicyError` naming the first mismatch."""
+    with torch.device("meta"):
+        layout = {k: tuple(v.shape) for k, v in make().state_dict().items()}
+    given = {k: tuple(v.shape) for k, v in weights.items()}
+    if layout != given:
+        wrong = sorted(set(layout) ^ set(given)) or [k for k in layout if layout[k] != given[k]]
+        k = wrong[0]
+        raise _bad(path, f"its weights do not fit the network its config describes: {k} is "
+                         f"{given.get(k, 'missing')} in the file, {layout.get(k, 'not a parameter')} by the config")
+    model = make()
+    model.load_state_dict(weights, strict=True)
+    return model.eval()
+
+
 def _inputs(state: np.ndarray, world: np.ndarray, step: np.ndarray) -> np.ndarray:
     return np.concatenate([state, world, (step / STEP_SCALE)[:, None]], axis=1).astype(np.float32)
 
@@ -339,12 +357,8 @@ class BCPolicy:
         cfg = self.ckpt["config"]
         self.chunk, self.decay = cfg["chunk"], cfg["ensemble_decay"]
         n_in, n_out = len(self.ckpt["x_mean"]), len(self.ckpt["a_mean"]) * self.chunk
-        self.model = _mlp(n_in, n_out, cfg["hidden"], cfg["layers"])
-        try:
-            self.model.load_state_dict(self.ckpt["model"], strict=True)
-        except RuntimeError as exc:
-            raise _bad(self.path, f"its weights do not fit the MLP its config describes ({exc})") from None
-        self.model.eval()
+        self.model = build_network(lambda: _mlp(n_in, n_out, cfg["hidden"], cfg["layers"]), self.ckpt["model"],
+                                   self.path)
         self.x = Normalizer(self.ckpt["x_mean"], self.ckpt["x_std"])
         self.a = Normalizer(self.ckpt["a_mean"], self.ckpt["a_std"])
 

@@ -39,6 +39,7 @@ from gendex.imitation.bc import (
     _chunk_targets,
     _dataset_meta,
     _mlp,
+    build_network,
     load_checkpoint,
     save_checkpoint,
 )
@@ -245,12 +246,8 @@ class MultiTaskPolicy(BCPolicy):
         self.ckpt = ckpt
         cfg = ckpt["config"]
         self.chunk, self.decay = cfg["chunk"], cfg["ensemble_decay"]
-        self.model = _mlp(len(ckpt["x_mean"]), len(ckpt["a_mean"]) * self.chunk, cfg["hidden"], cfg["layers"])
-        try:
-            self.model.load_state_dict(ckpt["model"], strict=True)
-        except RuntimeError as exc:
-            raise _bad(self.path, f"its weights do not fit the MLP its config describes ({exc})") from None
-        self.model.eval()
+        n_in, n_out = len(ckpt["x_mean"]), len(ckpt["a_mean"]) * self.chunk
+        self.model = build_network(lambda: _mlp(n_in, n_out, cfg["hidden"], cfg["layers"]), ckpt["model"], self.path)
         self.x = Normalizer(ckpt["x_mean"], ckpt["x_std"])
         self.a = Normalizer(ckpt["a_mean"], ckpt["a_std"])
         want = len(ckpt["x_mean"]) - len(ckpt["names"][STATE]) - world_dim - 1

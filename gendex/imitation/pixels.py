@@ -196,13 +196,9 @@ class PixelPolicy(bc.BCPolicy):
         self.ckpt, self.chunk, self.decay = ckpt, cfg["chunk"], cfg["ensemble_decay"]
         self.instructions = dict(zip(tasks.values(), emb.numpy().astype(np.float32), strict=True))
         self.camera, self.size = cfg["camera"], size
-        self.model = PixelNet(len(ckpt["x_mean"]), len(ckpt["a_mean"]) * self.chunk, size, channels, cfg["embed"],
-                              cfg["hidden"], cfg["layers"])
-        try:
-            self.model.load_state_dict(ckpt["model"], strict=True)
-        except RuntimeError as exc:
-            raise _bad(self.path, f"its weights do not fit the network its config describes ({exc})") from None
-        self.model.eval()
+        n_low, n_out = len(ckpt["x_mean"]), len(ckpt["a_mean"]) * self.chunk
+        self.model = bc.build_network(lambda: PixelNet(n_low, n_out, size, channels, cfg["embed"], cfg["hidden"],
+                                                       cfg["layers"]), ckpt["model"], self.path)
         self.x = bc.Normalizer(ckpt["x_mean"], ckpt["x_std"])
         self.a = bc.Normalizer(ckpt["a_mean"], ckpt["a_std"])
 

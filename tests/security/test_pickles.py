@@ -306,3 +306,37 @@ def test_a_bc_checkpoint_cannot_choose_gym_make_arguments_beyond_what_a_dataset_
     torch.save(dict(ckpt, env_kwargs={"control_mode": "pd_joint_pos", key: value}), path)
     with pytest.raises(PolicyError, match=f"env_kwargs {key}="):
         BCPolicy(path)
+
+
+_PEAK_SCRIPT = """
+import resource, sys
+from gendex.imitation.bc import BCPolicy
+from gendex_envs.errors import PolicyError
+try:
+    BCPolicy(sys.argv[1])
+    print("loaded")
+except PolicyError as exc:
+    print("refused:", exc)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+"""
+
+
+def test_a_small_checkpoint_whose_config_asks_for_a_huge_network_is_refused_before_it_is_built(tmp_path):
+    """Its config sizes the network the loader builds before loading the weights: 16 layers of 8192 units (4.3 GB of
+    float32) within the config's bounds, with the toy's few hundred weights. The shape is compared on the meta device
+    first, so the loader refuses it naming the first mismatch, and its process never holds the network."""
+    import subprocess
+    import sys
+
+    path = _toy_checkpoint(tmp_path / "bc.pt")
+    ckpt = torch.load(path, weights_only=True)
+    torch.save(dict(ckpt, config=dict(ckpt["config"], hidden=8192)), path)
+    with pytest.raises(PolicyError, match=r"0.weight is \(8, 5\) in the file, \(8192, 5\) by the config"):
+        BCPolicy(path)
+    torch.save(dict(ckpt, config=dict(ckpt["config"], hidden=8192, layers=16)), path)
+    assert path.stat().st_size < 100_000
+    out = subprocess.run([sys.executable, "-c", _PEAK_SCRIPT, str(path)], capture_output=True, text=True,
+                         timeout=300, check=True).stdout.split("\n")
+    assert out[0].startswith("refused:") and "do not fit the network its config describes" in out[0], out
+    assert "10.bias is missing in the file, (8192,) by the config" in out[0], out  # 16 layers asked, 2 given
+    assert int(out[1]) < 2048, f"the refused load peaked at {out[1]} MiB"  # the network alone would be 4 300
