@@ -33,6 +33,7 @@ from generator.errors import RetriesExhaustedError, SceneError
 from generator.groups import covered, group_kinds
 from generator.prompts import PROMPTS_DIR
 from generator.records import Proposal, SceneCandidate
+from generator.steps.approach import worked_by_hand
 from generator.steps.common import ask, parse_yaml_block
 
 log = logging.getLogger(__name__)
@@ -296,7 +297,7 @@ def parse_scene(text: str, proposal: Proposal) -> TaskSpec:
             except TaskSpecError as exc:
                 raise SceneError(str(exc)) from None
     settled = hand_over_settles(hold_joint_at(let_go(out_of_drawer(hold_lifted(spec)))))
-    return poured_stands_up(hung_lets_go(inserted_upright(twist_holds_cap(settled))))
+    return worked_by_hand(poured_stands_up(hung_lets_go(inserted_upright(twist_holds_cap(settled)))))
 
 
 def score_scene(spec: TaskSpec) -> tuple[float, tuple[str, ...]]:
