@@ -168,3 +168,19 @@ def test_the_committed_board_is_valid_current_and_written_into_the_docs():
             for task, t in e.per_task.items():
                 assert t["seeds"] == list(range(suite.seed, suite.seed + t["episodes"])), (e.file, task)
     assert (REPO_ROOT / "docs" / "leaderboard.md").read_text() == markdown(LEADERBOARD_DIR)
+
+
+@pytest.mark.parametrize("name", ["gendex-ref-v2", "gendex-skills-v2", "gendex-lib-v2"])
+def test_holding_still_and_random_actions_solve_no_task_of_a_v2_suite_past_5_percent(name):
+    """The v2 suites are calibrated: their filed hold and random results cover every task with the suite's 50
+    episodes, and solve none in more than 5 % of them at any step (``successes_once``, stricter than the metric)."""
+    suite = load_suite(name)
+    entries = {e.policy: e for e in load_entries(name)}
+    for policy in ("hold", "random"):
+        info = entries[policy].eval_info
+        assert info["layout"] == "lerobot-0.4" and info["suite"]["complete"], (name, policy)
+        rows = {row["task_id"]: row["metrics"] for row in info["per_task"]}
+        assert sorted(rows) == sorted(suite.tasks), (name, policy)
+        for task, metrics in rows.items():
+            assert len(metrics["successes_once"]) == suite.episodes == 50, (name, policy, task)
+            assert sum(metrics["successes_once"]) <= 0.05 * 50, (name, policy, task, sum(metrics["successes_once"]))
