@@ -57,6 +57,9 @@ class Episode:
     """Keyword arguments of the reset that started the episode (``{"seed": seed}`` at least)."""
     info: dict = field(default_factory=dict)
     """Anything else worth keeping (solver name, env steps used, ...), JSON-able."""
+    appearance: dict = field(default_factory=dict)
+    """What the episode looked like (``env.unwrapped.appearance``: the surface, floor, background, lights, camera
+    jitter and structure paints its seed drew from the task's ``scene``), JSON-able; empty for a task without one."""
 
     def __post_init__(self):
         t = len(self.action)

@@ -6,7 +6,8 @@ Layout (as lerobot's ``LeRobotDataset`` reads it)::
     meta/stats.json                              per feature min/max/mean/std/count (images: per channel, [3,1,1]);
                                                  with ``conventions=2`` also the quantiles q01/q10/q50/q90/q99
     meta/tasks.parquet                           task_index column; the task string is the pandas index
-    meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``)
+    meta/episodes/chunk-000/file-000.parquet     one row per episode (+ per-episode ``stats/<feature>/<stat>``, and
+                                                 ``appearance`` for a task with a scene)
     data/chunk-CCC/file-FFF.parquet              one row per action (frame); images as struct<bytes PNG, path>
     videos/<key>/chunk-CCC/file-FFF.mp4          with ``video_codec``: a camera's frames instead, episode after
                                                  episode (frame k of an episode at from_timestamp + k / fps), located
@@ -93,6 +94,9 @@ log = logging.getLogger(__name__)
 
 CODEBASE_VERSION = "v3.0"
 EPISODES_PATH = "meta/episodes/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+APPEARANCE = "appearance"
+"""Column of the episodes parquet with what each episode looked like (``Episode.appearance`` as JSON); present only
+in a dataset of a task with a ``scene`` section."""
 INFO_PATH, STATS_PATH, TASKS_PATH = ("meta/info.json", "meta/stats.json", "meta/tasks.parquet")
 PENDING_DIR = "meta/.pending"  # the journal: episodes added since the last close
 DEFAULT_VIDEO_FILE_SIZE_IN_MB = 500
@@ -312,7 +316,8 @@ class LeRobotV3Writer:
             for d in meta["stats"].values():
                 self._check_stat_names(set(d), f"its journal entry {entries[e].name}")
             stats = {k: {s: np.asarray(v) for s, v in d.items()} for k, d in meta["stats"].items()}
-            self._append(table.replace_schema_metadata(None), meta["instruction"], stats, self._segments(e))
+            self._append(table.replace_schema_metadata(None), meta["instruction"], stats, self._segments(e),
+                         meta.get("appearance"))
             replayed += 1
         if replayed:
             log.warning("%s: a writer was killed before closing; %d journaled episodes appended again", self.root,
@@ -399,6 +404,8 @@ class LeRobotV3Writer:
             for key, path in segments.items():
                 encode(videos[key], path, self.fps, self.video_codec)
             meta = {"instruction": ep.instruction, "stats": _jsonable(ep_stats)}
+            if ep.appearance:
+                meta["appearance"] = ep.appearance
             entry = table.replace_schema_metadata({"gendex": json.dumps(meta)})
             sink = pa.BufferOutputStream()
             with pa.ipc.new_file(sink, entry.schema) as ipc:
@@ -408,13 +415,15 @@ class LeRobotV3Writer:
             for path in segments.values():
                 path.unlink(missing_ok=True)
             raise
-        self._append(table, ep.instruction, ep_stats, segments)
+        self._append(table, ep.instruction, ep_stats, segments, ep.appearance)
         log.debug("%s: wrote episode %d (%d frames) to data chunk %d file %d", self.root, e, t, self._data.chunk,
                   self._data.file)
         return e
 
-    def _append(self, table: pa.Table, instruction: str, ep_stats: dict, segments: dict[str, Path]) -> None:
-        """Add a journaled episode to the open data and video files (new ones when a size limit would be passed)."""
+    def _append(self, table: pa.Table, instruction: str, ep_stats: dict, segments: dict[str, Path],
+                appearance: dict | None = None) -> None:
+        """Add a journaled episode to the open data and video files (new ones when a size limit would be passed);
+        its episodes row keeps the episode's ``appearance`` (JSON) when it has one."""
         e, t, start, r = len(self._rows), table.num_rows, self._n_frames, self.root
         try:
             data = self._data
@@ -445,6 +454,8 @@ class LeRobotV3Writer:
             self._abandon()
             log.error("%s: appending episode %d was interrupted; it is journaled: open a new writer to go on", r, e)
             raise
+        if appearance:
+            row[APPEARANCE] = json.dumps(appearance, sort_keys=True)
         row.update({f"stats/{k}/{s}": (np.asarray(v).astype(np.int64) if s == "count" else np.asarray(v)).tolist()
                     for k, d in ep_stats.items() for s, v in d.items()})
         self._rows.append(row)
@@ -480,6 +491,8 @@ class LeRobotV3Writer:
                      *(v.finish() for v in self._videos.values())]
             self._data, self._videos, self._finished = None, {}, []
             rows, tasks, stats = self._rows, self._tasks, self._stats
+            if any(APPEARANCE in row for row in rows):  # one column for all rows: parquet takes the first's keys
+                rows = [row if APPEARANCE in row else {**row, APPEARANCE: "{}"} for row in rows]
             info = self._info(len(rows), self._n_frames, tasks)
             _commit(r, [*((f, None) for f in files),
                         (r / TASKS_PATH, lambda p: pq.write_table(_tasks_table(tasks), p)),

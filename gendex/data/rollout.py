@@ -194,6 +194,8 @@ class EpisodeRecorder:
         self._states, self._env_states = [robot_state(self.env)], [flat_env_state(self.env)]
         self._world = [environment_state(self.env)]
         self._actions, self._rewards, self._success, self._fail = [], [], [], []
+        drawn = getattr(self._u, "appearance", None)
+        self._appearance = dict(drawn[0]) if drawn else {}
 
     def as_action(self, action) -> np.ndarray:
         """``action`` as what is stepped and recorded: float32 ``[A]``."""
@@ -233,7 +235,7 @@ class EpisodeRecorder:
             fail=np.asarray(self._fail, dtype=bool), env_states=np.stack(self._env_states),
             environment_state=np.stack(self._world),
             environment_state_names=tuple(observation.environment_state_names(self.env)),
-            reset_kwargs={"seed": self.seed}, info=dict(info or {}))
+            reset_kwargs={"seed": self.seed}, info=dict(info or {}), appearance=self._appearance)
 
 
 def record_rollout(env: gym.Env, seed: int, actions: np.ndarray | Sequence, *, info: dict | None = None) -> Episode:

@@ -158,3 +158,52 @@ def test_the_planner_of_an_env_with_a_scene_avoids_its_structures():
             assert motion.collision.is_free(motion.qpos())
         finally:
             env.close()
+
+
+def test_a_dataset_records_what_each_episode_looked_like_and_a_plain_one_records_nothing(tmp_path):
+    """The episodes parquet of a scene task's dataset holds each episode's drawn appearance (the env's, as JSON), also
+    for episodes a killed writer journaled and a new writer appended again; a dataset of a task without a scene has
+    no such column (its files are what they were before scenes)."""
+    import json
+
+    import pyarrow.parquet as pq
+
+    from gendex.data.lerobot_v3 import APPEARANCE, LeRobotV3Writer
+    from gendex.data.rollout import record_rollout
+
+    def episodes(scene, seeds):
+        env = gym.make(TASK, control_mode="pd_joint_delta_pos", **({"scene": scene} if scene else {}))
+        try:
+            out = []
+            for seed in seeds:
+                ep = record_rollout(env, seed, np.zeros((2, env.action_space.shape[0]), np.float32))
+                out.append((ep, env.unwrapped.appearance[0]))
+            return out
+        finally:
+            env.close()
+
+    def writer(root, ep):
+        return LeRobotV3Writer(root, fps=ep.fps, robot_type="ur10e_shadowhand",
+                               state_names=[f"s{i}" for i in range(ep.state.shape[1])],
+                               action_names=[f"a{i}" for i in range(ep.action.shape[1])])
+
+    kitchen = episodes("kitchen", (4, 5))
+    assert kitchen[0][1] and kitchen[0][1] != kitchen[1][1]  # drawn, and per seed
+    root = tmp_path / "kitchen"
+    with writer(root, kitchen[0][0]) as w:
+        w.add_episode(kitchen[0][0])
+    w = writer(root, kitchen[0][0])
+    for ep, _ in kitchen[1:]:
+        w.add_episode(ep)
+    w._abandon()  # killed before closing: the second episode only journaled
+    with writer(root, kitchen[0][0]):
+        pass  # appends the journaled episodes again and publishes them
+    rows = pq.read_table(next((root / "meta" / "episodes").rglob("*.parquet"))).to_pylist()
+    assert [json.loads(r[APPEARANCE]) for r in rows] == [a for _, a in kitchen]
+
+    (plain, drawn), = episodes(None, (4,))
+    assert drawn == {} and plain.appearance == {}
+    with writer(tmp_path / "plain", plain) as w:
+        w.add_episode(plain)
+    columns = pq.read_table(next((tmp_path / "plain" / "meta" / "episodes").rglob("*.parquet"))).column_names
+    assert APPEARANCE not in columns
