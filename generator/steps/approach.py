@@ -23,6 +23,7 @@ import logging
 
 import yaml
 
+from gendex_envs.errors import TaskSpecError
 from gendex_envs.spec import ConditionSpec, SequenceStepSpec, TaskSpec, dump_task_spec, load_task_spec
 from gendex_envs.success import SET_DOWN_CONDITIONS
 from gendex_envs.task_version import TaskLayout, TaskVersion, publish_derived
@@ -86,7 +87,7 @@ def first_steps(spec: TaskSpec) -> tuple[SequenceStepSpec, ...]:
 
 
 def step_phrase(step: SequenceStepSpec) -> str:
-    """A first step in a few words ("the fingers at the cabinet's handle for 5 steps")."""
+    """A first step in a few words ("the fingers at the cabinet's handle for 8 steps")."""
     c = step.conditions[0]
     what = (f"the fingers at the {c.object.replace('_', ' ')}'s handle" if c.type == "fingertips_near"
             else f"the palm at the {c.object.replace('_', ' ')}'s handle" if c.type == "hand_at"
@@ -121,7 +122,7 @@ def replace_success(text: str, spec: TaskSpec) -> str:
     return text[:start] + dumped + text[end:].lstrip("\n")
 
 
-class NothingToHarden(ValueError):
+class NothingToHarden(TaskSpecError):
     """The task's success already asks for the hand's work (or has nothing a flailing arm could reach)."""
 
 
