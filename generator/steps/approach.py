@@ -147,10 +147,9 @@ def publish_worked_by_hand(source: TaskVersion) -> TaskVersion:
         out.spec.write_text("".join(lines[:head]) + note + replace_success("".join(lines[head:]), harder))
         if load_task_spec(out.spec) != harder:
             raise NothingToHarden(f"{source.env_id}: the rewritten spec does not read back as written")
-        solvability = out.root / "solvability.json"
-        if solvability.exists():
-            solvability.unlink()
-        return {"changed": ["task.yaml: success.sequence " + "; ".join(s.description for s in harder.success.sequence)],
+        out.record("solvability").unlink(missing_ok=True)
+        steps = "; ".join(s.description for s in harder.success.sequence)
+        return {"changed": [f"{out.spec.name}: success.sequence {steps}"],
                 "reason": "Random joint targets reached the task's end state without the hand's work (the first v2 "
                           "suite calibration); success now first needs the fingers at the handle, or the object held."}
 
