@@ -90,7 +90,6 @@ def step_phrase(step: SequenceStepSpec) -> str:
     """A first step in a few words ("the fingers at the cabinet's handle for 8 steps")."""
     c = step.conditions[0]
     what = (f"the fingers at the {c.object.replace('_', ' ')}'s handle" if c.type == "fingertips_near"
-            else f"the palm at the {c.object.replace('_', ' ')}'s handle" if c.type == "hand_at"
             else f"the {c.object.replace('_', ' ')} held")
     return f"{what} for {step.hold_steps} steps"
 
