@@ -72,8 +72,8 @@ def problems() -> list[str]:
     capability = torch.backends.cpu.get_cpu_capability()
     if capability != "DEFAULT":
         found.append(f"torch runs its {capability} kernels (ATEN_CPU_CAPABILITY was read before it was set)")
-    features = _numpy_cpu_features()
-    on = [f for f in _NUMPY_DISPATCH.split() if features.get(f)]
+    features, compiled = _numpy_cpu_features()
+    on = [f for f in _NUMPY_DISPATCH.split() if features.get(f) and f in compiled]
     if on:
         found.append(f"numpy dispatches to {', '.join(on)} (numpy was imported before NPY_DISABLE_CPU_FEATURES)")
     for pool in threadpool_info():
@@ -82,17 +82,24 @@ def problems() -> list[str]:
     return found
 
 
-def _numpy_cpu_features() -> dict[str, bool]:
-    """numpy's table of the instruction sets it dispatches to (no public name for it: numpy 1 and 2 keep it in
-    their private core module, as ``numpy.show_runtime`` reads it)."""
+def _numpy_cpu_features() -> tuple[dict[str, bool], frozenset[str]]:
+    """numpy's table of the instruction sets it may use (the CPU's, less those disabled), and the sets this numpy
+    build has dispatched kernels for (no public name for either: numpy 1 and 2 keep them in their private core
+    module, as ``numpy.show_runtime`` reads them).
+
+    A set the CPU has but the build has no kernels for (numpy 1.26 on a Sapphire Rapids: ``AVX512_SPR``) stays on
+    in the first table, since ``NPY_DISABLE_CPU_FEATURES`` ignores names the build does not dispatch to; numpy
+    never runs code for it, so it is no problem."""
     import importlib
 
     for name in ("numpy._core._multiarray_umath", "numpy.core._multiarray_umath"):
         try:
-            return dict(importlib.import_module(name).__cpu_features__)
+            module = importlib.import_module(name)
+            features = dict(module.__cpu_features__)
         except (ImportError, AttributeError):
             continue
-    return {}
+        return features, frozenset(getattr(module, "__cpu_dispatch__", features))
+    return {}, frozenset()
 
 
 def check() -> None:

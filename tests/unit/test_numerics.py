@@ -53,3 +53,13 @@ def test_the_pinned_numerics_are_refused_off_x86(monkeypatch):
     monkeypatch.setattr(numerics.platform, "machine", lambda: "aarch64")
     with pytest.raises(numerics.NumericsError, match="aarch64 .*allowed: x86_64"):
         numerics.pinned_backend(None)
+
+
+def test_an_instruction_set_numpy_has_no_kernels_for_is_no_problem(monkeypatch):
+    """numpy 1.26 on a Sapphire Rapids reports AVX512_SPR as on even under NPY_DISABLE_CPU_FEATURES (it ignores a
+    name it does not dispatch to); only the sets it has kernels for count."""
+    compiled = frozenset(numerics._NUMPY_DISPATCH.split()) - {"AVX512_SPR"}
+    monkeypatch.setattr(numerics, "_numpy_cpu_features", lambda: ({"SSE3": True, "AVX512_SPR": True}, compiled))
+    assert not any("numpy dispatches" in p for p in numerics.problems())
+    monkeypatch.setattr(numerics, "_numpy_cpu_features", lambda: ({"AVX2": True, "AVX512_SPR": True}, compiled))
+    assert any("numpy dispatches to AVX2 (" in p for p in numerics.problems())
