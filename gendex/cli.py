@@ -24,6 +24,7 @@ from gendex.cli_common import refuse_request as _refuse
 from gendex.cli_dataset import dataset_app
 from gendex.cli_eval import eval_command, leaderboard_app
 from gendex.cli_list import list_command
+from gendex.cli_restyle import restyle_command
 from gendex.cli_store import store_app
 from gendex.cli_trust import trust_command
 from gendex_envs.registry import REFERENCE_TASKS
@@ -36,6 +37,7 @@ app.command("eval")(eval_command)
 app.command("list")(list_command)
 app.add_typer(leaderboard_app, name="leaderboard")
 app.command("trust")(trust_command)
+app.command("restyle")(restyle_command)
 app.command("check")(check_command)
 app.add_typer(store_app, name="store")
 log = logging.getLogger("gendex")
