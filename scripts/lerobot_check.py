@@ -37,22 +37,24 @@ def check(root: str) -> dict:
     except ValueError as exc:
         out["act"] = f"refused: {exc}"
     out["pi05_norm"] = _pi05_normalisation(ds, features, item)
+    out["quantiles_flat_across_episodes"] = _flat_quantiles(ds)
     return out
 
 
 def _pi05_normalisation(ds, features, item) -> str:
-    """What pi0.5's normalisation (state and action by quantiles, images as they are) says to the dataset's stats:
-    ``accepted (...)`` with the range of the normalised values, or ``refused: <lerobot's error>``."""
+    """What pi0.5's normalisation says to the dataset's stats: its own mapping (``PI05Config.normalization_mapping``:
+    state and action by quantiles, images as they are, the environment state not at all, since pi0.5 does not read
+    it): ``accepted (...)`` with the range of the normalised values, or ``refused: <lerobot's error>``."""
     import torch
-    from lerobot.configs.types import FeatureType, NormalizationMode
+    from lerobot.configs.types import FeatureType
+    from lerobot.policies.pi05.configuration_pi05 import PI05Config
     from lerobot.processor.converters import create_transition
     from lerobot.processor.core import TransitionKey
     from lerobot.processor.normalize_processor import NormalizerProcessorStep
 
-    norm_map = {FeatureType.STATE: NormalizationMode.QUANTILES, FeatureType.ACTION: NormalizationMode.QUANTILES,
-                FeatureType.VISUAL: NormalizationMode.IDENTITY, FeatureType.ENV: NormalizationMode.QUANTILES}
+    norm_map = {FeatureType[k]: v for k, v in PI05Config().normalization_mapping.items()}
     step = NormalizerProcessorStep.from_lerobot_dataset(ds, features, norm_map)
-    obs = {k: item[k][None] for k, f in features.items() if f.type is FeatureType.STATE or f.type is FeatureType.ENV}
+    obs = {k: item[k][None] for k, f in features.items() if f.type is FeatureType.STATE}
     try:
         out = step(create_transition(observation=obs, action=item["action"][None]))
     except ValueError as exc:
@@ -61,6 +63,24 @@ def _pi05_normalisation(ds, features, item) -> str:
     if not bool(torch.isfinite(values).all()):
         return "refused: non-finite normalised values"
     return f"accepted (normalised values in [{float(values.min()):.2f}, {float(values.max()):.2f}])"
+
+
+def _flat_quantiles(ds) -> dict[str, int]:
+    """Per feature, the dimensions whose q01..q99 span under a thousandth of their min..max: a value constant
+    within each episode (an articulated object's pose) that varies between episodes.
+    lerobot 0.4 aggregates quantiles as the
+    count-weighted mean of the episodes' (``aggregate_feature_stats``), so these collapse; normalise them by
+    mean/std, not by quantiles."""
+    import numpy as np
+
+    out = {}
+    for key, s in ds.meta.stats.items():
+        if "q01" in s and "q99" in s:
+            span = np.asarray(s["max"], np.float64) - np.asarray(s["min"], np.float64)
+            flat = (np.asarray(s["q99"], np.float64) - np.asarray(s["q01"], np.float64) < 1e-3 * span) & (span > 0)
+            if flat.any():
+                out[key] = int(flat.sum())
+    return out
 
 
 def main() -> int:
