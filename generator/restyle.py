@@ -48,27 +48,32 @@ class Restyle:
         return self.source.env_id
 
 
-def newest_without_scene(versions: Iterable[TaskVersion]) -> list[TaskVersion]:
-    """The newest version of each task, for the tasks whose newest version has no ``scene`` section, by name."""
+def _newest(versions: Iterable[TaskVersion]) -> list[TaskVersion]:
+    """The newest version of each task, by name."""
     newest: dict[str, TaskVersion] = {}
     for v in versions:
         if v.name not in newest or v.version > newest[v.name].version:
             newest[v.name] = v
-    return [v for _, v in sorted(newest.items()) if v.spec.scene is None]
+    return [v for _, v in sorted(newest.items())]
+
+
+def newest_without_scene(versions: Iterable[TaskVersion]) -> list[TaskVersion]:
+    """The newest version of each task, for the tasks whose newest version has no ``scene`` section, by name."""
+    return [v for v in _newest(versions) if v.spec.scene is None]
 
 
 def plan_restyle(versions: Mapping[str, TaskVersion] | Iterable[TaskVersion], seed: int = RESTYLE_SEED,
                  names: Iterable[str] | None = None) -> list[Restyle]:
-    """The style each task without a scene gets (module docstring); ``names`` keeps only those tasks (the rotation
-    is still dealt over the whole library, so a task's style does not depend on which others are asked for)."""
+    """The style each task without a scene gets (module docstring); ``names`` keeps only those tasks. The rotation
+    is dealt over every task of the library, those with a scene included, so a task's style depends neither on
+    which others are asked for nor on which were restyled before it."""
     from generator.backends.offline_style import style_for
 
     items = versions.values() if isinstance(versions, Mapping) else versions
-    todo = newest_without_scene(items)
     wanted = None if names is None else set(names)
     plan = []
-    for index, source in enumerate(todo):
-        if wanted is not None and source.name not in wanted:
+    for index, source in enumerate(_newest(items)):
+        if (wanted is not None and source.name not in wanted) or source.spec.scene is not None:
             continue
         raw = yaml.safe_load(source.files.spec.read_text())
         plan.append(Restyle(source, style_for(raw, seed, index)))

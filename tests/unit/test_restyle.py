@@ -69,3 +69,7 @@ def test_the_plan_deals_the_rotation_over_the_newest_versions_without_a_scene(tm
                                                      if p.source.name in ("PutAppleBowl", "StackBlocks")]
     published = publish_restyled(some[0].source, some[0].style)
     assert published.name not in {v.name for v in newest_without_scene([*versions.values(), published])}
+    # the others keep their styles once one task has its scene (the rotation counts every task)
+    after = plan_restyle({**versions, published.env_id: published})
+    assert [(p.env_id, p.style) for p in after] == [(p.env_id, p.style) for p in plan
+                                                      if p.source.name != published.name]
