@@ -46,7 +46,7 @@ import sapien
 import torch
 from mani_skill.envs.sapien_env import BaseEnv
 from mani_skill.sensors.camera import CameraConfig
-from mani_skill.utils import common, sapien_utils
+from mani_skill.utils import common
 from mani_skill.utils.structs import Actor, Articulation, Link, Pose
 from mani_skill.utils.structs.types import DefaultMaterialsConfig, SceneConfig, SimConfig
 
@@ -54,6 +54,7 @@ from gendex_envs import guard
 from gendex_envs.agents.ur10e_shadow import CONTROL_JOINT_GROUPS, KEYFRAME_QPOS_BY_NAME, UR10eShadowHand
 from gendex_envs.assets.catalog import AssetRecord, get_asset, lowest_point_z
 from gendex_envs.assets.manifest import JointEntry
+from gendex_envs.cameras import VIEW_CAMERAS, check_sensors, human_camera_configs, sensor_configs
 from gendex_envs.detents import Detents
 from gendex_envs.errors import ControlModeError, RenderModeError, StageError, TaskSpecError, suggest
 from gendex_envs.geometry import quat_mul, transform_points, yaw_quat
@@ -77,9 +78,6 @@ SIM_FREQ = 120
 CONTAINER_INSIDE_SHARE = 0.8
 """Share of a rigid container's half footprint its ``inside`` condition checks (:meth:`TaskEnv.container_extent`)."""
 CONTROL_FREQ = 20
-VIEW_CAMERAS = ("left_overhead", "right_overhead", "top_down")
-"""The three scene views used by rendering, refinement and the docs."""
-HAND_CAMERA = "hand_camera"
 DEFAULT_REWARD_MODULE = Path(__file__).resolve().parent / "preview_rewards.py"
 """Reward module of an in-memory spec: no failure, reward = reaching the first stage's target."""
 
@@ -94,10 +92,6 @@ def _check_render_mode(mode: str | None) -> None:
         raise RenderModeError("render_mode='human' opens a viewer window, but this machine has no display (DISPLAY "
                               "and WAYLAND_DISPLAY are unset); use render_mode='rgb_array' for frames as arrays "
                               "(env.render()), or run under a display or Xvfb")
-
-
-def _look_at(eye, target, up=(0.0, 0.0, 1.0)) -> Pose:
-    return sapien_utils.look_at(eye=list(eye), target=list(target), up=list(up))
 
 
 class TaskEnv(BaseEnv):
@@ -120,6 +114,8 @@ class TaskEnv(BaseEnv):
             restricted builtins and the read-only view apply either way.
         scene: a scene style name or ``scene`` section (mapping) to use instead of the task's own; None: the task's.
         randomize_appearance: draw each episode's look from its seed (default); False: the scene's nominal look.
+        sensors: the sensor cameras to declare (:data:`~gendex_envs.cameras.SENSOR_CAMERAS`); None: all. With
+            ``obs_mode="rgb"`` every declared camera renders at every step, so name only those you read.
     """
 
     SUPPORTED_ROBOTS = [UR10eShadowHand.uid]
@@ -129,7 +125,7 @@ class TaskEnv(BaseEnv):
                  control_joint: str | None = None, stage: str | int | None = None,
                  start_states: StartStates | str | Path | None = None, view_resolution: int = 512,
                  sensor_resolution: int = 128, gym_api: bool | None = None, trust_remote_code: bool = False,
-                 scene=None, randomize_appearance: bool = True, **kwargs):
+                 scene=None, randomize_appearance: bool = True, sensors: tuple[str, ...] | None = None, **kwargs):
         if (task is None) == (task_spec is None):
             raise TaskSpecError("TaskEnv needs exactly one of task (a task version or its folder) or task_spec "
                                 "(a spec held in memory)")
@@ -169,6 +165,8 @@ class TaskEnv(BaseEnv):
         """Steps after which an episode is truncated whatever the time limit (a stage env's horizon), else None."""
         self.view_resolution = view_resolution
         self.sensor_resolution = sensor_resolution
+        self.sensors = check_sensors(sensors)
+        """The sensor cameras the env declares (None: all of :data:`~gendex_envs.cameras.SENSOR_CAMERAS`)."""
         self.table_height = 0.0
         self.objects: dict[str, Actor | Articulation] = {}
         self._frame: dict | None = None
@@ -216,30 +214,13 @@ class TaskEnv(BaseEnv):
             default_materials_config=DefaultMaterialsConfig(static_friction=1.0, dynamic_friction=0.8),
         )
 
-    def _view_poses(self) -> dict[str, Pose]:
-        target = [0.1, 0.0, 0.08]  # middle of the workspace in front of the robot
-        return {
-            "left_overhead": _look_at([0.0, 1.0, 0.9], target),
-            "right_overhead": _look_at([0.0, -1.0, 0.9], target),
-            "top_down": _look_at([0.05, 0.0, 1.6], [0.05, 0.0, 0.0], up=[1.0, 0.0, 0.0]),
-        }
-
     @property
     def _default_sensor_configs(self) -> list[CameraConfig]:
-        res = self.sensor_resolution
-        views = [CameraConfig(uid=n, pose=p, width=res, height=res, fov=1.0, near=0.01, far=10.0)
-                 for n, p in self._view_poses().items()]
-        # hand camera: on the palm, looking out of the palm (-y of the palm frame) towards the grasp
-        mount = sapien.Pose(p=[0.0, -0.06, 0.03], q=[0.7071068, 0.0, 0.0, -0.7071068])
-        hand = CameraConfig(uid=HAND_CAMERA, pose=mount, width=res, height=res, fov=1.4, near=0.01, far=5.0,
-                            mount=self.agent.palm_link)
-        return [*views, hand]
+        return sensor_configs(self.sensor_resolution, self.agent.palm_link, self.sensors)
 
     @property
     def _default_human_render_camera_configs(self) -> list[CameraConfig]:
-        res = self.view_resolution
-        return [CameraConfig(uid=n, pose=p, width=res, height=res, fov=1.0, near=0.01, far=10.0)
-                for n, p in self._view_poses().items()]
+        return human_camera_configs(self.view_resolution)
 
     # ------------------------------------------------------------------ loading
     def _load_agent(self, options: dict, initial_agent_poses=None, build_separate: bool = False):

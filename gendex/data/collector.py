@@ -69,8 +69,9 @@ class CollectConfig:
         """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""
         kwargs = {"control_mode": self.control_mode, "control_joint": self.control_joint,
                   "obs_mode": "rgb" if self.cameras else "state", **HISTORY_FREE}
-        if self.cameras:
+        if self.cameras:  # only the recorded cameras render (each declared one renders at every step)
             kwargs["sensor_resolution"] = self.resolution
+            kwargs["sensors"] = list(self.cameras)
         return kwargs
 
 

@@ -26,6 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 from gendex.episode_loop import Hooks, bind, run_episode
+from gendex_envs.cameras import SENSOR_CAMERAS
 from gendex_envs.observation import LeRobotObservation
 from gendex_envs.registry import HISTORY_FREE
 
@@ -75,20 +76,27 @@ def make_eval_env(task: str, env_kwargs: dict | None = None, max_episode_steps: 
     return LeRobotObservation(gym.make(task, **kwargs))
 
 
-OBSERVATION_KWARGS = {"obs_mode": ("state", "rgb"), "sensor_resolution": range(8, 513)}
-"""What a policy may ask the evaluation env to observe (``policy.observation_kwargs``): cameras and their size. These
-change what the env renders, never its physics; nothing else a policy asks for reaches ``gym.make``."""
+OBSERVATION_KWARGS = {"obs_mode": ("state", "rgb"), "sensor_resolution": range(8, 513), "sensors": SENSOR_CAMERAS}
+"""What a policy may ask the evaluation env to observe (``policy.observation_kwargs``): cameras (``sensors``: a list
+of their names, each rendered at every step) and their size. These change what the env renders, never its physics;
+nothing else a policy asks for reaches ``gym.make``."""
 
 
 def observation_kwargs(policy) -> dict:
     """The policy's ``observation_kwargs`` (e.g. a pixel policy's camera rendering), checked against
     :data:`OBSERVATION_KWARGS`; ValueError naming what is not allowed."""
     asked = getattr(policy, "observation_kwargs", None) or {}
-    bad = {k: v for k, v in asked.items() if k not in OBSERVATION_KWARGS or v not in OBSERVATION_KWARGS[k]
-           or type(v) is bool}
+
+    def allowed(key, value) -> bool:
+        if key == "sensors":
+            return (isinstance(value, list | tuple) and 0 < len(value) <= len(SENSOR_CAMERAS)
+                    and all(type(v) is str and v in SENSOR_CAMERAS for v in value) and len(set(value)) == len(value))
+        return key in OBSERVATION_KWARGS and type(value) is not bool and value in OBSERVATION_KWARGS[key]
+
+    bad = {k: v for k, v in asked.items() if not allowed(k, v)}
     if bad:
-        raise ValueError(f"the policy asks the env for {bad}; a policy may only set obs_mode (state, rgb) and "
-                         "sensor_resolution (8..512)")
+        raise ValueError(f"the policy asks the env for {bad}; a policy may only set obs_mode (state, rgb), "
+                         f"sensor_resolution (8..512) and sensors (a list of {list(SENSOR_CAMERAS)})")
     return dict(asked)
 
 

@@ -60,7 +60,7 @@ CHECKPOINT_FORMAT = 2
 MAX_CHECKPOINT_BYTES = 512_000_000
 """A checkpoint file (the default 3 x 512 MLP is about 4 MB)."""
 ENV_KWARGS = {"control_mode": str, "control_joint": str, "obs_mode": str, "sensor_resolution": int,
-              "reconfiguration_freq": int}
+              "reconfiguration_freq": int, "sensors": list}
 """The ``gym.make`` keyword arguments a checkpoint may ask for (those a GenDex dataset records), with their types:
 a checkpoint never chooses ``trust_remote_code``, start states or any other argument."""
 MAX_RECORDS = 10_000
@@ -328,7 +328,22 @@ def load_checkpoint(path: Path | str) -> dict:
         if key not in ENV_KWARGS or type(value) is not ENV_KWARGS[key]:
             raise _bad(path, f"env_kwargs {key}={str(value)[:60]!r}: a checkpoint may only set "
                              f"{', '.join(f'{k} ({t.__name__})' for k, t in ENV_KWARGS.items())}")
+        if key == "sensors":
+            _check_sensors(path, value)
     return ckpt
+
+
+def _check_sensors(path: Path, value: list) -> None:
+    """A checkpoint's ``sensors``: names of the env's cameras (a list the dataset recorded)."""
+    from gendex_envs.cameras import check_sensors
+    from gendex_envs.errors import RenderModeError
+
+    try:
+        if len(value) > 8 or not all(type(v) is str for v in value):
+            raise RenderModeError("sensors must be a short list of camera names")
+        check_sensors(value)
+    except RenderModeError as exc:
+        raise _bad(path, f"env_kwargs {exc}") from None
 
 
 def resave_trusted_checkpoint(path: Path | str, out: Path | str | None = None) -> Path:

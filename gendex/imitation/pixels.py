@@ -122,7 +122,7 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
         torch.set_num_threads(threads)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    env_kwargs = {k: v for k, v in tasks[0].env_kwargs.items() if k not in ("obs_mode", "sensor_resolution")}
+    env_kwargs = {k: v for k, v in tasks[0].env_kwargs.items() if k not in ("obs_mode", "sensor_resolution", "sensors")}
     info = {"config": {**asdict(config), "channels": list(config.channels)},
             "names": {STATE: tasks[0].frames.names[STATE], "action": tasks[0].frames.names["action"]},
             "task_id": f"{KIND}:{len(tasks)}", "kind": KIND, "tasks": {t.task_id: t.instruction for t in tasks},
@@ -205,7 +205,7 @@ class PixelPolicy(bc.BCPolicy):
     @property
     def observation_kwargs(self) -> dict:
         """What the env must render for this policy (added to ``gym.make`` by the evaluation runner)."""
-        return {"obs_mode": "rgb", "sensor_resolution": self.size}
+        return {"obs_mode": "rgb", "sensor_resolution": self.size, "sensors": [self.camera]}
 
     def bind(self, env) -> None:
         self.emb = instruction_embedding(self, env)

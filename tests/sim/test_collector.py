@@ -119,3 +119,4 @@ def test_cameras_are_recorded_as_video_at_the_asked_resolution(near_task, tmp_pa
     [video] = (root / "videos" / key).rglob("*.mp4")
     assert decode(video).shape == (info["total_frames"], 64, 64, 3)
     assert cfg.env_kwargs()["sensor_resolution"] == 64 and cfg.env_kwargs()["obs_mode"] == "rgb"
+    assert cfg.env_kwargs()["sensors"] == list(cfg.cameras)  # only the recorded cameras render

@@ -40,7 +40,8 @@ def _episode(task: str, seed: int, t: int = 6) -> Episode:
     return Episode(task_id=task, instruction=text, seed=seed, control_mode="pd_joint_pos", control_joint="both",
                    fps=20, state=np.zeros((t + 1, S), np.float32), action=np.repeat(sign * world[None], t, 0),
                    reward=np.zeros(t, np.float32), success=np.r_[np.zeros(t - 1, bool), True],
-                   fail=np.zeros(t, bool), env_states=np.zeros((t + 1, 2), np.float32), images={"cam": frames},
+                   fail=np.zeros(t, bool), env_states=np.zeros((t + 1, 2), np.float32),
+                   images={"left_overhead": frames},
                    environment_state=np.zeros((t + 1, 1), np.float32), environment_state_names=("w",))
 
 
@@ -50,7 +51,7 @@ def datasets(tmp_path):
     for i, task in enumerate(TASKS):
         root = tmp_path / f"d{i}" / "lerobot"
         with LeRobotV3Writer(root, fps=20, robot_type="toy", state_names=[f"s{k}" for k in range(S)],
-                             action_names=[f"a{k}" for k in range(A)], cameras={"cam": (RES, RES)},
+                             action_names=[f"a{k}" for k in range(A)], cameras={"left_overhead": (RES, RES)},
                              environment_state_names=["w"], video_codec="libx264") as w:
             for seed in range(30):
                 w.add_episode(_episode(task, seed))
@@ -63,13 +64,13 @@ def datasets(tmp_path):
 
 def test_frames_are_decoded_in_the_rows_order_and_resized(datasets):
     rows = load_frames(datasets[0], episodes=3)
-    images = load_images(datasets[0], "cam", episodes=3)
+    images = load_images(datasets[0], "left_overhead", episodes=3)
     assert images.shape == (len(rows.action), RES, RES, 3)
     for e in range(3):  # each episode's frames show its own colour (lossy video: within a few levels)
-        want = _episode("GenDex/ToyToward-v0", e).images["cam"][:-1]
+        want = _episode("GenDex/ToyToward-v0", e).images["left_overhead"][:-1]
         np.testing.assert_allclose(images[rows.episode == e].mean((1, 2)), want.mean((1, 2)), atol=6)
-    assert load_images(datasets[0], "cam", episodes=1, size=16).shape[1:] == (16, 16, 3)
-    with pytest.raises(DatasetReadError, match="no video of camera 'wrist'.*cameras: \\['cam'\\]"):
+    assert load_images(datasets[0], "left_overhead", episodes=1, size=16).shape[1:] == (16, 16, 3)
+    with pytest.raises(DatasetReadError, match="no video of camera 'wrist'.*cameras: \\['left_overhead'\\]"):
         load_images(datasets[0], "wrist")
 
 
@@ -85,18 +86,18 @@ def _error(policy, task: str, instruction: str | None = None) -> float:
         ep = _episode(task, seed)
         policy.reset()
         for t in range(ep.length):
-            errs.append(np.abs(policy.act({STATE: ep.state[t], IMAGES + "cam": ep.images["cam"][t]})
+            errs.append(np.abs(policy.act({STATE: ep.state[t], IMAGES + "left_overhead": ep.images["left_overhead"][t]})
                                - ep.action[t]).max())
     return float(np.mean(errs))
 
 
 def test_the_pixel_policy_reads_the_camera_and_the_instruction(datasets, tmp_path):
-    cfg = PixelConfig(camera="cam", image_size=16, channels=(8, 16), embed=32, hidden=64, layers=2, chunk=2,
+    cfg = PixelConfig(camera="left_overhead", image_size=16, channels=(8, 16), embed=32, hidden=64, layers=2, chunk=2,
                       steps=600, batch=64, lr=2e-3, shift=1, obs_noise=0.0)
     path = train(datasets, tmp_path / "px", fake_embed, config=cfg)
     policy = load_policy(str(path))
     assert isinstance(policy, PixelPolicy) and policy.training_seeds == list(range(30))
-    assert observation_kwargs(policy) == {"obs_mode": "rgb", "sensor_resolution": 16}
+    assert observation_kwargs(policy) == {"obs_mode": "rgb", "sensor_resolution": 16, "sensors": ["left_overhead"]}
     assert "obs_mode" not in policy.env_kwargs  # what it observes is the runner's business, not a task argument
     for task in TASKS:
         assert _error(policy, task) < 0.35, task  # actions span 2 units; the mean guess errs by about 0.5
@@ -111,3 +112,6 @@ def test_a_policy_may_only_ask_the_env_for_cameras():
         observation_kwargs(SimpleNamespace(observation_kwargs={"obs_mode": "rgb", "robot_init_qpos_noise": 1.0}))
     with pytest.raises(ValueError, match="sensor_resolution"):
         observation_kwargs(SimpleNamespace(observation_kwargs={"sensor_resolution": 4096}))
+    for sensors in (["wrist"], "left_overhead", ["top_down", "top_down"], []):
+        with pytest.raises(ValueError, match="sensors"):
+            observation_kwargs(SimpleNamespace(observation_kwargs={"sensors": sensors}))
