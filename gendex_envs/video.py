@@ -12,12 +12,15 @@ takes for x264). :func:`decode` reads every frame back.
 from __future__ import annotations
 
 import functools
+import logging
 import os
 from pathlib import Path
 
 import numpy as np
 
 from gendex_envs.errors import GenDexError
+
+log = logging.getLogger(__name__)
 
 CODECS = {"libsvtav1": ("av1", {"g": "2", "crf": "30"}), "libx264": ("h264", {"g": "2", "crf": "23"})}
 """Encoder -> (codec name recorded in the dataset's features, encoder options)."""
@@ -29,8 +32,17 @@ class VideoError(GenDexError, ValueError):
     """Frames cannot be encoded as asked, or a video file cannot be read."""
 
 
+ENCODE_TRIES = 3
+"""Times :func:`encode` runs FFmpeg on one video before it gives up."""
+
+
 def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_CODEC) -> None:
-    """Write ``frames`` ([T, H, W, 3] uint8 RGB; H and W even) to the MP4 file ``path``."""
+    """Write ``frames`` ([T, H, W, 3] uint8 RGB; H and W even) to the MP4 file ``path``.
+
+    The MP4 muxer once refused a packet SVT-AV1 flushed at the end of an episode (``Invalid argument``, errno 22;
+    one video in about 170 of a dataset build under full CPU load; 150 encodes of the same sizes beside the build
+    did not repeat it). The same frames encode again from the start, up to :data:`ENCODE_TRIES` times, and give the
+    same bytes (the encoding is deterministic); a :class:`VideoError` names the last failure."""
     import av
 
     if codec not in CODECS:
@@ -41,6 +53,23 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
     h, w = frames.shape[1:3]
     if h % 2 or w % 2:
         raise VideoError(f"frames of {h} x {w}: {PIX_FMT} video needs an even height and width")
+    for attempt in range(1, ENCODE_TRIES + 1):
+        try:
+            return _encode(frames, path, fps, codec)
+        except av.error.FFmpegError as exc:
+            Path(path).unlink(missing_ok=True)
+            if attempt == ENCODE_TRIES:
+                raise VideoError(f"{path}: FFmpeg failed to encode {len(frames)} frames {ENCODE_TRIES} times "
+                                 f"({exc})") from exc
+            log.warning("%s: FFmpeg failed to encode (%s); encoding it again (try %d of %d)", path, exc,
+                        attempt + 1, ENCODE_TRIES)
+
+
+def _encode(frames: np.ndarray, path: Path | str, fps: int, codec: str) -> None:
+    """One run of FFmpeg's encoder and muxer over ``frames`` (checked by :func:`encode`)."""
+    import av
+
+    h, w = frames.shape[1:3]
     os.environ.setdefault("SVT_LOG", "1")  # SVT-AV1 prints its whole configuration at info level
     with av.open(str(path), "w", format="mp4") as container:
         stream = container.add_stream(codec, rate=int(fps))

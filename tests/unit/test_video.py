@@ -1,0 +1,47 @@
+"""gendex_envs.video.encode: a video FFmpeg fails to write is encoded again from the start, to the same bytes; a
+video that keeps failing is a VideoError naming the file."""
+
+from __future__ import annotations
+
+import av
+import numpy as np
+import pytest
+
+from gendex_envs import video
+
+
+def _frames(t: int = 24) -> np.ndarray:
+    rng = np.random.default_rng(0)
+    return rng.integers(0, 255, (t, 32, 32, 3), dtype=np.uint8)
+
+
+def test_a_failed_encode_is_encoded_again_to_the_same_bytes(tmp_path, monkeypatch):
+    frames = _frames()
+    video.encode(frames, tmp_path / "once.mp4", 20)
+    real, calls = video._encode, []
+
+    def flaky(frames, path, fps, codec):
+        calls.append(path)
+        if len(calls) == 1:  # as the muxer refused a flushed packet: a partial file is left behind
+            real(frames[:3], path, fps, codec)
+            raise av.error.ArgumentError(22, "Invalid argument", str(path))
+        return real(frames, path, fps, codec)
+
+    monkeypatch.setattr(video, "_encode", flaky)
+    video.encode(frames, tmp_path / "again.mp4", 20)
+    assert len(calls) == 2
+    assert (tmp_path / "again.mp4").read_bytes() == (tmp_path / "once.mp4").read_bytes()
+    np.testing.assert_array_equal(video.decode(tmp_path / "again.mp4").shape, frames.shape)
+
+
+def test_an_encode_that_keeps_failing_is_a_video_error_and_leaves_no_file(tmp_path, monkeypatch):
+    def broken(frames, path, fps, codec):
+        path.write_bytes(b"partial")
+        raise av.error.ArgumentError(22, "Invalid argument", str(path))
+
+    monkeypatch.setattr(video, "_encode", broken)
+    with pytest.raises(video.VideoError, match=f"bad.mp4: FFmpeg failed to encode 24 frames {video.ENCODE_TRIES} "):
+        video.encode(_frames(), tmp_path / "bad.mp4", 20)
+    assert not (tmp_path / "bad.mp4").exists()
+    with pytest.raises(video.VideoError, match="not one of"):  # bad input is refused at once, not retried
+        video.encode(_frames(), tmp_path / "x.mp4", 20, codec="mpeg2")
