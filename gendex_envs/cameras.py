@@ -41,12 +41,14 @@ def view_poses() -> dict[str, Pose]:
 
 def check_sensors(sensors: Sequence[str] | None) -> tuple[str, ...] | None:
     """``sensors`` as a tuple (None: every camera); :class:`RenderModeError` naming an unknown or repeated camera
-    and the allowed ones."""
+    and the allowed ones, or saying that none was named."""
     if sensors is None:
         return None
     if isinstance(sensors, str):
         sensors = (sensors,)
     names = tuple(sensors)
+    if not names:
+        raise RenderModeError(f"sensors: name at least one camera of {list(SENSOR_CAMERAS)} (None: all of them)")
     for name in names:
         if name not in SENSOR_CAMERAS:
             raise RenderModeError(f"sensors: {name!r} is not a camera of the env; allowed: {list(SENSOR_CAMERAS)}."

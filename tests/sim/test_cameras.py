@@ -36,7 +36,8 @@ def test_only_the_cameras_asked_for_render_and_they_render_the_same_pixels():
 
 
 @pytest.mark.parametrize("sensors, message", [(["wrist_cam"], "not a camera of the env; allowed"),
-                                              (["top_down", "top_down"], "named twice")])
+                                              (["top_down", "top_down"], "named twice"),
+                                              ([], "name at least one camera")])
 def test_an_unknown_or_repeated_camera_is_refused(sensors, message):
     with pytest.raises(RenderModeError, match=message):
         gym.make(TASK, obs_mode="rgb", sensors=sensors)
