@@ -116,6 +116,30 @@ def _process_init(make_worker: Callable[[], Callable]) -> None:
     _WORKER = _build_worker(make_worker)
 
 
+TERMINATE_WAIT_S = 30.0
+"""How long :func:`_terminate` waits for ``Pool.terminate`` before it kills the pool's workers itself."""
+
+
+def _terminate(pool, before: set) -> None:
+    """``pool.terminate()``, but never a hang: ``Pool.terminate`` joins the pool's task-feeding thread, which can stay
+    blocked putting queued jobs to workers that are gone (a gendex-lib-v2 build hung so for 13 minutes after a task's
+    last episode; py-spy: the main thread in ``_terminate_pool``'s join, the feeder in ``SimpleQueue.put``). It runs
+    in a daemon thread; after :data:`TERMINATE_WAIT_S` the worker processes this pool started (the children that
+    were not there before it) are killed and the thread is left to the interpreter's exit."""
+    import multiprocessing
+    import threading
+
+    done = threading.Thread(target=pool.terminate, name="pool-terminate", daemon=True)
+    done.start()
+    done.join(TERMINATE_WAIT_S)
+    if done.is_alive():
+        stray = [p for p in multiprocessing.active_children() if p not in before]
+        log.warning("the worker pool did not end within %.0f s; killing its %d worker processes", TERMINATE_WAIT_S,
+                    len(stray))
+        for p in stray:
+            p.kill()
+
+
 def _process_call(job):
     return _WORKER(job)
 
@@ -262,6 +286,7 @@ def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Ba
     elif backend.kind == "process":
         import multiprocessing
 
+        before = set(multiprocessing.active_children())
         with _environ(backend.env):  # spawned workers copy this process's environment when they start
             pool = multiprocessing.get_context("spawn").Pool(backend.workers, _process_init, (make_worker,))
         try:  # in order, at most ``ahead`` submitted past the last result taken (jobs are pulled lazily)
@@ -278,7 +303,7 @@ def ordered_map(make_worker: Callable[[], Callable], jobs: Iterable, backend: Ba
                     return
                 yield pending.popleft().get()
         finally:
-            pool.terminate()
+            _terminate(pool, before)
     else:
         yield from _ray_map(make_worker, jobs, backend, ahead)
 

@@ -113,3 +113,35 @@ def test_worker_processes_start_with_the_backends_environment(ray_cluster):
     assert "GENDEX_FANOUT_TEST" not in os.environ
     plain = list(ordered_map(_make_env_reader, ["GENDEX_FANOUT_TEST"] * 2, Backend("process", 2)))
     assert {r[1] for r in plain} == {None}
+
+
+class _StuckPool:
+    """A pool whose terminate() never returns, as Pool.terminate did when its task feeder hung."""
+
+    def __init__(self):
+        import threading
+
+        self.called = threading.Event()
+
+    def terminate(self):
+        import threading
+
+        self.called.set()
+        threading.Event().wait()
+
+
+def test_a_pool_whose_terminate_hangs_has_its_workers_killed(monkeypatch):
+    import multiprocessing
+
+    from gendex import fanout
+
+    before = set(multiprocessing.active_children())
+    worker = multiprocessing.get_context("spawn").Process(target=time.sleep, args=(120,), daemon=True)
+    worker.start()
+    monkeypatch.setattr(fanout, "TERMINATE_WAIT_S", 0.5)
+    pool = _StuckPool()
+    t0 = time.monotonic()
+    fanout._terminate(pool, before)
+    assert pool.called.is_set() and time.monotonic() - t0 < 10
+    worker.join(10)
+    assert not worker.is_alive() and worker.exitcode is not None and worker.exitcode < 0  # killed, not finished
