@@ -16,7 +16,7 @@ UNITS = {"gendex_envs": "runtime", "gendex.solve": "solve", "gendex.data": "data
          "gendex.eval": "eval", "gendex.imitation": "imitation", "gendex.gallery": "gallery", "generator": "generator",
          "gendex.fanout": "fanout", "gendex.episode_loop": "loop",
          **{f"gendex.{m}": "cli" for m in ("cli", "cli_common", "cli_dataset", "cli_bc", "cli_eval", "cli_trust",
-                                           "cli_check", "cli_list", "cli_store", "check", "demo")}}
+                                           "cli_check", "cli_list", "cli_store", "cli_restyle", "check", "demo")}}
 """Import prefix -> the unit the architecture diagram draws (the longest matching prefix wins)."""
 ALLOWED = {
     "runtime": set(),
