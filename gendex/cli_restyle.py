@@ -24,6 +24,8 @@ def restyle_command(names: list[str] = typer.Argument(None, help="Task names to 
         raise typer.BadParameter(f"no registered task named {', '.join(unknown)}", param_hint="NAMES")
     try:
         plan = plan_restyle(versions, names=names or None)
+        for name in sorted(set(names or ()) - {c.source.name for c in plan}):
+            typer.echo(f"{name}: its newest version already has a scene; left as it is")
         for change in plan:
             if dry_run:
                 typer.echo(f"{change.env_id}: {change.style}")

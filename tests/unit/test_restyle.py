@@ -73,3 +73,20 @@ def test_the_plan_deals_the_rotation_over_the_newest_versions_without_a_scene(tm
     after = plan_restyle({**versions, published.env_id: published})
     assert [(p.env_id, p.style) for p in after] == [(p.env_id, p.style) for p in plan
                                                       if p.source.name != published.name]
+
+
+def test_the_command_names_a_task_that_already_has_a_scene(monkeypatch, tmp_path):
+    from typer.testing import CliRunner
+
+    from gendex.cli import app
+
+    versions = _library(tmp_path, "PutAppleBowl/v1", "LiftApple/v0")
+    published = publish_restyled(versions["GenDex/PutAppleBowl-v1"], "lab")
+    monkeypatch.setattr("gendex_envs.registry.registered_tasks",
+                        lambda: {**versions, published.env_id: published})
+    result = CliRunner().invoke(app, ["restyle", "PutAppleBowl", "LiftApple", "--dry-run"])
+    assert result.exit_code == 0, result.output
+    assert "PutAppleBowl: its newest version already has a scene" in result.output
+    assert "GenDex/LiftApple-v0: " in result.output and "1 tasks to restyle (dry run)" in result.output
+    unknown = CliRunner().invoke(app, ["restyle", "NoSuchTask"])
+    assert unknown.exit_code == 2 and "no registered task named NoSuchTask" in unknown.output
