@@ -49,12 +49,10 @@ class Restyle:
 
 
 def _newest(versions: Iterable[TaskVersion]) -> list[TaskVersion]:
-    """The newest version of each task, by name."""
-    newest: dict[str, TaskVersion] = {}
-    for v in versions:
-        if v.name not in newest or v.version > newest[v.name].version:
-            newest[v.name] = v
-    return [v for _, v in sorted(newest.items())]
+    """The newest version of each task (:func:`generator.stats.latest_versions`), sorted by task name."""
+    from generator.stats import latest_versions
+
+    return sorted(latest_versions({v.env_id: v for v in versions}).values(), key=lambda v: v.name)
 
 
 def newest_without_scene(versions: Iterable[TaskVersion]) -> list[TaskVersion]:
