@@ -308,6 +308,18 @@ def test_a_bc_checkpoint_cannot_choose_gym_make_arguments_beyond_what_a_dataset_
         BCPolicy(path)
 
 
+
+@pytest.mark.parametrize("sensors", [["/etc/passwd"], ["left_overhead"] * 9, [{"uid": "top_down"}], [3], []])
+def test_a_bc_checkpoint_names_only_the_envs_own_cameras(tmp_path, sensors):
+    """A dataset records ``sensors`` (the cameras it rendered); a checkpoint's list holds only the env's camera
+    names, few, once each."""
+    path = _toy_checkpoint(tmp_path / "bc.pt")
+    ckpt = torch.load(path, weights_only=True)
+    torch.save(dict(ckpt, env_kwargs={"control_mode": "pd_joint_pos", "sensors": sensors}), path)
+    with pytest.raises(PolicyError, match="env_kwargs sensors"):
+        BCPolicy(path)
+
+
 _PEAK_SCRIPT = """
 import resource, sys
 from gendex.imitation.bc import BCPolicy
