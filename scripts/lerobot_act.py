@@ -23,9 +23,12 @@ because one core cannot afford lerobot's per-item decoding at every step.
 ``train`` writes into ``--out``: the policy (``save_pretrained``: ``config.json``, ``model.safetensors``), the pre- and
 post-processors (with the normalization stats), ``loss.csv`` (the loss curve) and ``train_info.json`` (dataset, task,
 ``gym.make`` keyword arguments and training seeds from the dataset's ``meta/gendex.json``, steps, time, final loss);
-its last stdout line is that record as JSON. ``serve`` speaks one JSON object per line:
-``{"cmd": "reset"}`` -> ``{"ok": true}``; ``{"cmd": "act", "obs": {"observation.state": [...],
-"observation.environment_state": [...]}}`` -> ``{"action": [...]}``; errors come back as ``{"error": "..."}``.
+its last stdout line is that record as JSON. ``serve`` loads any lerobot policy checkpoint (this script's, or one
+``scripts/lerobot_train_pixels.py`` trained with lerobot's own entry point: ACT or Diffusion from camera frames) and
+speaks one JSON object per line: it greets first with ``{"ready": true, "type": ..., "inputs": {feature: shape}, ...}``;
+``{"cmd": "reset"}`` -> ``{"ok": true}``; ``{"cmd": "act", "obs": {...}}`` with one entry per input feature
+(vectors as lists; ``observation.images.*`` as H x W x 3 uint8 nested lists) -> ``{"action": [...]}``; errors come
+back as ``{"error": "..."}``.
 """
 
 from __future__ import annotations
@@ -50,6 +53,7 @@ log = logging.getLogger("lerobot_act")
 STATE = "observation.state"
 ENV_STATE = "observation.environment_state"
 ACTION = "action"
+IMAGE_PREFIX = "observation.images."
 INPUTS = (STATE, ENV_STATE)
 REPO_ID = "local/gendex"
 """lerobot wants a repo id even for a local folder; nothing is fetched (HF_HUB_OFFLINE)."""
@@ -190,23 +194,40 @@ def train(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def load(checkpoint: Path, temporal_ensemble: float | None, n_action_steps: int | None) -> tuple[Any, Any, Any]:
-    """The saved ACT policy with its pre- and post-processors; inference may switch to temporal ensembling
-    (a prediction every step, ``n_action_steps`` 1) or execute ``n_action_steps`` actions of each chunk."""
+    """The saved lerobot policy (ACT from ``train`` here, or ACT or Diffusion from ``lerobot_train_pixels.py``) with
+    its pre- and post-processors. ACT's inference may switch to temporal ensembling (a prediction every step,
+    ``n_action_steps`` 1); any policy may execute ``n_action_steps`` actions of each predicted chunk."""
     from lerobot.configs.policies import PreTrainedConfig
-    from lerobot.policies.act.modeling_act import ACTPolicy
-    from lerobot.policies.factory import make_pre_post_processors
+    from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
     cfg = PreTrainedConfig.from_pretrained(checkpoint)
     if temporal_ensemble is not None:
+        if not hasattr(cfg, "temporal_ensemble_coeff"):
+            raise ValueError(f"--temporal-ensemble is ACT's; {checkpoint} holds a {cfg.type} policy")
         cfg.temporal_ensemble_coeff = temporal_ensemble
         cfg.n_action_steps = 1
     elif n_action_steps is not None:
         cfg.n_action_steps = n_action_steps
     cfg.device = "cpu"
-    policy = ACTPolicy.from_pretrained(checkpoint, config=cfg)
+    policy = get_policy_class(cfg.type).from_pretrained(checkpoint, config=cfg)
     policy.eval()
     pre, post = make_pre_post_processors(cfg, pretrained_path=str(checkpoint))
     return policy, pre, post
+
+
+def _observation(msg_obs: dict[str, Any], keys: list[str]) -> dict[str, torch.Tensor]:
+    """The policy's inputs from one JSON observation: vectors as float32; camera frames (``observation.images.*``,
+    H x W x 3 uint8 as the env renders them) as float32 3 x H x W in [0, 1], as ``LeRobotDataset`` returns frames."""
+    missing = [k for k in keys if k not in msg_obs]
+    if missing:
+        raise KeyError(f"the observation lacks {missing}; the policy reads {keys}")
+    obs = {}
+    for k in keys:
+        if k.startswith(IMAGE_PREFIX):
+            obs[k] = torch.tensor(msg_obs[k], dtype=torch.uint8).permute(2, 0, 1).float() / 255.0
+        else:
+            obs[k] = torch.tensor(msg_obs[k], dtype=torch.float32)
+    return obs
 
 
 def serve(args: argparse.Namespace) -> None:
@@ -214,15 +235,19 @@ def serve(args: argparse.Namespace) -> None:
     out: TextIO = sys.stdout
     sys.stdout = sys.stderr  # only replies go to the pipe, whatever a library prints
     policy, pre, post = load(Path(args.checkpoint), args.temporal_ensemble, args.n_action_steps)
-    log.info("serving %s (chunk %d, n_action_steps %d, temporal ensembling %s)", args.checkpoint,
-             policy.config.chunk_size, policy.config.n_action_steps, policy.config.temporal_ensemble_coeff)
+    cfg = policy.config
+    inputs = sorted(cfg.input_features)
+    chunk = getattr(cfg, "chunk_size", None) or getattr(cfg, "horizon", None)
+    ensemble = getattr(cfg, "temporal_ensemble_coeff", None)
+    log.info("serving %s %s (inputs %s, chunk %s, n_action_steps %d, temporal ensembling %s)", cfg.type,
+             args.checkpoint, inputs, chunk, cfg.n_action_steps, ensemble)
 
     def reply(obj: dict[str, Any]) -> None:
         out.write(json.dumps(obj) + "\n")
         out.flush()
 
-    reply({"ready": True, "chunk_size": policy.config.chunk_size, "n_action_steps": policy.config.n_action_steps,
-           "temporal_ensemble_coeff": policy.config.temporal_ensemble_coeff})
+    reply({"ready": True, "type": cfg.type, "inputs": {k: list(cfg.input_features[k].shape) for k in inputs},
+           "chunk_size": chunk, "n_action_steps": cfg.n_action_steps, "temporal_ensemble_coeff": ensemble})
     for line in sys.stdin:
         if not line.strip():
             continue
@@ -232,7 +257,7 @@ def serve(args: argparse.Namespace) -> None:
                 policy.reset()
                 reply({"ok": True})
             elif msg.get("cmd") == "act":
-                obs = {k: torch.tensor(msg["obs"][k], dtype=torch.float32) for k in INPUTS}
+                obs = _observation(msg["obs"], inputs)
                 with torch.inference_mode():
                     action = post(policy.select_action(pre(obs)))
                 reply({"action": action.reshape(-1).tolist()})

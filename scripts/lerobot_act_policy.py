@@ -42,6 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SERVER = ROOT / "scripts" / "lerobot_act.py"
 STATE = "observation.state"
 ENV_STATE = "observation.environment_state"
+IMAGES = "observation.images."
 
 
 class ServerError(RuntimeError):
@@ -66,6 +67,8 @@ class LeRobotACTPolicy:
                                      bufsize=1)
         atexit.register(self.close)
         self.hello = self._read()
+        self.inputs: dict[str, list[int]] = self.hello.get("inputs") or {STATE: [], ENV_STATE: []}
+        self.cameras = sorted(k[len(IMAGES):] for k in self.inputs if k.startswith(IMAGES))
         self.low: np.ndarray | None = None
         self.high: np.ndarray | None = None
 
@@ -89,6 +92,15 @@ class LeRobotACTPolicy:
         self.proc.stdin.flush()
         return self._read()
 
+    @property
+    def observation_kwargs(self) -> dict[str, Any]:
+        """A policy that reads camera frames asks the evaluation env to render its cameras at the trained size
+        (channels-first shapes in lerobot's config: [3, H, W])."""
+        if not self.cameras:
+            return {}
+        return {"obs_mode": "rgb", "sensor_resolution": self.inputs[IMAGES + self.cameras[0]][-1],
+                "sensors": list(self.cameras)}
+
     def bind(self, env: Any) -> None:
         """Keep the env's action bounds (joint limits of the absolute targets): actions are clipped to them."""
         self.low, self.high = env.action_space.low, env.action_space.high
@@ -97,7 +109,8 @@ class LeRobotACTPolicy:
         self._ask({"cmd": "reset"})
 
     def act(self, obs: dict[str, np.ndarray]) -> np.ndarray:
-        payload = {k: np.asarray(obs[k], dtype=np.float32).reshape(-1).tolist() for k in (STATE, ENV_STATE)}
+        payload = {k: (np.asarray(obs[k], dtype=np.uint8).tolist() if k.startswith(IMAGES)
+                       else np.asarray(obs[k], dtype=np.float32).reshape(-1).tolist()) for k in self.inputs}
         action = np.asarray(self._ask({"cmd": "act", "obs": payload})["action"], dtype=np.float32)
         return np.clip(action, self.low, self.high) if self.low is not None else action
 
