@@ -128,7 +128,8 @@ def factory() -> LeRobotACTPolicy:
     """The ``gendex eval --policy lerobot_act_policy:factory`` entry (``GENDEX_ACT_CHECKPOINT`` names the folder)."""
     ckpt = os.environ.get("GENDEX_ACT_CHECKPOINT")
     if not ckpt:
-        raise ValueError("set GENDEX_ACT_CHECKPOINT to a folder written by scripts/lerobot_act.py train")
+        raise ValueError("set GENDEX_ACT_CHECKPOINT to a lerobot policy folder (scripts/lerobot_act.py train, or "
+                         "OUT/checkpoints/last/pretrained_model of scripts/lerobot_train_pixels.py)")
     return LeRobotACTPolicy(ckpt, serve_args=shlex.split(os.environ.get("GENDEX_ACT_SERVE_ARGS", "")))
 
 
