@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import logging
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +35,14 @@ class VideoError(GenDexError, ValueError):
 
 ENCODE_TRIES = 3
 """Times :func:`encode` runs FFmpeg on one video before it gives up."""
+ENCODE_TIMEOUT_S = 120.0
+"""Seconds one run of the encoder may take before :func:`encode` counts it as hung and runs it again. A 96 px episode
+encodes in well under a second; SVT-AV1 once blocked for good inside ``svt_av1_enc_send_picture`` with every thread
+idle (twice in one dataset build of 52 tasks under full CPU load; a known class of SVT-AV1 deadlock)."""
+
+
+class EncoderHung(VideoError):
+    """One run of the encoder did not finish within :data:`ENCODE_TIMEOUT_S`."""
 
 
 def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_CODEC) -> None:
@@ -42,7 +51,10 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
     The MP4 muxer once refused a packet SVT-AV1 flushed at the end of an episode (``Invalid argument``, errno 22;
     one video in about 170 of a dataset build under full CPU load; 150 encodes of the same sizes beside the build
     did not repeat it). The same frames encode again from the start, up to :data:`ENCODE_TRIES` times, and give the
-    same bytes (the encoding is deterministic); a :class:`VideoError` names the last failure."""
+    same bytes (the encoding is deterministic); a :class:`VideoError` names the last failure. An encoder that hangs
+    (:data:`ENCODE_TIMEOUT_S`) is left behind and the frames are encoded again by a fresh one. Each run writes its own
+    hidden file beside ``path`` and only a finished one is renamed to ``path``, so a run left behind never touches the
+    result, and nothing half-written is left at ``path``."""
     import av
 
     if codec not in CODECS:
@@ -53,16 +65,41 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
     h, w = frames.shape[1:3]
     if h % 2 or w % 2:
         raise VideoError(f"frames of {h} x {w}: {PIX_FMT} video needs an even height and width")
+    path = Path(path)
     for attempt in range(1, ENCODE_TRIES + 1):
+        part = path.with_name(f".{path.name}.{os.getpid()}.{attempt}.part")
         try:
-            return _encode(frames, path, fps, codec)
-        except av.error.FFmpegError as exc:
-            Path(path).unlink(missing_ok=True)
+            _encode_watched(frames, part, fps, codec)
+            os.replace(part, path)
+            return None
+        except (av.error.FFmpegError, EncoderHung) as exc:
+            part.unlink(missing_ok=True)  # a hung run that holds it open writes on into the unlinked file
             if attempt == ENCODE_TRIES:
                 raise VideoError(f"{path}: FFmpeg failed to encode {len(frames)} frames {ENCODE_TRIES} times "
                                  f"({exc})") from exc
             log.warning("%s: FFmpeg failed to encode (%s); encoding it again (try %d of %d)", path, exc,
                         attempt + 1, ENCODE_TRIES)
+    return None
+
+
+def _encode_watched(frames: np.ndarray, path: Path, fps: int, codec: str) -> None:
+    """:func:`_encode` on a daemon thread (PyAV releases the GIL inside FFmpeg), given up after
+    :data:`ENCODE_TIMEOUT_S` as :class:`EncoderHung`; the thread is abandoned (it sleeps, holding no CPU)."""
+    failure: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            _encode(frames, path, fps, codec)
+        except BaseException as exc:  # handed to the caller's thread
+            failure.append(exc)
+
+    worker = threading.Thread(target=run, name=f"encode {path.name}", daemon=True)
+    worker.start()
+    worker.join(ENCODE_TIMEOUT_S)
+    if worker.is_alive():
+        raise EncoderHung(f"the encoder did not finish {len(frames)} frames in {ENCODE_TIMEOUT_S:g} s")
+    if failure:
+        raise failure[0]
 
 
 def _encode(frames: np.ndarray, path: Path | str, fps: int, codec: str) -> None:

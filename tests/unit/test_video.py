@@ -45,3 +45,48 @@ def test_an_encode_that_keeps_failing_is_a_video_error_and_leaves_no_file(tmp_pa
     assert not (tmp_path / "bad.mp4").exists()
     with pytest.raises(video.VideoError, match="not one of"):  # bad input is refused at once, not retried
         video.encode(_frames(), tmp_path / "x.mp4", 20, codec="mpeg2")
+
+
+def test_a_hung_encoder_is_left_behind_and_a_fresh_one_writes_the_same_bytes(tmp_path, monkeypatch):
+    """As SVT-AV1 once blocked for good inside svt_av1_enc_send_picture: the first run opens its file, writes a
+    little and never returns while encode waits; a fresh run gives the file, and the first one, let go afterwards,
+    changes nothing in the folder."""
+    import threading
+
+    frames = _frames()
+    video.encode(frames, tmp_path / "once.mp4", 20)
+    real, calls, release = video._encode, [], threading.Event()
+    out = tmp_path / "out"
+    out.mkdir()
+
+    def hangs_once(frames, path, fps, codec):
+        calls.append(path)
+        if len(calls) == 1:
+            with open(path, "wb") as f:
+                f.write(b"partial")
+                release.wait(30)
+                f.write(b"late bytes")
+            return None
+        return real(frames, path, fps, codec)
+
+    monkeypatch.setattr(video, "_encode", hangs_once)
+    monkeypatch.setattr(video, "ENCODE_TIMEOUT_S", 0.5)
+    video.encode(frames, out / "again.mp4", 20)
+    assert len(calls) == 2 and calls[0] != calls[1]  # each run writes its own file
+    release.set()
+    for t in [t for t in threading.enumerate() if t.name.startswith("encode ")]:
+        t.join(5)
+    assert [p.name for p in out.iterdir()] == ["again.mp4"]
+    assert (out / "again.mp4").read_bytes() == (tmp_path / "once.mp4").read_bytes()
+
+
+def test_an_encoder_that_always_hangs_is_a_video_error_naming_the_file(tmp_path, monkeypatch):
+    import threading
+
+    release = threading.Event()
+    monkeypatch.setattr(video, "_encode", lambda frames, path, fps, codec: release.wait(30))
+    monkeypatch.setattr(video, "ENCODE_TIMEOUT_S", 0.2)
+    with pytest.raises(video.VideoError, match=r"stuck.mp4: .*did not finish 24 frames in 0.2 s"):
+        video.encode(_frames(), tmp_path / "stuck.mp4", 20)
+    release.set()
+    assert list(tmp_path.iterdir()) == []
