@@ -79,6 +79,9 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
                                  f"({exc})") from exc
             log.warning("%s: FFmpeg failed to encode (%s); encoding it again (try %d of %d)", path, exc,
                         attempt + 1, ENCODE_TRIES)
+        except BaseException:  # not worth another try (a full disk, an interrupt): leave no part file either
+            part.unlink(missing_ok=True)
+            raise
     return None
 
 

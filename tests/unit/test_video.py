@@ -90,3 +90,17 @@ def test_an_encoder_that_always_hangs_is_a_video_error_naming_the_file(tmp_path,
         video.encode(_frames(), tmp_path / "stuck.mp4", 20)
     release.set()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_error_that_is_not_ffmpegs_is_raised_at_once_and_leaves_no_part_file(tmp_path, monkeypatch):
+    calls = []
+
+    def full_disk(frames, path, fps, codec):
+        calls.append(path)
+        path.write_bytes(b"partial")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(video, "_encode", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        video.encode(_frames(), tmp_path / "full.mp4", 20)
+    assert len(calls) == 1 and list(tmp_path.iterdir()) == []
