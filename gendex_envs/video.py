@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gendex_envs.atomic_io import atomic_path
 from gendex_envs.errors import GenDexError
 
 log = logging.getLogger(__name__)
@@ -67,21 +68,19 @@ def encode(frames: np.ndarray, path: Path | str, fps: int, codec: str = DEFAULT_
         raise VideoError(f"frames of {h} x {w}: {PIX_FMT} video needs an even height and width")
     path = Path(path)
     for attempt in range(1, ENCODE_TRIES + 1):
-        part = path.with_name(f".{path.name}.{os.getpid()}.{attempt}.part")
         try:
-            _encode_watched(frames, part, fps, codec)
-            os.replace(part, path)
+            # atomic_path removes the run's file on any error (a hung run that holds it open writes on into the
+            # unlinked file) and renames only a finished one into place
+            with atomic_path(path) as part:
+                _encode_watched(frames, part, fps, codec)
             return None
         except (av.error.FFmpegError, EncoderHung) as exc:
-            part.unlink(missing_ok=True)  # a hung run that holds it open writes on into the unlinked file
             if attempt == ENCODE_TRIES:
                 raise VideoError(f"{path}: FFmpeg failed to encode {len(frames)} frames {ENCODE_TRIES} times "
                                  f"({exc})") from exc
             log.warning("%s: FFmpeg failed to encode (%s); encoding it again (try %d of %d)", path, exc,
                         attempt + 1, ENCODE_TRIES)
-        except BaseException:  # not worth another try (a full disk, an interrupt): leave no part file either
-            part.unlink(missing_ok=True)
-            raise
+        # anything else (a full disk, an interrupt) is not worth another try and propagates at once
     return None
 
 
