@@ -71,6 +71,16 @@ STEP_SCALE = 200.0
 """The step-count input is ``step / STEP_SCALE``."""
 
 
+CURVE_POINTS = 50  # a training run's learning curve: the smoothed loss at about this many evenly spaced steps
+
+
+def curve_due(step: int, steps: int) -> bool:
+    """Whether 1-based ``step`` of a ``steps``-step run is a point of its learning curve: every ``steps //
+    CURVE_POINTS`` steps (at least every step, at most 1 000 apart) and the last."""
+    every = min(1000, max(1, steps // CURVE_POINTS))
+    return step % every == 0 or step == steps
+
+
 @dataclass(frozen=True)
 class BCConfig:
     chunk: int = 10

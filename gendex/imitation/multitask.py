@@ -40,6 +40,7 @@ from gendex.imitation.bc import (
     _dataset_meta,
     _mlp,
     build_network,
+    curve_due,
     load_checkpoint,
     save_checkpoint,
 )
@@ -213,7 +214,7 @@ def _fit(x: np.ndarray, y: np.ndarray, config: MultiTaskConfig, progress):
         opt.step()
         sched.step()
         loss_avg = loss.item() if loss_avg is None else 0.98 * loss_avg + 0.02 * loss.item()
-        if (step + 1) % 1000 == 0 or step + 1 == config.steps:
+        if curve_due(step + 1, config.steps):
             curve.append((step + 1, loss_avg))
             if progress is not None:
                 progress(step + 1, loss_avg)

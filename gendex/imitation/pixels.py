@@ -161,7 +161,7 @@ def _fit(image: np.ndarray, low: np.ndarray, y: np.ndarray, config: PixelConfig,
         opt.step()
         sched.step()
         loss_avg = loss.item() if loss_avg is None else 0.98 * loss_avg + 0.02 * loss.item()
-        if (step + 1) % 1000 == 0 or step + 1 == config.steps:
+        if bc.curve_due(step + 1, config.steps):
             curve.append((step + 1, loss_avg))
             if progress is not None:
                 progress(step + 1, loss_avg)

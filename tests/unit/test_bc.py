@@ -11,7 +11,7 @@ import pytest
 
 from gendex.data.episode import Episode
 from gendex.data.lerobot_v3 import LeRobotV3Writer
-from gendex.imitation.bc import BCConfig, BCPolicy, _chunk_targets, train
+from gendex.imitation.bc import BCConfig, BCPolicy, _chunk_targets, curve_due, train
 from gendex.imitation.frames import DatasetReadError, load_frames
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 
@@ -123,3 +123,10 @@ def test_a_checkpoint_acts_only_in_the_task_it_learned_and_several_cover_a_suite
     rows = evaluate_task("GenDex/PutAppleBowl-v1", lambda: load_policy(str(toy)), [7, 8])
     assert [(r.seed, r.success_at_end, r.length) for r in rows] == [(7, False, 0), (8, False, 0)]
     assert all("learned GenDex/Toy-v0, not GenDex/PutAppleBowl-v1" in r.failure for r in rows)
+
+
+@pytest.mark.parametrize(("steps", "points", "first"), [(3, 3, 1), (50, 50, 1), (800, 50, 16), (6000, 50, 120),
+                                                         (100_000, 100, 1000), (101, 51, 2)])
+def test_a_learning_curve_has_evenly_spaced_points_and_the_last_step(steps, points, first):
+    due = [s for s in range(1, steps + 1) if curve_due(s, steps)]
+    assert len(due) == points and due[0] == first and due[-1] == steps
