@@ -39,7 +39,7 @@ def test_signatures_of_a_proposal_and_of_its_committed_spec_agree():
 def test_near_duplicates_are_named_with_the_task_they_duplicate(novelty):
     same = _put("apple_scan", "bowl", "Drop the scanned apple in the bowl, for a healthy snack.")
     why = novelty.near_duplicate(proposal_signature(same), same["description"])
-    assert why is not None and "GenDex/PutAppleBowl-v1" in why and "same skills" in why
+    assert why is not None and "GenDex/PutAppleBowl-v" in why and "same skills" in why  # one of its versions
     other = _put("peach", "pot", "Drop the peach in the pot, for a healthy snack.")  # no library task does
     assert novelty.near_duplicate(proposal_signature(other), other["description"]) is None
 
@@ -49,7 +49,7 @@ def test_an_instruction_that_reads_like_an_existing_one_is_a_near_duplicate(nove
         pytest.skip(f"MiniLM not installed ({novelty.embedding}): only the signature test runs")
     text = resolve_task("GenDex/PutAppleBowl-v1").spec.instruction
     why = novelty.near_duplicate((("lift",), ("peach",)), text)  # another task, worded exactly like one that exists
-    assert why is not None and "reads like GenDex/PutAppleBowl-v1" in why
+    assert why is not None and "reads like GenDex/PutAppleBowl-v" in why  # v1 or a later version worded alike
 
 
 def test_the_offline_author_proposes_no_duplicate_of_the_library_or_of_its_own_batch():

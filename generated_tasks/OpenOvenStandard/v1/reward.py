@@ -1,0 +1,25 @@
+"""OpenOvenStandard: Open the door of the standard oven, to take out the warm leftovers.
+
+Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
+"""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+REWARD_MAX = 4.0
+
+
+def evaluate(env):
+    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    return {"fail": fail, "open_fraction": env.joint_open_fraction('oven')}
+
+
+def compute_dense_reward(env, obs, action, info):
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - env.handle_pos('oven'), dim=-1))
+    reward = reach + 2.0 * rt.fraction(info["open_fraction"])
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {"palm_to_handle": env.handle_pos('oven') - env.palm_pose.p}

@@ -1,0 +1,39 @@
+"""PutLemonInBoxWithLidLargeThenCloseBoxWithLidLarge3: Pop the lemon into the box with a lid, then
+close the lid of the box with a lid.
+
+Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
+"""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+REWARD_MAX = 7.0
+LIFT_M = 0.1
+PART_DONE_PLACE = 0.8
+
+
+def evaluate(env):
+    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    for name in ('lemon',):
+        fail = fail | (env.obj_pose(name).p[:, 2] < env.table_height - 0.05)  # fell off the table
+    return {"fail": fail, "height_0": env.obj_height('lemon'), "open_fraction_1": env.joint_open_fraction('box_with_lid')}
+
+
+def compute_dense_reward(env, obs, action, info):
+    reward = torch.zeros(env.num_envs, device=env.device)
+    gate = torch.ones(env.num_envs, device=env.device)
+    p = env.obj_pose('lemon').p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj('lemon')))
+    lifted = rt.lift(info["height_0"], LIFT_M)
+    carry = rt.place(p, env.obj_pose('box_with_lid').p) * (lifted > 0.5)
+    over = rt.place(p, env.obj_pose('box_with_lid').p)
+    done = (over > PART_DONE_PLACE) & (info["height_0"] < LIFT_M / 2)
+    reward = reward + gate * torch.where(done, torch.full_like(reach, 4.0), reach + grasp + lifted + carry)
+    gate = gate * done
+    d = rt.fraction((1.0 - info["open_fraction_1"]) / 0.9)
+    done = d > 0.99
+    reward = reward + gate * torch.where(done, torch.full_like(d, 2.0), 2.0 * d)
+    gate = gate * done
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)

@@ -1,0 +1,33 @@
+"""SetLemonLeftOfBowl: The smoothie blender is already humming: place the lemon to the left of the
+mixing bowl, before it bruises.
+
+Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
+"""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+REWARD_MAX = 5.0
+LIFT_M = 0.1
+
+
+def evaluate(env):
+    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    for name in ('lemon', 'bowl'):
+        fail = fail | (env.obj_pose(name).p[:, 2] < env.table_height - 0.05)  # fell off the table
+    return {"fail": fail, "height": env.obj_height('lemon')}
+
+
+def compute_dense_reward(env, obs, action, info):
+    p = env.obj_pose('lemon').p
+    reach = rt.reach(torch.linalg.norm(env.palm_pose.p - p, dim=-1))
+    grasp = rt.contact(env.agent.get_hand_group_obj_mean_force(env.obj('lemon')))
+    lifted = rt.lift(info["height"], LIFT_M)
+    carry = rt.place(p, env.obj_pose('bowl').p + torch.tensor([[-0.0000, 0.2520, 0.0]], device=env.device)) * (lifted > 0.5)
+    reward = reach + grasp + lifted + carry
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {"palm_to_obj": env.obj_pose('lemon').p - env.palm_pose.p}

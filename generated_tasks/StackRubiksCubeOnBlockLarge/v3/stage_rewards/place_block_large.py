@@ -1,0 +1,28 @@
+"""StackRubiksCubeOnBlockLarge, stage place_block_large: Set the rubiks cube down on the block large's top.
+
+Composed by GenDex's offline author from the vetted terms of gendex_envs.reward_terms.
+"""
+
+import torch
+
+from gendex_envs import reward_terms as rt
+
+REWARD_MAX = 3.0
+
+
+def evaluate(env):
+    fail = torch.zeros(env.num_envs, dtype=torch.bool, device=env.device)
+    for name in ('rubiks_cube', 'block_large', 'distractor_baseball'):
+        fail = fail | (env.obj_pose(name).p[:, 2] < env.table_height - 0.05)  # fell off the table
+    force = env.agent.get_hand_group_obj_mean_force(env.obj('block_large'))  # [N, 6, 1]
+    return {"fail": fail, "contact": rt.contact(force)}
+
+
+def compute_dense_reward(env, obs, action, info):
+    place = rt.place(env.obj_pose('block_large').p, env.obj_pose('block_large').p)
+    reward = 2.0 * place + info['contact']
+    return torch.where(info["success"], torch.full_like(reward, REWARD_MAX), reward)
+
+
+def _get_obs_extra(env, info):
+    return {"obj_to_target": env.obj_pose('block_large').p - env.obj_pose('block_large').p}
