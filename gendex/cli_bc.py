@@ -99,6 +99,10 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
                                                                          "joint state instead of the object poses."),
                        image_size: int = typer.Option(64, "--image-size", min=8, max=512,
                                                       help="With --camera: frames resized to this size."),
+                       task_balance: float = typer.Option(
+                           0.0, "--task-balance", min=0.0, max=1.0,
+                           help="How batches share out over tasks: 0 frames uniform (long demonstrations dominate), "
+                                "1 every task equally often."),
                        seed: int = typer.Option(0, "--seed")) -> None:
     """Train one language-conditioned policy on many tasks (state + environment state, or with --camera the
     camera's frames + joint state, and the instruction's MiniLM embedding); evaluate it with gendex eval --policy
@@ -112,11 +116,12 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
         show = lambda s, loss: typer.echo(f"  step {s}: loss {loss:.4f}", err=True)  # noqa: E731
         if camera is None:
             path = multitask.train(folders, out, embed_instructions, demos,
-                                   multitask.MultiTaskConfig(chunk=chunk, steps=steps, seed=seed), progress=show)
+                                   multitask.MultiTaskConfig(chunk=chunk, steps=steps, task_balance=task_balance,
+                                                             seed=seed), progress=show)
         else:
             path = pixels.train(folders, out, embed_instructions, demos,
                                 pixels.PixelConfig(camera=camera, image_size=image_size, chunk=chunk, steps=steps,
-                                                   seed=seed), progress=show)
+                                                   task_balance=task_balance, seed=seed), progress=show)
         typer.echo(f"wrote {path}")
     except (GenDexError, ValueError, OSError) as exc:
         die(exc)

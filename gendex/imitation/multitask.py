@@ -69,7 +69,32 @@ class MultiTaskConfig:
     """Std of the Gaussian noise added to normalized inputs while training."""
     ensemble_decay: float = 0.1
     """Temporal ensembling: the weight of a prediction made k steps ago is exp(-decay * k)."""
+    task_balance: float = 0.0
+    """How a batch shares out over tasks: 0 draws frames uniformly (a task's share is its share of the frames, so
+    long demonstrations dominate), 1 draws each task equally often; in between a task's share is frames^(1 - b)."""
     seed: int = 0
+
+    def __post_init__(self):
+        if not 0.0 <= self.task_balance <= 1.0:
+            raise ValueError(f"task_balance {self.task_balance!r} must be from 0 (frames uniform) to 1 (tasks equal)")
+
+
+class FrameSampler:
+    """Draws training rows from tasks laid end to end (``counts`` rows each), a task's share of the draws being
+    ``counts ** (1 - balance)`` normalised, uniform within a task."""
+
+    def __init__(self, counts: Sequence[int], balance: float, rng: np.random.Generator):
+        counts = np.asarray(counts, np.float64)
+        if counts.ndim != 1 or not len(counts) or (counts < 1).any():
+            raise ValueError(f"every task needs at least one frame; counts {counts.tolist()[:10]}")
+        share = counts ** (1.0 - balance)
+        per_row = np.repeat(share / share.sum() / counts, counts.astype(np.int64))
+        self.cdf = np.cumsum(per_row)
+        self.cdf /= self.cdf[-1]
+        self.rng = rng
+
+    def __call__(self, size: int) -> np.ndarray:
+        return np.minimum(np.searchsorted(self.cdf, self.rng.random(size), side="right"), len(self.cdf) - 1)
 
 
 @dataclass(frozen=True)
@@ -172,7 +197,7 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     threads = torch.get_num_threads()
     torch.set_num_threads(1)  # as the single-task baseline: an MLP's threads only contend on two cores
     try:
-        model, xn, yn, curve, seconds = _fit(x, y, config, progress)
+        model, xn, yn, curve, seconds = _fit(x, y, [len(c) for c in xs], config, progress)
     finally:
         torch.set_num_threads(threads)
     out = Path(out)
@@ -195,9 +220,9 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     return path
 
 
-def _fit(x: np.ndarray, y: np.ndarray, config: MultiTaskConfig, progress):
+def _fit(x: np.ndarray, y: np.ndarray, counts: Sequence[int], config: MultiTaskConfig, progress):
     torch.manual_seed(config.seed)
-    rng = np.random.default_rng(config.seed)
+    sample = FrameSampler(counts, config.task_balance, np.random.default_rng(config.seed))
     n, chunk, a = y.shape
     xn, yn = Normalizer.fit(x), Normalizer.fit(y.reshape(-1, a))
     xt = torch.as_tensor(xn(x))
@@ -207,7 +232,7 @@ def _fit(x: np.ndarray, y: np.ndarray, config: MultiTaskConfig, progress):
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, config.steps)
     t0, loss_avg, curve = time.perf_counter(), None, []
     for step in range(config.steps):
-        idx = torch.as_tensor(rng.integers(n, size=min(config.batch, n)))
+        idx = torch.as_tensor(sample(min(config.batch, n)))
         loss = (model(xt[idx] + config.obs_noise * torch.randn(len(idx), xt.shape[1])) - yt[idx]).abs().mean()
         opt.zero_grad()
         loss.backward()
@@ -280,5 +305,5 @@ def is_multitask(path: Path | str) -> bool:
     return load_checkpoint(path).get("kind") == KIND
 
 
-__all__ = ["KIND", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks", "instruction_embedding",
-           "is_multitask", "load_tasks", "train"]
+__all__ = ["KIND", "FrameSampler", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks",
+           "instruction_embedding", "is_multitask", "load_tasks", "train"]

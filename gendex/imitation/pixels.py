@@ -29,7 +29,14 @@ from torch import nn
 from gendex.imitation import bc
 from gendex.imitation.bc import _bad, _chunk_targets, _mlp
 from gendex.imitation.frames import DatasetReadError, load_images
-from gendex.imitation.multitask import Embed, PolicyTaskError, embed_tasks, instruction_embedding, load_tasks
+from gendex.imitation.multitask import (
+    Embed,
+    FrameSampler,
+    PolicyTaskError,
+    embed_tasks,
+    instruction_embedding,
+    load_tasks,
+)
 from gendex_envs.observation import IMAGES, STATE
 
 log = logging.getLogger(__name__)
@@ -59,7 +66,13 @@ class PixelConfig:
     weight_decay: float = 1e-4
     obs_noise: float = 0.02
     ensemble_decay: float = 0.1
+    task_balance: float = 0.0
+    """As :attr:`gendex.imitation.multitask.MultiTaskConfig.task_balance`."""
     seed: int = 0
+
+    def __post_init__(self):
+        if not 0.0 <= self.task_balance <= 1.0:
+            raise ValueError(f"task_balance {self.task_balance!r} must be from 0 (frames uniform) to 1 (tasks equal)")
 
 
 class PixelNet(nn.Module):
@@ -117,7 +130,7 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     del images
     threads = torch.get_num_threads()
     try:
-        model, ln, yn, curve, seconds = _fit(image, low, y, config, progress)
+        model, ln, yn, curve, seconds = _fit(image, low, y, [len(v) for v in lows], config, progress)
     finally:
         torch.set_num_threads(threads)
     out = Path(out)
@@ -139,9 +152,10 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     return path
 
 
-def _fit(image: np.ndarray, low: np.ndarray, y: np.ndarray, config: PixelConfig, progress):
+def _fit(image: np.ndarray, low: np.ndarray, y: np.ndarray, counts: Sequence[int], config: PixelConfig, progress):
     torch.manual_seed(config.seed)
     gen = torch.Generator().manual_seed(config.seed)
+    sample = FrameSampler(counts, config.task_balance, np.random.default_rng(config.seed))
     n, chunk, a = y.shape
     ln, yn = bc.Normalizer.fit(low), bc.Normalizer.fit(y.reshape(-1, a))
     it, lt = torch.from_numpy(image), torch.as_tensor(ln(low))
@@ -152,7 +166,7 @@ def _fit(image: np.ndarray, low: np.ndarray, y: np.ndarray, config: PixelConfig,
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, config.steps)
     t0, loss_avg, curve = time.perf_counter(), None, []
     for step in range(config.steps):
-        idx = torch.randint(0, n, (min(config.batch, n),), generator=gen)
+        idx = torch.as_tensor(sample(min(config.batch, n)))
         img = _shift(it[idx], config.shift, gen)
         inp = lt[idx] + config.obs_noise * torch.randn(len(idx), lt.shape[1], generator=gen)
         loss = (model(img, inp) - yt[idx]).abs().mean()

@@ -14,7 +14,7 @@ from gendex.data.episode import Episode
 from gendex.data.lerobot_v3 import LeRobotV3Writer
 from gendex.imitation.bc import load_policy
 from gendex.imitation.frames import DatasetReadError
-from gendex.imitation.multitask import MultiTaskConfig, MultiTaskPolicy, PolicyTaskError, train
+from gendex.imitation.multitask import FrameSampler, MultiTaskConfig, MultiTaskPolicy, PolicyTaskError, train
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 
 S, A = 4, 2
@@ -118,3 +118,21 @@ def test_datasets_of_other_robots_or_the_same_task_twice_are_refused(datasets, t
     with pytest.raises(DatasetReadError, match="given twice"):
         train([datasets[0], datasets[0]], tmp_path / "x", fake_embed, config=MultiTaskConfig(steps=1))
     assert not (tmp_path / "x").exists()  # nothing written for a refused training
+
+
+@pytest.mark.parametrize("balance, want", [(0.0, [0.01, 0.09, 0.90]), (1.0, [1 / 3, 1 / 3, 1 / 3])])
+def test_task_balance_shares_batches_out_over_tasks(balance, want):
+    counts = [10, 90, 900]
+    draws = FrameSampler(counts, balance, np.random.default_rng(3))(60_000)
+    assert draws.min() >= 0 and draws.max() < sum(counts)
+    share = np.bincount(np.searchsorted(np.cumsum(counts), draws, side="right"), minlength=3) / len(draws)
+    assert np.allclose(share, want, atol=0.01)
+    first = np.bincount(draws[draws < 10], minlength=10) / (draws < 10).sum()
+    assert np.allclose(first, 0.1, atol=0.03)  # uniform within a task
+
+
+def test_task_balance_out_of_range_is_refused():
+    with pytest.raises(ValueError, match="task_balance 1.5 must be from 0"):
+        MultiTaskConfig(task_balance=1.5)
+    with pytest.raises(ValueError, match="at least one frame"):
+        FrameSampler([5, 0], 0.5, np.random.default_rng(0))
