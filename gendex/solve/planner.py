@@ -9,6 +9,7 @@ more than ``max_step_rad`` apart, so a position-controlled arm tracks it closely
 from __future__ import annotations
 
 import logging
+import time
 from itertools import pairwise
 
 import numpy as np
@@ -21,22 +22,31 @@ log = logging.getLogger(__name__)
 
 START_SLACK_M = 0.002
 """A path from a start in collision may go this much deeper than the start (the check's own resolution)."""
+MAX_CHECKS = 20_000
+"""A search's budget: RRT-Connect stops after this many collision checks. Counted work, not seconds, so a search
+ends the same way on a loaded machine or a slow one (a wall-clock budget had made dataset builds differ with load)."""
+HANG_GUARD_S = 120.0
+"""Wall-clock guard only against a runaway search; the check budget ends every search long before it."""
 
 
 class PlanningError(GenDexError):
-    """No collision-free arm motion was found (start or goal in collision, or the search ran out of time)."""
+    """No collision-free arm motion was found (start or goal in collision, or the search used up its budget)."""
 
 
 class ArmPlanner:
     """Plans arm motions for one env; joint vectors are full [dof] vectors, only the arm entries move."""
 
     def __init__(self, collision: ArmCollisionModel, max_step_rad: float = 0.04, check_step_rad: float = 0.02,
-                 time_limit_s: float = 2.0, seed: int = 0):
+                 max_checks: int = MAX_CHECKS, seed: int = 0):
+        if max_checks < 1:
+            raise ValueError(f"max_checks {max_checks!r} must be a positive number of collision checks")
         self.collision = collision
         self.ik = collision.ik
         self.max_step_rad = max_step_rad
         self.check_step_rad = check_step_rad
-        self.time_limit_s = time_limit_s
+        self.max_checks = int(max_checks)
+        self.last_checks = 0
+        """Collision checks the last RRT-Connect search made (its share of :attr:`max_checks`)."""
         self.reseed(seed)
 
     def reseed(self, seed: int) -> None:
@@ -124,7 +134,13 @@ class ArmPlanner:
             q[arm] = [state[i] for i in range(len(arm))]
             return q
 
-        ss.setStateValidityChecker(lambda s: self._ok(full(s), floor))
+        checks = [0]
+
+        def valid(state) -> bool:
+            checks[0] += 1
+            return self._ok(full(state), floor)
+
+        ss.setStateValidityChecker(valid)
         si = ss.getSpaceInformation()
         span = float(np.max(hi - lo))
         si.setStateValidityCheckingResolution(self.check_step_rad / span)
@@ -133,9 +149,22 @@ class ArmPlanner:
             s0[i], s1[i] = float(start[arm[i]]), float(goal[arm[i]])
         ss.setStartAndGoalStates(s0, s1)
         ss.setPlanner(og.RRTConnect(si))
-        solved = ss.solve(self.time_limit_s)
+        guard = time.monotonic() + HANG_GUARD_S
+        budget = self.max_checks
+
+        def spent() -> bool:
+            if checks[0] >= budget:
+                return True
+            if time.monotonic() > guard:  # pragma: no cover - a guard, not a budget
+                log.warning("RRT-Connect stopped by its %.0f s guard after %d checks: this search's result depends "
+                            "on the machine's speed", HANG_GUARD_S, checks[0])
+                return True
+            return False
+
+        solved = ss.solve(ob.PlannerTerminationCondition(spent))
+        self.last_checks = checks[0]
         if not solved or not ss.haveExactSolutionPath():
-            raise PlanningError(f"RRT-Connect found no collision-free arm path in {self.time_limit_s:.1f} s")
+            raise PlanningError(f"RRT-Connect found no collision-free arm path in {self.max_checks} collision checks")
         ss.simplifySolution()
         states = ss.getSolutionPath().getStates()
         path = [full(s) for s in states]

@@ -89,7 +89,7 @@ def _pan(apple_env):
     apple_env.reset(seed=0)
     ik = ArmIK(env.agent)
     model = ArmCollisionModel(ik)
-    planner = ArmPlanner(model, time_limit_s=5.0)
+    planner = ArmPlanner(model)
     q0 = env.agent.robot.get_qpos()[0].numpy().astype(np.float64)
     q1, mid = q0.copy(), q0.copy()
     q1[ik.arm[0]] += 1.2

@@ -65,7 +65,7 @@ def test_a_planned_motion_goes_over_a_structure_in_its_way(ik, rest):
     plan; with a 60 cm splashback standing across the table between the two ends, that motion is blocked, and the
     plan that comes back keeps every step clear of it (and of the table), lifting the arm over it."""
     col = ArmCollisionModel(ik)
-    planner = ArmPlanner(col, time_limit_s=5.0)
+    planner = ArmPlanner(col)
     a, b = _palm_at(ik, rest, [0.0, 0.3, 0.15]), _palm_at(ik, rest, [0.0, -0.3, 0.15])
     assert planner.segment_free(a, b)
     straight = planner.plan(a, b)
@@ -151,3 +151,31 @@ def test_an_env_with_a_scene_gives_its_planner_the_structures():
     assert {b.name for b in boxes} == {f"structure:{s.name}" for s in STYLES["kitchen"].structures}
     _Env.scenery = None
     assert scene_obstacles(_Env()) == []
+
+
+def test_a_search_ends_on_counted_checks_not_on_the_clock(ik, rest, monkeypatch):
+    """The search over the splashback, planned twice with the same seed: once as is, once with every collision check
+    slowed down (a loaded machine). The budget counts checks, so both plans are the same, waypoint for waypoint; a
+    budget below what the search needs fails, saying so (a wall-clock budget had made dataset builds differ with
+    the machine's load)."""
+    import time
+
+    col = ArmCollisionModel(ik)
+    col.set_static(_wall("backsplash", 0.6))
+    a, b = _palm_at(ik, rest, [0.0, 0.3, 0.15]), _palm_at(ik, rest, [0.0, -0.3, 0.15])
+    fast = ArmPlanner(col, seed=7)
+    first = fast.plan(a, b)
+    needed = fast.last_checks
+    assert 0 < needed < fast.max_checks
+
+    slow = ArmPlanner(col, seed=7)
+    check = slow._ok
+    monkeypatch.setattr(slow, "_ok", lambda q, floor: (time.sleep(2e-4), check(q, floor))[1])
+    np.testing.assert_array_equal(slow.plan(a, b), first)
+    assert slow.last_checks == needed
+
+    short = ArmPlanner(col, seed=7, max_checks=max(1, needed // 4))
+    with pytest.raises(PlanningError, match=f"in {max(1, needed // 4)} collision checks"):
+        short.plan(a, b)
+    with pytest.raises(ValueError, match="max_checks 0 must be a positive number"):
+        ArmPlanner(col, max_checks=0)
