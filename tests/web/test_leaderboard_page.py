@@ -89,3 +89,35 @@ def test_the_per_skill_columns_sort_in_the_browser(tmp_path, browser):
         th.click()  # descending: the best at this skill first
         assert methods()[0] == best and "sorted-desc" in th.get_attribute("class"), (skill, methods())
     assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == []
+
+
+def test_the_committed_board_sorts_by_every_skill_without_console_errors(tmp_path, browser):
+    """The real board (leaderboard/, every suite with results): each suite page loads without a console error, and
+    clicking a skill's column orders the methods by that skill's success, descending on the second click."""
+    from selenium.webdriver.common.by import By
+
+    from gendex.eval.leaderboard import LEADERBOARD_DIR, suites_with_results
+
+    build_site(tmp_path / "site", LEADERBOARD_DIR)
+    names = suites_with_results(LEADERBOARD_DIR)
+    assert "gendex-skills-v2" in names
+    sorted_skills = 0
+    for name in names:
+        browser.get((tmp_path / "site" / f"{name}.html").as_uri())
+        assert browser.title == f"GenDex leaderboard: {name}"
+        heads = browser.find_elements(By.CSS_SELECTOR, 'th[data-key^="skill-"]')
+        col = {th.get_attribute("data-key"): i for i, th in
+               enumerate(browser.find_elements(By.CSS_SELECTOR, "table.board th[data-key]"))} if heads else {}
+        for key in [th.get_attribute("data-key") for th in heads]:
+            th = browser.find_element(By.CSS_SELECTOR, f'th[data-key="{key}"]')
+            th.click()
+            th.click()
+            rows = browser.find_elements(By.CSS_SELECTOR, "tr.entry")
+            values = [float(r.find_elements(By.TAG_NAME, "td")[col[key]].get_attribute("data-value") or "nan")
+                      for r in rows]
+            present = [v for v in values if v == v]
+            assert present == sorted(present, reverse=True), (name, key, values)
+            assert "sorted-desc" in th.get_attribute("class")
+            sorted_skills += 1
+        assert [e for e in browser.get_log("browser") if e["level"] == "SEVERE"] == [], name
+    assert sorted_skills >= 13  # gendex-skills-v2 alone has a column for each of its skills
