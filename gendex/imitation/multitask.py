@@ -75,8 +75,13 @@ class MultiTaskConfig:
     seed: int = 0
 
     def __post_init__(self):
-        if not 0.0 <= self.task_balance <= 1.0:
-            raise ValueError(f"task_balance {self.task_balance!r} must be from 0 (frames uniform) to 1 (tasks equal)")
+        check_task_balance(self.task_balance)
+
+
+def check_task_balance(value: float) -> None:
+    """ValueError unless ``value`` is a task balance (:attr:`MultiTaskConfig.task_balance`): from 0 to 1."""
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"task_balance {value!r} must be from 0 (frames uniform) to 1 (tasks equal)")
 
 
 class FrameSampler:

@@ -33,6 +33,7 @@ from gendex.imitation.multitask import (
     Embed,
     FrameSampler,
     PolicyTaskError,
+    check_task_balance,
     embed_tasks,
     instruction_embedding,
     load_tasks,
@@ -71,8 +72,7 @@ class PixelConfig:
     seed: int = 0
 
     def __post_init__(self):
-        if not 0.0 <= self.task_balance <= 1.0:
-            raise ValueError(f"task_balance {self.task_balance!r} must be from 0 (frames uniform) to 1 (tasks equal)")
+        check_task_balance(self.task_balance)
 
 
 class PixelNet(nn.Module):
