@@ -103,7 +103,10 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
                            0.0, "--task-balance", min=0.0, max=1.0,
                            help="How batches share out over tasks: 0 frames uniform (long demonstrations dominate), "
                                 "1 every task equally often."),
-                       seed: int = typer.Option(0, "--seed")) -> None:
+                       seed: int = typer.Option(0, "--seed"),
+                       threads: int = typer.Option(1, "--threads", min=1,
+                                                   help="Torch threads for the fit (state policy); more help only "
+                                                        "on cores nothing else uses.")) -> None:
     """Train one language-conditioned policy on many tasks (state + environment state, or with --camera the
     camera's frames + joint state, and the instruction's MiniLM embedding); evaluate it with gendex eval --policy
     bc:OUT/bc.pt."""
@@ -117,7 +120,7 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
         if camera is None:
             path = multitask.train(folders, out, embed_instructions, demos,
                                    multitask.MultiTaskConfig(chunk=chunk, steps=steps, task_balance=task_balance,
-                                                             seed=seed), progress=show)
+                                                             seed=seed), progress=show, threads=threads)
         else:
             path = pixels.train(folders, out, embed_instructions, demos,
                                 pixels.PixelConfig(camera=camera, image_size=image_size, chunk=chunk, steps=steps,

@@ -136,3 +136,16 @@ def test_task_balance_out_of_range_is_refused():
         MultiTaskConfig(task_balance=1.5)
     with pytest.raises(ValueError, match="at least one frame"):
         FrameSampler([5, 0], 0.5, np.random.default_rng(0))
+
+
+def test_the_fit_runs_on_the_threads_asked_and_gives_them_back(datasets, tmp_path):
+    import torch
+
+    before = torch.get_num_threads()
+    train(datasets, tmp_path / "mt", fake_embed, config=MultiTaskConfig(chunk=2, steps=3, hidden=16, layers=1),
+          threads=2)
+    assert json.loads((tmp_path / "mt" / "bc.json").read_text())["threads"] == 2
+    assert torch.get_num_threads() == before
+    with pytest.raises(ValueError, match="threads 0 must be at least 1"):
+        train(datasets, tmp_path / "none", fake_embed, config=MultiTaskConfig(steps=1), threads=0)
+    assert not (tmp_path / "none").exists()
