@@ -1,8 +1,8 @@
 """Run INSIDE the lerobot side venv (scripts/lerobot_venv.sh), not the project's: load GenDex datasets with lerobot's
 own LeRobotDataset, decode a frame of each video feature, ask lerobot's ACT config whether it accepts the
 dataset's features, and normalise a frame's state and action as pi0.5 does (lerobot's NormalizerProcessorStep in
-QUANTILES mode, from the dataset's stats: it needs q01 and q99). Prints one JSON object per dataset; exits 0 unless a
-dataset fails to load.
+QUANTILES mode, from the dataset's stats: it needs q01 and q99; a value beyond 100 is reported as degenerate stats).
+Prints one JSON object per dataset; exits 0 unless a dataset fails to load.
 
     .venv-lerobot/bin/python scripts/lerobot_check.py DATASET_ROOT [DATASET_ROOT ...]
 """
@@ -12,6 +12,9 @@ from __future__ import annotations
 import json
 import os
 import sys
+
+LARGEST_SANE = 100.0
+"""A normalised value beyond this is a stats defect, not data: quantile normalisation maps q01..q99 to [-1, 1]."""
 
 
 def check(root: str) -> dict:
@@ -62,7 +65,10 @@ def _pi05_normalisation(ds, features, item) -> str:
     values = torch.cat([v.flatten() for v in [*out[TransitionKey.OBSERVATION].values(), out[TransitionKey.ACTION]]])
     if not bool(torch.isfinite(values).all()):
         return "refused: non-finite normalised values"
-    return f"accepted (normalised values in [{float(values.min()):.2f}, {float(values.max()):.2f}])"
+    span = f"[{float(values.min()):.2f}, {float(values.max()):.2f}]"
+    if float(values.abs().max()) > LARGEST_SANE:
+        return f"degenerate (normalised values in {span}: a q01 == q99 where the frames differ)"
+    return f"accepted (normalised values in {span})"
 
 
 def _flat_quantiles(ds) -> dict[str, int]:

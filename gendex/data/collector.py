@@ -63,7 +63,7 @@ class CollectConfig:
     """Camera images as MP4 videos with this encoder (LeRobot v3.0's ``videos/``), or None: PNG in the parquet."""
     conventions: int = 1
     """The LeRobot dataset's stats (:class:`~gendex.data.lerobot_v3.LeRobotV3Writer`): 1 as the published datasets,
-    2 lerobot 0.4's (with the quantiles q01 ... q99)."""
+    2 lerobot 0.4's (with the quantiles q01 ... q99), 3 as 2 with the dataset's quantiles over all its frames."""
 
     def env_kwargs(self) -> dict:
         """The exact ``gym.make`` keyword arguments of the collection's env (recorded in the dataset)."""

@@ -2,7 +2,8 @@
 
 A manifest (``datasets/<name>.yaml``) says what a dataset is: its tasks with episodes and seeds per task, the
 solver, cameras, resolution and video codec, the stats' ``conventions`` (1, the default: as published; 2: lerobot
-0.4's, with quantiles), the GenDex version, and the SHA-256 of every file of the built dataset. From it,
+0.4's, with quantiles; 3: as 2, quantiles over all frames), the GenDex version, and the SHA-256 of every file of the
+built dataset. From it,
 
 - :func:`build` collects each task with ``gendex.data.collector`` into ``<out>/<task>/`` (a LeRobot v3.0 dataset
   in ``lerobot/`` with its card; resumable: a killed build goes on where it stopped; ``workers`` processes per task)
@@ -99,8 +100,9 @@ class DatasetManifest:
     video_codec: str | None = "libsvtav1"
     conventions: int = 1
     """The LeRobot conventions of the built dataset's stats: 1 (the default, what the published manifests build)
-    min/max/mean/std/count; 2 lerobot 0.4's, also the quantiles q01/q10/q50/q90/q99 (:mod:`gendex.data.lerobot_v3`).
-    Written to the manifest file and the build record only when it is not 1, so those stay as published."""
+    min/max/mean/std/count; 2 lerobot 0.4's, also the quantiles q01/q10/q50/q90/q99 (:mod:`gendex.data.lerobot_v3`);
+    3 as 2, with ``stats.json``'s quantiles over all frames (what pi0.5's normalisation needs). Written to the
+    manifest file and the build record only when it is not 1, so those stay as published."""
     checksums: dict[str, str] = field(default_factory=dict)
     """Path in the built dataset -> SHA-256 (hex) of its bytes; empty until a build was recorded."""
     built_with: BuiltWith | None = None
@@ -133,7 +135,7 @@ def _check(m: DatasetManifest) -> DatasetManifest:
         problems.append(f"video_codec {m.video_codec!r} is not one of {sorted(CODECS)} or null")
     if type(m.conventions) is not int or m.conventions not in CONVENTIONS:
         problems.append(f"conventions {m.conventions!r} is not one of {list(CONVENTIONS)} (1: stats as published; "
-                        "2: lerobot 0.4's, with quantiles)")
+                        "2: lerobot 0.4's, with quantiles; 3: as 2, quantiles over all frames)")
     if problems:
         raise DatasetError(f"dataset manifest {m.name!r}: " + "; ".join(problems))
     return m

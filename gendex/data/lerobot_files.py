@@ -27,9 +27,17 @@ JOURNAL_PATH = "meta/.commit.json"
 STAT_NAMES = ("min", "max", "mean", "std", "count")
 QUANTILES = {"q01": 0.01, "q10": 0.10, "q50": 0.50, "q90": 0.90, "q99": 0.99}
 """lerobot 0.4's quantile stats (``compute_stats.DEFAULT_QUANTILES``, keyed ``q{int(q * 100):02d}``)."""
-CONVENTIONS = (1, 2)
+CONVENTIONS = (1, 2, 3)
 """How a dataset's stats are written: 1 as the published GenDex datasets (``STAT_NAMES``), 2 as lerobot 0.4 writes
-them (``STAT_NAMES`` and the ``QUANTILES``, which pi0.5's quantile normalisation needs)."""
+them (``STAT_NAMES`` and the ``QUANTILES``, which pi0.5's quantile normalisation needs), 3 the same stats, but the
+quantiles of every non-image feature in ``stats.json`` those of all the dataset's frames (see
+:data:`POOLED_QUANTILES`)."""
+POOLED_QUANTILES = 3
+"""The conventions whose ``stats.json`` holds the quantiles of every frame of the dataset (non-image features).
+lerobot 0.4 aggregates each quantile as the count-weighted mean of the episodes' (``aggregate_feature_stats``), so a
+value that is constant within each episode but differs between episodes (which fingers a grasp curls) gets q01 ==
+q99 while its min and max differ: pi0.5's quantile normalisation then divides by its epsilon (1e-8) and turns such
+a frame into values of 1e7 and more. Images keep the episodes' mean (pi0.5 does not normalise them by quantiles)."""
 
 
 class LeRobotDatasetError(EpisodeError):
@@ -40,8 +48,9 @@ def stat_names(conventions: int) -> tuple[str, ...]:
     """The stats of each feature a dataset of ``conventions`` holds, in the order they are written."""
     if type(conventions) is not int or conventions not in CONVENTIONS:
         raise LeRobotDatasetError(f"conventions {conventions!r} is not one of {list(CONVENTIONS)} (1: min/max/mean/"
-                                  f"std/count as published; 2: lerobot 0.4's, with the quantiles {list(QUANTILES)})")
-    return STAT_NAMES + (tuple(QUANTILES) if conventions == 2 else ())
+                                  f"std/count as published; 2: lerobot 0.4's, with the quantiles {list(QUANTILES)}; 3: "
+                                  f"as 2, the dataset's quantiles over all its frames)")
+    return STAT_NAMES + (tuple(QUANTILES) if conventions >= 2 else ())
 
 
 # --------------------------------------------------------------------------------------------- atomic files
@@ -101,6 +110,60 @@ def _quantiles(x: np.ndarray) -> dict[str, np.ndarray]:
     values; lerobot estimates them from a histogram)."""
     values = np.quantile(x, list(QUANTILES.values()), axis=0)
     return {name: np.asarray(v, np.float64) for name, v in zip(QUANTILES, values, strict=True)}
+
+
+def _pooled_quantiles(stats: dict[str, dict[str, np.ndarray]],
+                      values: dict[str, list[np.ndarray]]) -> dict[str, dict[str, np.ndarray]]:
+    """``stats`` with the quantiles of each feature in ``values`` replaced by those of all its frames (``values``:
+    per feature, the episodes' arrays, [T] or [T, D], in any order: a quantile does not depend on it)."""
+    out = dict(stats)
+    for key, parts in values.items():
+        x = np.concatenate([np.asarray(p, np.float64) for p in parts])
+        out[key] = {**stats[key], **_quantiles(x[:, None] if x.ndim == 1 else x)}
+    return out
+
+
+def _numeric_values(table: pa.Table, keys: list[str]) -> dict[str, np.ndarray]:
+    """The columns ``keys`` of ``table`` as float64 arrays ([T] or, for a vector feature, [T, D])."""
+    out = {}
+    for key in keys:
+        col = table.column(key).combine_chunks()
+        if pa.types.is_fixed_size_list(col.type):
+            arr = col.flatten().to_numpy(zero_copy_only=False).reshape(len(col), col.type.list_size)
+        else:
+            arr = col.to_numpy(zero_copy_only=False)
+        out[key] = np.asarray(arr, np.float64)
+    return out
+
+
+def pool_quantiles(root: Path | str) -> Path:
+    """Rewrite the ``meta/stats.json`` of the published dataset at ``root`` (conventions 2 or 3) with the quantiles
+    of every non-image feature over all its frames: conventions 3's stats, the same bytes a conventions-3 writer
+    writes, without writing the dataset again. Returns the stats file's path."""
+    from gendex_envs.atomic_io import write_text
+
+    root = Path(root)
+    try:
+        info = json.loads((root / "meta" / "info.json").read_text())
+        stats = json.loads((root / "meta" / "stats.json").read_text())
+    except (OSError, ValueError) as exc:
+        raise LeRobotDatasetError(f"{root}: not a published LeRobot v3.0 dataset ({exc})") from None
+    keys = [k for k, ft in info["features"].items() if ft["dtype"] not in ("video", "image")]
+    missing = [k for k in keys if set(QUANTILES) - set(stats.get(k, {}))]
+    if missing:
+        raise LeRobotDatasetError(f"{root}: stats.json has no quantiles for {missing}; only a dataset written with "
+                                  f"conventions 2 or 3 can have them pooled")
+    paths = sorted(root.glob("data/chunk-*/file-*.parquet"))
+    if not paths:
+        raise LeRobotDatasetError(f"{root} holds no data/chunk-*/file-*.parquet files")
+    values: dict[str, list[np.ndarray]] = {k: [] for k in keys}
+    for path in paths:
+        for k, v in _numeric_values(pq.read_table(path, columns=keys), keys).items():
+            values[k].append(v)
+    arrays = {k: {s: np.asarray(v) for s, v in d.items()} for k, d in stats.items()}
+    path = root / "meta" / "stats.json"
+    write_text(path, json.dumps(_jsonable(_pooled_quantiles(arrays, values)), indent=4, ensure_ascii=False) + "\n")
+    return path
 
 
 def _array_stats(x: np.ndarray, quantiles: bool = False) -> dict[str, np.ndarray]:

@@ -43,8 +43,11 @@ is cleared. So:
 min/max/mean/std/count, as the published GenDex datasets hold them; 2 writes lerobot 0.4's stats, those and the
 quantiles q01, q10, q50, q90 and q99 (pi0.5 normalises state and action by q01/q99): each episode's exact quantiles
 per dimension (images: per channel over every pixel, scaled to [0, 1]) in its episode row, and in ``stats.json`` their
-count-weighted mean over the episodes, as lerobot aggregates them. A root is appended to only with the conventions
-it was written with.
+count-weighted mean over the episodes, as lerobot aggregates them; 3 writes the same, but in ``stats.json`` the
+quantiles of each non-image feature over all the dataset's frames (a value constant within episodes that differ
+otherwise collapses to q01 == q99 in lerobot's mean: :data:`~gendex.data.lerobot_files.POOLED_QUANTILES`). A root is
+appended to only with the stats it was written with (2 and 3 hold the same stat names: the writer cannot tell them
+apart on disk).
 
 One writer per root at a time.
 """
@@ -64,6 +67,7 @@ from gendex.data.episode import Episode, EpisodeError
 from gendex.data.lerobot_files import (
     CONVENTIONS,
     DATA_PATH,
+    POOLED_QUANTILES,
     QUANTILES,
     STAT_NAMES,
     VIDEO_PATH,
@@ -76,10 +80,12 @@ from gendex.data.lerobot_files import (
     _image_stats,
     _jsonable,
     _next_file,
+    _numeric_values,
     _OpenData,
     _OpenVideo,
     _packet_bytes,
     _png_column,
+    _pooled_quantiles,
     _recover,
     _tasks_table,
     _tmp,
@@ -159,6 +165,7 @@ class LeRobotV3Writer:
         self._rows: list[dict] = []  # episodes parquet rows
         self._tasks: dict[str, int] = {}
         self._stats: dict | None = None
+        self._values: dict[str, list[np.ndarray]] = {}  # conventions 3: every frame's non-image values
         self._n_frames = 0
         self._data: _OpenData | None = None
         self._videos: dict[str, _OpenVideo] = {}
@@ -253,6 +260,9 @@ class LeRobotV3Writer:
         self._published = len(self._rows)
         if self._rows:
             self._stats = _fold([self._row_stats(r) for r in self._rows])
+            if self.conventions == POOLED_QUANTILES:
+                for path in sorted(self.root.glob("data/chunk-*/file-*.parquet")):
+                    self._keep_values(pq.read_table(path, columns=self._pooled_keys()))
             self._reopen(self._rows[-1])
         log.info("resuming %s: %d episodes, %d frames, %d tasks", self.root, len(self._rows), self._n_frames,
                  len(self._tasks))
@@ -327,6 +337,15 @@ class LeRobotV3Writer:
         return {k: self.root / PENDING_DIR / f"episode-{e:06d}.{k}.mp4" for k, ft in self.features.items()
                 if ft["dtype"] == "video"}
 
+    def _pooled_keys(self) -> list[str]:
+        return [k for k, ft in self.features.items() if ft["dtype"] not in ("video", "image")]
+
+    def _keep_values(self, table: pa.Table) -> None:
+        """Conventions 3: keep the non-image columns of ``table`` (an episode's rows, or a published data file's)
+        for the dataset's quantiles."""
+        for key, arr in _numeric_values(table, self._pooled_keys()).items():
+            self._values.setdefault(key, []).append(arr)
+
     def _row_stats(self, row: dict) -> dict[str, dict[str, np.ndarray]]:
         return {k: {s: np.asarray(row[f"stats/{k}/{s}"]) for s in self.stat_names} for k in self.features}
 
@@ -384,7 +403,7 @@ class LeRobotV3Writer:
                    "task_index": np.full(t, task_index, np.int64)}
         if self.environment_state_names:
             numeric["observation.environment_state"] = np.asarray(ep.environment_state[:t], np.float32)
-        columns, ep_stats, videos, quantiles = {}, {}, {}, self.conventions == 2
+        columns, ep_stats, videos, quantiles = {}, {}, {}, self.conventions >= 2
         for key, ft in self.features.items():
             if ft["dtype"] == "video":
                 images = ep.images[key.removeprefix("observation.images.")][:t]
@@ -461,6 +480,8 @@ class LeRobotV3Writer:
         self._rows.append(row)
         self._tasks.setdefault(instruction, len(self._tasks))
         self._stats = ep_stats if self._stats is None else _aggregate([self._stats, ep_stats])
+        if self.conventions == POOLED_QUANTILES:
+            self._keep_values(table)
         self._n_frames = start + t
 
     def _abandon(self) -> None:
@@ -491,6 +512,8 @@ class LeRobotV3Writer:
                      *(v.finish() for v in self._videos.values())]
             self._data, self._videos, self._finished = None, {}, []
             rows, tasks, stats = self._rows, self._tasks, self._stats
+            if self.conventions == POOLED_QUANTILES:
+                stats = _pooled_quantiles(stats, self._values)
             if any(APPEARANCE in row for row in rows):  # one column for all rows: parquet takes the first's keys
                 rows = [row if APPEARANCE in row else {**row, APPEARANCE: "{}"} for row in rows]
             info = self._info(len(rows), self._n_frames, tasks)

@@ -73,8 +73,8 @@ def _manifest_file(tmp_path: Path, **changes) -> Path:
     ({"tasks": [{"task": "PutAppleBowl", "episodes": 3}]}, "not a versioned GenDex id"),
     ({"tasks": [{"task": "GenDex/PutAppleBowl-v1", "episodes": 5, "max_attempts": 2}]}, "must be >= 1 and <="),
     ({"tasks": [{"task": "GenDex/PutAppleBowl-v1", "episodes": 3, "colour": "red"}]}, "colour"),
-    ({"conventions": 3}, r"conventions 3 is not one of \[1, 2\]"),
-    ({"conventions": True}, r"conventions True is not one of \[1, 2\]"),
+    ({"conventions": 4}, r"conventions 4 is not one of \[1, 2, 3\]"),
+    ({"conventions": True}, r"conventions True is not one of \[1, 2, 3\]"),
     ({"conventions": "2"}, "wrong value type for field \"conventions\""),
 ])
 def test_a_bad_manifest_is_refused_with_what_is_wrong(tmp_path, changes, message):
@@ -133,7 +133,7 @@ def test_the_published_manifests_are_conventions_1_and_save_as_the_same_bytes(tm
         assert (tmp_path / f"{name}.yaml").read_bytes() == (DATASETS_DIR / f"{name}.yaml").read_bytes(), name
 
 
-@pytest.mark.parametrize("conventions", [1, 2])
+@pytest.mark.parametrize("conventions", [1, 2, 3])
 def test_build_hands_the_manifests_conventions_to_the_collector(tmp_path, monkeypatch, conventions):
     """No simulation: the collector is replaced by one that records its config. A conventions-1 build record has
     exactly the keys published records have."""

@@ -1,5 +1,6 @@
 """The writer's ``conventions``: 1 writes the stats the published datasets hold (pinned byte for byte), 2 lerobot
-0.4's, with the quantiles q01/q10/q50/q90/q99 pi0.5 normalises by; resume and replay keep the bytes in both; and
+0.4's, with the quantiles q01/q10/q50/q90/q99 pi0.5 normalises by, 3 those with the dataset's quantiles over all its
+frames; resume and replay keep the bytes in each; and
 lerobot 0.4's video layout (one file per camera, episodes remuxed into it), which both conventions write."""
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import pytest
 from test_lerobot_v3 import FPS, _smooth_episode, assert_consistent, make_episode, meta, writer
 
 from gendex.data import lerobot_v3 as lv3
-from gendex.data.lerobot_files import QUANTILES, STAT_NAMES, stat_names
+from gendex.data.lerobot_files import QUANTILES, STAT_NAMES, pool_quantiles, stat_names
 from gendex.data.lerobot_v3 import LeRobotDatasetError
 
 Q_NAMES = ["q01", "q10", "q50", "q90", "q99"]
@@ -40,7 +41,7 @@ def _files(root: Path) -> dict[str, bytes]:
 def test_the_quantile_names_are_lerobots():
     assert list(QUANTILES) == [f"q{int(q * 100):02d}" for q in [0.01, 0.10, 0.50, 0.90, 0.99]] == Q_NAMES
     assert stat_names(1) == STAT_NAMES == ("min", "max", "mean", "std", "count")
-    assert stat_names(2) == (*STAT_NAMES, *Q_NAMES)
+    assert stat_names(2) == stat_names(3) == (*STAT_NAMES, *Q_NAMES)
 
 
 def test_conventions_1_is_the_default_and_writes_the_published_stats_byte_for_byte(tmp_path):
@@ -114,14 +115,53 @@ def test_pi05_quantile_normalisation_of_the_written_stats_is_finite_and_spans_mi
             assert np.all(np.abs(y).max(0) < 1.5), key
 
 
+def test_conventions_3_pools_the_quantiles_over_every_frame(tmp_path):
+    """A value constant within each episode but not between them (which fingers a grasp curls): lerobot's mean of the
+    episodes' quantiles (conventions 2) gives q01 == q99 inside a wider min..max, and pi0.5's normalisation turns a
+    frame into ~1e8; the dataset's own quantiles (conventions 3) keep it within [-1, 1]. Nothing else differs."""
+    episodes = []
+    for seed, curl in enumerate([0.0, 0.0, 0.0, 1.4, 0.0]):
+        ep = make_episode(20 + seed, seed)
+        ep.action[:, 1] = curl
+        episodes.append(ep)
+    two, three = (_write(tmp_path / f"c{c}", episodes, conventions=c) for c in (2, 3))
+    _, stats2, rows2 = meta(two)
+    _, stats3, rows3 = meta(three)
+    assert rows3.to_pylist() == rows2.to_pylist()  # each episode's own quantiles, as lerobot writes them
+    frames = lv3.read_episode_frames(three)
+    for key in NUMERIC:
+        x = np.asarray(frames[key].to_pylist(), np.float64).reshape(frames.num_rows, -1)
+        for q, level in QUANTILES.items():
+            np.testing.assert_array_equal(stats3[key][q], np.quantile(x, level, axis=0), err_msg=f"{key} {q}")
+        assert {s: stats3[key][s] for s in STAT_NAMES} == {s: stats2[key][s] for s in STAT_NAMES}
+    assert stats3["observation.images.front"] == stats2["observation.images.front"]  # images: as lerobot's
+
+    def pi05(stats, x):
+        q01, q99 = np.asarray(stats["action"]["q01"]), np.asarray(stats["action"]["q99"])
+        return 2 * (x - q01) / np.where(q99 - q01 == 0, 1e-8, q99 - q01) - 1
+
+    curled = episodes[3].action[0].astype(np.float64)
+    assert stats2["action"]["q01"][1] == stats2["action"]["q99"][1] < stats2["action"]["max"][1]
+    assert abs(pi05(stats2, curled)[1]) > 1e6
+    assert stats3["action"]["q01"][1] == 0.0 and stats3["action"]["q99"][1] == pytest.approx(1.4)
+    y = pi05(stats3, np.asarray(frames["action"].to_pylist(), np.float64))
+    assert np.all(np.abs(y[:, 1]) <= 1.0 + 1e-6) and np.abs(y).max() < 1.5  # beyond q01..q99: the tails only
+    # a published conventions-2 dataset pooled afterwards: conventions 3's bytes, every file
+    pool_quantiles(two)
+    assert _files(two) == _files(three)
+    with pytest.raises(LeRobotDatasetError, match=r"no quantiles for \['observation.state'.*conventions 2 or 3"):
+        pool_quantiles(_write(tmp_path / "c1", episodes[:1]))
+
+
+@pytest.mark.parametrize("conventions", [2, 3])
 @pytest.mark.parametrize("codec", [None, "libx264"])
-def test_conventions_2_resumed_or_killed_writes_the_same_bytes(tmp_path, codec):
+def test_conventions_with_quantiles_resumed_or_killed_write_the_same_bytes(tmp_path, codec, conventions):
     """Closed and reopened, or killed with journaled episodes and replayed: the same files as one session (the
     per-episode quantiles come back from the episodes parquet and from the journal)."""
     eps = [_smooth_episode(6, 1), _smooth_episode(4, 2), _smooth_episode(5, 3)]
 
     def open_writer(root):
-        return writer(root, cameras={"front": (16, 24)}, video_codec=codec, conventions=2)
+        return writer(root, cameras={"front": (16, 24)}, video_codec=codec, conventions=conventions)
 
     roots = [tmp_path / "once", tmp_path / "reopened", tmp_path / "killed"]
     with open_writer(roots[0]) as w:
@@ -167,9 +207,9 @@ def test_a_root_is_appended_to_only_with_the_conventions_it_was_written_with(tmp
         "stats/action/q01") == 1
 
 
-@pytest.mark.parametrize("value", [0, 3, True, "2", 2.0, None])
-def test_conventions_must_be_1_or_2(tmp_path, value):
-    with pytest.raises(LeRobotDatasetError, match=rf"conventions {value!r} is not one of \[1, 2\]"):
+@pytest.mark.parametrize("value", [0, 4, True, "2", 2.0, None])
+def test_conventions_must_be_1_2_or_3(tmp_path, value):
+    with pytest.raises(LeRobotDatasetError, match=rf"conventions {value!r} is not one of \[1, 2, 3\]"):
         writer(tmp_path / "x", conventions=value)
     assert not (tmp_path / "x").exists()
 
