@@ -48,7 +48,7 @@ def test_the_shipped_manifests_load_and_cover_what_the_issue_asks(committed_task
     assert load_manifest("gendex-smoke").checksums  # built and recorded: the tests rebuild it byte for byte
 
 
-def test_the_library_dataset_v2_is_every_task_of_the_v2_suites_with_a_camera_and_quantile_stats():
+def test_the_library_dataset_v2_is_every_task_of_the_v2_suites_with_a_camera_and_pooled_quantile_stats():
     from gendex.eval.suite import load_suite, suite_task_digests
 
     m = load_manifest("gendex-lib-v2")
@@ -56,7 +56,7 @@ def test_the_library_dataset_v2_is_every_task_of_the_v2_suites_with_a_camera_and
                    for t in load_suite(name).tasks}
     assert {t.task for t in m.tasks} == suite_tasks == set(load_suite("gendex-lib-v2").tasks)
     assert suite_task_digests(load_suite("gendex-lib-v2"))  # each a committed task version
-    assert min(t.episodes for t in m.tasks) >= 50 and m.cameras and m.conventions == 2 and m.video_codec
+    assert min(t.episodes for t in m.tasks) >= 50 and m.cameras and m.conventions == 3 and m.video_codec
 
 
 def _manifest_file(tmp_path: Path, **changes) -> Path:
