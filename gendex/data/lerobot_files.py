@@ -58,8 +58,13 @@ def _tmp(path: Path) -> Path:
     return path.with_name(f".{path.name}.tmp")
 
 
+def _json_text(obj) -> str:
+    """A meta JSON file's text, as lerobot writes them."""
+    return json.dumps(obj, indent=4, ensure_ascii=False) + "\n"
+
+
 def _write_json(obj, path: Path) -> None:
-    path.write_text(json.dumps(obj, indent=4, ensure_ascii=False) + "\n", encoding="utf-8")
+    path.write_text(_json_text(obj), encoding="utf-8")
 
 
 def _roll_forward(root: Path) -> bool:
@@ -146,10 +151,12 @@ def pool_quantiles(root: Path | str) -> Path:
     try:
         info = json.loads((root / "meta" / "info.json").read_text())
         stats = json.loads((root / "meta" / "stats.json").read_text())
-    except (OSError, ValueError) as exc:
-        raise LeRobotDatasetError(f"{root}: not a published LeRobot v3.0 dataset ({exc})") from None
-    keys = [k for k, ft in info["features"].items() if ft["dtype"] not in ("video", "image")]
-    missing = [k for k in keys if set(QUANTILES) - set(stats.get(k, {}))]
+        keys = [k for k, ft in info["features"].items() if ft["dtype"] not in ("video", "image")]
+        missing = [k for k in keys if not isinstance(stats.get(k), dict) or set(QUANTILES) - set(stats[k])]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise LeRobotDatasetError(f"{root}: not a published LeRobot v3.0 dataset: meta/info.json needs a `features` "
+                                  f"object of objects with a `dtype`, meta/stats.json an object per feature "
+                                  f"({type(exc).__name__}: {exc})") from None
     if missing:
         raise LeRobotDatasetError(f"{root}: stats.json has no quantiles for {missing}; only a dataset written with "
                                   f"conventions 2 or 3 can have them pooled")
@@ -158,11 +165,15 @@ def pool_quantiles(root: Path | str) -> Path:
         raise LeRobotDatasetError(f"{root} holds no data/chunk-*/file-*.parquet files")
     values: dict[str, list[np.ndarray]] = {k: [] for k in keys}
     for path in paths:
-        for k, v in _numeric_values(pq.read_table(path, columns=keys), keys).items():
+        try:
+            table = pq.read_table(path, columns=keys)
+        except (OSError, pa.ArrowException) as exc:
+            raise LeRobotDatasetError(f"{path}: not a data file with the columns {keys} ({exc})") from None
+        for k, v in _numeric_values(table, keys).items():
             values[k].append(v)
     arrays = {k: {s: np.asarray(v) for s, v in d.items()} for k, d in stats.items()}
     path = root / "meta" / "stats.json"
-    write_text(path, json.dumps(_jsonable(_pooled_quantiles(arrays, values)), indent=4, ensure_ascii=False) + "\n")
+    write_text(path, _json_text(_jsonable(_pooled_quantiles(arrays, values))))
     return path
 
 

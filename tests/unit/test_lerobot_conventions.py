@@ -151,6 +151,17 @@ def test_conventions_3_pools_the_quantiles_over_every_frame(tmp_path):
     assert _files(two) == _files(three)
     with pytest.raises(LeRobotDatasetError, match=r"no quantiles for \['observation.state'.*conventions 2 or 3"):
         pool_quantiles(_write(tmp_path / "c1", episodes[:1]))
+    (two / "data/chunk-000/file-000.parquet").write_bytes(b"PAR1 not parquet")
+    with pytest.raises(LeRobotDatasetError, match=r"file-000.parquet: not a data file with the columns"):
+        pool_quantiles(two)
+    for info, stats in [("[]", "{}"), ('{"features": {"a": {"dtype": "float32"}}}', '"x"'), ("{", "{}")]:
+        bad = tmp_path / "bad" / "meta"
+        bad.mkdir(parents=True, exist_ok=True)
+        (bad / "info.json").write_text(info)
+        (bad / "stats.json").write_text(stats)
+        with pytest.raises(LeRobotDatasetError, match=r"not a published LeRobot v3.0 dataset"):
+            pool_quantiles(bad.parent)
+        assert (bad / "stats.json").read_text() == stats  # nothing rewritten
 
 
 @pytest.mark.parametrize("conventions", [2, 3])
