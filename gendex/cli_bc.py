@@ -103,6 +103,10 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
                            0.0, "--task-balance", min=0.0, max=1.0,
                            help="How batches share out over tasks: 0 frames uniform (long demonstrations dominate), "
                                 "1 every task equally often."),
+                       joint_velocity: bool = typer.Option(
+                           False, "--joint-velocity/--no-joint-velocity",
+                           help="State policy: read the joint velocities as well as the positions (off: the fit "
+                                "leans on them and drifts in closed loop)."),
                        seed: int = typer.Option(0, "--seed"),
                        threads: int = typer.Option(1, "--threads", min=1,
                                                    help="Torch threads for the fit (state policy); more help only "
@@ -118,9 +122,9 @@ def bc_train_multitask(datasets: list[Path] = typer.Argument(..., help="LeRobot 
         typer.echo(f"training on {len(folders)} datasets", err=True)
         show = lambda s, loss: typer.echo(f"  step {s}: loss {loss:.4f}", err=True)  # noqa: E731
         if camera is None:
-            path = multitask.train(folders, out, embed_instructions, demos,
-                                   multitask.MultiTaskConfig(chunk=chunk, steps=steps, task_balance=task_balance,
-                                                             seed=seed), progress=show, threads=threads)
+            config = multitask.MultiTaskConfig(chunk=chunk, steps=steps, task_balance=task_balance,
+                                               joint_velocity=joint_velocity, seed=seed)
+            path = multitask.train(folders, out, embed_instructions, demos, config, progress=show, threads=threads)
         else:
             path = pixels.train(folders, out, embed_instructions, demos,
                                 pixels.PixelConfig(camera=camera, image_size=image_size, chunk=chunk, steps=steps,

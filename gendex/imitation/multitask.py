@@ -2,7 +2,8 @@
 baseline of the library datasets.
 
 It learns from several GenDex datasets at once (one task each, as ``gendex dataset build`` lays them out) and sees,
-per frame, what the single-task baseline (:mod:`gendex.imitation.bc`) sees: ``observation.state``,
+per frame, what the single-task baseline (:mod:`gendex.imitation.bc`) sees: ``observation.state`` (by default its
+joint positions only, not the velocities: :attr:`MultiTaskConfig.joint_velocity`),
 ``observation.environment_state`` and the step count; and the task's instruction, embedded once per task by a
 sentence encoder (all-MiniLM-L6-v2, the model the generator measures instruction diversity with; the caller passes
 the ``embed`` function, so this module needs no language model of its own). The environment states of different
@@ -72,10 +73,27 @@ class MultiTaskConfig:
     task_balance: float = 0.0
     """How a batch shares out over tasks: 0 draws frames uniformly (a task's share is its share of the frames, so
     long demonstrations dominate), 1 draws each task equally often; in between a task's share is frames^(1 - b)."""
+    joint_velocity: bool = False
+    """Whether the network reads the joint velocities of ``observation.state`` (its ``.vel`` entries) besides the
+    positions. Off by default: with them the fit leans on the velocity (the next target is nearly the position plus
+    the velocity's step) and the policy drifts in closed loop; without them single-task press went from 0/10 to 9/10
+    on held-out seeds (benchmarks/results/imitation.md). Checkpoints written before this field read them."""
     seed: int = 0
 
     def __post_init__(self):
         check_task_balance(self.task_balance)
+        if type(self.joint_velocity) is not bool:
+            raise ValueError(f"joint_velocity {self.joint_velocity!r} must be True or False")
+
+
+VELOCITY_SUFFIX = ".vel"
+"""How ``observation.state`` names a joint velocity (``<joint>.vel``; positions are ``<joint>.pos``)."""
+
+
+def state_columns(names: Sequence[str], joint_velocity: bool) -> np.ndarray:
+    """Indices of the ``observation.state`` entries (named ``names``) the network reads: all of them, or with
+    ``joint_velocity`` False all but the velocities."""
+    return np.array([i for i, n in enumerate(names) if joint_velocity or not n.endswith(VELOCITY_SUFFIX)], np.int64)
 
 
 def check_task_balance(value: float) -> None:
@@ -196,10 +214,11 @@ def train(datasets: Sequence[Path | str], out: Path | str, embed: Embed, demos: 
     tasks = load_tasks(datasets, demos)
     emb = embed_tasks(embed, tasks)
     world_dim = max(t.frames.environment_state.shape[1] for t in tasks)
+    keep = state_columns(tasks[0].frames.names[STATE], config.joint_velocity)
     xs, ys = [], []
     for t, e in zip(tasks, emb, strict=True):
         f = t.frames
-        xs.append(_inputs(f.state, f.environment_state, f.frame.astype(np.float32), e, world_dim))
+        xs.append(_inputs(f.state[:, keep], f.environment_state, f.frame.astype(np.float32), e, world_dim))
         ys.append(_chunk_targets(f, config.chunk))
     x, y = np.concatenate(xs), np.concatenate(ys)
     if x.shape[1] > MAX_FEATURES:
@@ -277,6 +296,13 @@ class MultiTaskPolicy(BCPolicy):
         if emb is None or emb.ndim != 2 or len(emb) != len(tasks) or not emb.is_floating_point() \
                 or not bool(torch.isfinite(emb).all()):
             raise _bad(self.path, "_embeddings must be a finite [tasks, E] float tensor, a row per task")
+        names, velocity = ckpt["names"].get(STATE) if isinstance(ckpt["names"], dict) else None, \
+            ckpt["config"].get("joint_velocity", True)
+        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+            raise _bad(self.path, f"names[{STATE!r}] must be the list of the state's entry names")
+        if type(velocity) is not bool:
+            raise _bad(self.path, f"config.joint_velocity {velocity!r} must be true or false")
+        self.state_names, self.keep = names, state_columns(names, velocity)
         self.instructions = dict(zip(tasks.values(), emb.numpy().astype(np.float32), strict=True))
         self.world_dim = world_dim
         self.ckpt = ckpt
@@ -286,7 +312,7 @@ class MultiTaskPolicy(BCPolicy):
         self.model = build_network(lambda: _mlp(n_in, n_out, cfg["hidden"], cfg["layers"]), ckpt["model"], self.path)
         self.x = Normalizer(ckpt["x_mean"], ckpt["x_std"])
         self.a = Normalizer(ckpt["a_mean"], ckpt["a_std"])
-        want = len(ckpt["x_mean"]) - len(ckpt["names"][STATE]) - world_dim - 1
+        want = len(ckpt["x_mean"]) - len(self.keep) - world_dim - 1
         if want != emb.shape[1]:
             raise _bad(self.path, f"its inputs leave {want} values for an instruction embedding of {emb.shape[1]}")
 
@@ -303,11 +329,14 @@ class MultiTaskPolicy(BCPolicy):
         self.low, self.high = env.action_space.low, env.action_space.high
 
     def features(self, obs: dict[str, np.ndarray]) -> np.ndarray:
-        world = obs[ENVIRONMENT_STATE][None]
+        world, state = obs[ENVIRONMENT_STATE][None], obs[STATE][None]
         if world.shape[1] > self.world_dim:
             raise PolicyTaskError(f"the env's environment state has {world.shape[1]} values; the policy learned "
                                   f"at most {self.world_dim}")
-        return _inputs(obs[STATE][None], world, np.array([self.t], np.float32), self.emb, self.world_dim)
+        if state.shape[1] != len(self.state_names):
+            raise PolicyTaskError(f"the env's state has {state.shape[1]} values; the policy learned "
+                                  f"{len(self.state_names)} ({self.state_names[0]} ... {self.state_names[-1]})")
+        return _inputs(state[:, self.keep], world, np.array([self.t], np.float32), self.emb, self.world_dim)
 
 
 def is_multitask(path: Path | str) -> bool:
@@ -315,5 +344,5 @@ def is_multitask(path: Path | str) -> bool:
     return load_checkpoint(path).get("kind") == KIND
 
 
-__all__ = ["KIND", "FrameSampler", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks",
-           "instruction_embedding", "is_multitask", "load_tasks", "train"]
+__all__ = ["KIND", "VELOCITY_SUFFIX", "FrameSampler", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks",
+           "instruction_embedding", "is_multitask", "load_tasks", "state_columns", "train"]

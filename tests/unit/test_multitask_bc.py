@@ -12,9 +12,16 @@ import pytest
 
 from gendex.data.episode import Episode
 from gendex.data.lerobot_v3 import LeRobotV3Writer
-from gendex.imitation.bc import load_policy
+from gendex.imitation.bc import PolicyError, load_policy
 from gendex.imitation.frames import DatasetReadError
-from gendex.imitation.multitask import FrameSampler, MultiTaskConfig, MultiTaskPolicy, PolicyTaskError, train
+from gendex.imitation.multitask import (
+    FrameSampler,
+    MultiTaskConfig,
+    MultiTaskPolicy,
+    PolicyTaskError,
+    state_columns,
+    train,
+)
 from gendex_envs.observation import ENVIRONMENT_STATE, STATE
 
 S, A = 4, 2
@@ -44,9 +51,9 @@ def _episode(task: str, seed: int, t: int = 12) -> Episode:
                    environment_state_names=tuple(f"w{i}" for i in range(k)))
 
 
-def _dataset(root, task: str, action_names=None) -> None:
+def _dataset(root, task: str, action_names=None, state_names=None) -> None:
     k = TASKS[task][2]
-    with LeRobotV3Writer(root, fps=20, robot_type="toy", state_names=[f"s{i}" for i in range(S)],
+    with LeRobotV3Writer(root, fps=20, robot_type="toy", state_names=state_names or [f"s{i}" for i in range(S)],
                          action_names=action_names or [f"a{i}" for i in range(A)],
                          environment_state_names=[f"w{i}" for i in range(k)]) as w:
         for seed in range(30):
@@ -149,3 +156,45 @@ def test_the_fit_runs_on_the_threads_asked_and_gives_them_back(datasets, tmp_pat
     with pytest.raises(ValueError, match="threads 0 must be at least 1"):
         train(datasets, tmp_path / "none", fake_embed, config=MultiTaskConfig(steps=1), threads=0)
     assert not (tmp_path / "none").exists()
+
+
+JOINT_STATE = ["j0.pos", "j1.pos", "j0.vel", "j1.vel"]
+
+
+def _acts(policy, state: np.ndarray) -> np.ndarray:
+    policy.reset()
+    return policy.act({STATE: state, ENVIRONMENT_STATE: np.full(3, 0.5, np.float32)})
+
+
+@pytest.mark.parametrize("velocity", [False, True])
+def test_joint_velocities_are_read_only_when_asked(tmp_path, velocity):
+    _dataset(tmp_path / "d" / "lerobot", "GenDex/ToyToward-v0", state_names=JOINT_STATE)
+    path = train([tmp_path / "d"], tmp_path / "mt", fake_embed,
+                 config=MultiTaskConfig(chunk=2, steps=30, hidden=32, layers=1, joint_velocity=velocity))
+    policy = MultiTaskPolicy(path)
+    policy.bind(_env(TASKS["GenDex/ToyToward-v0"][0]))
+    # inputs: the state entries read, the 3 world values, the step and the 16-value embedding
+    assert len(policy.ckpt["x_mean"]) == (4 if velocity else 2) + 3 + 1 + 16
+    still, moving = np.zeros(4, np.float32), np.array([0, 0, 5, -5], np.float32)
+    assert np.array_equal(_acts(policy, still), _acts(policy, moving)) is not velocity
+    with pytest.raises(PolicyTaskError, match="state has 3 values; the policy learned 4 \\(j0.pos ... j1.vel\\)"):
+        _acts(policy, np.zeros(3, np.float32))
+
+
+def test_checkpoints_from_before_the_switch_read_velocities_and_a_bad_switch_is_refused(tmp_path):
+    import torch
+
+    _dataset(tmp_path / "d" / "lerobot", "GenDex/ToyToward-v0", state_names=JOINT_STATE)
+    path = train([tmp_path / "d"], tmp_path / "mt", fake_embed,
+                 config=MultiTaskConfig(chunk=2, steps=3, hidden=16, layers=1, joint_velocity=True))
+    ckpt = torch.load(path, weights_only=True)
+    del ckpt["config"]["joint_velocity"]  # what a checkpoint written before the field holds
+    torch.save(ckpt, path)
+    assert MultiTaskPolicy(path).keep.tolist() == [0, 1, 2, 3]
+    ckpt["config"]["joint_velocity"] = "no"
+    torch.save(ckpt, path)
+    with pytest.raises(PolicyError, match="config.joint_velocity 'no' must be true or false"):
+        MultiTaskPolicy(path)
+    with pytest.raises(ValueError, match="joint_velocity 1 must be True or False"):
+        MultiTaskConfig(joint_velocity=1)
+    assert state_columns(JOINT_STATE, False).tolist() == [0, 1]
