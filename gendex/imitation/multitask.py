@@ -298,8 +298,8 @@ class MultiTaskPolicy(BCPolicy):
             raise _bad(self.path, "_embeddings must be a finite [tasks, E] float tensor, a row per task")
         names, velocity = ckpt["names"].get(STATE) if isinstance(ckpt["names"], dict) else None, \
             ckpt["config"].get("joint_velocity", True)
-        if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-            raise _bad(self.path, f"names[{STATE!r}] must be the list of the state's entry names")
+        if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+            raise _bad(self.path, f"names[{STATE!r}] must be the (non-empty) list of the state's entry names")
         if type(velocity) is not bool:
             raise _bad(self.path, f"config.joint_velocity {velocity!r} must be true or false")
         self.state_names, self.keep = names, state_columns(names, velocity)

@@ -195,6 +195,10 @@ def test_checkpoints_from_before_the_switch_read_velocities_and_a_bad_switch_is_
     torch.save(ckpt, path)
     with pytest.raises(PolicyError, match="config.joint_velocity 'no' must be true or false"):
         MultiTaskPolicy(path)
+    ckpt["config"]["joint_velocity"], ckpt["names"][STATE] = False, []
+    torch.save(ckpt, path)
+    with pytest.raises(PolicyError, match="must be the \\(non-empty\\) list of the state's entry names"):
+        MultiTaskPolicy(path)
     with pytest.raises(ValueError, match="joint_velocity 1 must be True or False"):
         MultiTaskConfig(joint_velocity=1)
     assert state_columns(JOINT_STATE, False).tolist() == [0, 1]
