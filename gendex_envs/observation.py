@@ -35,6 +35,8 @@ STATE = "observation.state"
 ENVIRONMENT_STATE = "observation.environment_state"
 IMAGES = "observation.images."
 POSE_FIELDS = ("pos.x", "pos.y", "pos.z", "quat.w", "quat.x", "quat.y", "quat.z")
+POSITION_SUFFIX, VELOCITY_SUFFIX = ".pos", ".vel"
+"""How ``observation.state`` names a joint's position and velocity (``<joint>.pos``, ``<joint>.vel``)."""
 
 
 def _task_env(env: gym.Env) -> TaskEnv:
@@ -48,7 +50,7 @@ def _task_env(env: gym.Env) -> TaskEnv:
 
 def robot_state_names(env: gym.Env) -> list[str]:
     names = [j.name for j in _task_env(env).agent.robot.get_active_joints()]
-    return [f"{n}.pos" for n in names] + [f"{n}.vel" for n in names]
+    return [f"{n}{POSITION_SUFFIX}" for n in names] + [f"{n}{VELOCITY_SUFFIX}" for n in names]
 
 
 def robot_state(env: gym.Env) -> torch.Tensor:
@@ -139,5 +141,6 @@ class LeRobotObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs
         return out
 
 
-__all__ = ["ENVIRONMENT_STATE", "IMAGES", "STATE", "LeRobotObservation", "environment_state", "flat_float_state",
-           "environment_state_names", "feature_names", "robot_state", "robot_state_names"]
+__all__ = ["ENVIRONMENT_STATE", "IMAGES", "POSITION_SUFFIX", "STATE", "VELOCITY_SUFFIX", "LeRobotObservation",
+           "environment_state", "flat_float_state", "environment_state_names", "feature_names", "robot_state",
+           "robot_state_names"]

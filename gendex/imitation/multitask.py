@@ -46,7 +46,7 @@ from gendex.imitation.bc import (
     save_checkpoint,
 )
 from gendex.imitation.frames import DatasetReadError, Frames, load_frames
-from gendex_envs.observation import ENVIRONMENT_STATE, STATE
+from gendex_envs.observation import ENVIRONMENT_STATE, STATE, VELOCITY_SUFFIX
 
 log = logging.getLogger(__name__)
 
@@ -85,9 +85,6 @@ class MultiTaskConfig:
         if type(self.joint_velocity) is not bool:
             raise ValueError(f"joint_velocity {self.joint_velocity!r} must be True or False")
 
-
-VELOCITY_SUFFIX = ".vel"
-"""How ``observation.state`` names a joint velocity (``<joint>.vel``; positions are ``<joint>.pos``)."""
 
 
 def state_columns(names: Sequence[str], joint_velocity: bool) -> np.ndarray:
@@ -296,8 +293,8 @@ class MultiTaskPolicy(BCPolicy):
         if emb is None or emb.ndim != 2 or len(emb) != len(tasks) or not emb.is_floating_point() \
                 or not bool(torch.isfinite(emb).all()):
             raise _bad(self.path, "_embeddings must be a finite [tasks, E] float tensor, a row per task")
-        names, velocity = ckpt["names"].get(STATE) if isinstance(ckpt["names"], dict) else None, \
-            ckpt["config"].get("joint_velocity", True)
+        names = ckpt["names"].get(STATE) if isinstance(ckpt["names"], dict) else None
+        velocity = ckpt["config"].get("joint_velocity", True)  # checkpoints from before the switch read them
         if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
             raise _bad(self.path, f"names[{STATE!r}] must be the (non-empty) list of the state's entry names")
         if type(velocity) is not bool:
@@ -344,5 +341,5 @@ def is_multitask(path: Path | str) -> bool:
     return load_checkpoint(path).get("kind") == KIND
 
 
-__all__ = ["KIND", "VELOCITY_SUFFIX", "FrameSampler", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks",
+__all__ = ["KIND", "FrameSampler", "MultiTaskConfig", "MultiTaskPolicy", "TaskData", "embed_tasks",
            "instruction_embedding", "is_multitask", "load_tasks", "state_columns", "train"]
